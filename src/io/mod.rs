@@ -1,0 +1,4 @@
+//! Files in and out: parameter files, atomic writes.
+
+pub mod atomic;
+pub mod params_file;

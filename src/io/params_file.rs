@@ -1,0 +1,166 @@
+//! Reading and writing parameter files (the JSON of [`Params`]), with errors that name
+//! the file, the line and the field.
+
+use std::path::{Path, PathBuf};
+
+use crate::model::params::{ParamError, Params};
+
+/// A parameter file that cannot be used.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ParamsFileError {
+    #[error("cannot read parameter file {path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("parameter file {path}, line {line}, column {column}: {message}")]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    #[error("parameter file {path}: {source}")]
+    Invalid { path: PathBuf, source: ParamError },
+    #[error("cannot write parameter file {path}: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// Reads and validates a parameter file.
+pub fn read(path: &Path) -> Result<Params, ParamsFileError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ParamsFileError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(&text, path)
+}
+
+/// Parses and validates parameter JSON; `path` is only used in error messages.
+pub fn parse(text: &str, path: &Path) -> Result<Params, ParamsFileError> {
+    let params: Params = serde_json::from_str(text).map_err(|e| ParamsFileError::Syntax {
+        path: path.to_path_buf(),
+        line: e.line(),
+        column: e.column(),
+        message: e
+            .to_string()
+            .split(" at line ")
+            .next()
+            .unwrap_or("")
+            .to_string(),
+    })?;
+    params
+        .validate()
+        .map_err(|source| ParamsFileError::Invalid {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    Ok(params)
+}
+
+/// Writes a parameter file atomically (temporary file in the same folder, then rename).
+pub fn write(path: &Path, params: &Params) -> Result<(), ParamsFileError> {
+    let text = serde_json::to_string_pretty(params).expect("Params always serialises");
+    crate::io::atomic::write(path, text.as_bytes()).map_err(|source| ParamsFileError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets;
+
+    fn worm_json() -> serde_json::Value {
+        serde_json::to_value(presets::load("worm-gear").unwrap()).unwrap()
+    }
+
+    fn parse_value(v: &serde_json::Value) -> Result<Params, ParamsFileError> {
+        parse(
+            &serde_json::to_string_pretty(v).unwrap(),
+            Path::new("p.json"),
+        )
+    }
+
+    #[test]
+    fn a_written_file_reads_back_equal() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.json");
+        let p = presets::load("roller-gear-cam").unwrap();
+        write(&path, &p).unwrap();
+        assert_eq!(read(&path).unwrap(), p);
+    }
+
+    #[test]
+    fn invalid_values_give_the_typed_error_naming_the_field() {
+        let mut v = worm_json();
+        v["Kw"] = serde_json::json!(-3.1e5);
+        match parse_value(&v) {
+            Err(ParamsFileError::Invalid {
+                source: ParamError::NotPositive { name: "Kw", .. },
+                ..
+            }) => {}
+            other => panic!("{other:?}"),
+        }
+        let mut v = worm_json();
+        v["Rw"] = serde_json::json!(0.0);
+        assert!(matches!(
+            parse_value(&v),
+            Err(ParamsFileError::Invalid {
+                source: ParamError::Zero { name: "Rw", .. },
+                ..
+            })
+        ));
+        let mut v = worm_json();
+        v["theta_bg"] = serde_json::json!(-1e-4);
+        assert!(matches!(
+            parse_value(&v),
+            Err(ParamsFileError::Invalid {
+                source: ParamError::Negative {
+                    name: "theta_bg",
+                    ..
+                },
+                ..
+            })
+        ));
+        let mut v = worm_json();
+        v.as_object_mut().unwrap().remove("Kg");
+        assert!(matches!(
+            parse_value(&v),
+            Err(ParamsFileError::Invalid {
+                source: ParamError::Missing { name: "Kg", .. },
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn syntax_errors_and_unknown_fields_name_the_line() {
+        let err = parse(
+            "{\n  \"topology\": \"spur_gear\",\n  \"Jm\": ,\n}",
+            Path::new("bad.json"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("bad.json, line 3"), "{err}");
+        let mut v = worm_json();
+        v["Kww"] = serde_json::json!(1.0);
+        let err = parse_value(&v).unwrap_err().to_string();
+        assert!(
+            err.contains("unknown field `Kww`") && err.contains("line"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_missing_file_names_the_path() {
+        let err = read(Path::new("/nonexistent/params.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("/nonexistent/params.json"), "{err}");
+    }
+}

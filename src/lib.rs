@@ -1,0 +1,9 @@
+//! rtid — simulation and identification of CNC rotary tables (worm-gear and
+//! roller-gear-cam drives), after the model of IMECE2008-66108.
+//!
+//! Data flows one way: files (`io`) → simulation (`model`, `controller`, `sim`) →
+//! results → report.
+#![forbid(unsafe_code)]
+
+pub mod io;
+pub mod model;

@@ -1,0 +1,66 @@
+//! Gear meshes with free play (MODEL.md §2): a dead zone of half-width `b` that
+//! transmits stiffness plus internal damping only while the teeth touch, and never
+//! pulls while they separate.
+
+/// The dead-zone deflection: δ − b above the gap, δ + b below it, 0 inside.
+#[inline(always)]
+pub fn dead_zone(delta: f64, b: f64) -> f64 {
+    delta - delta.clamp(-b, b)
+}
+
+/// Torque transmitted by a mesh of stiffness `k`, internal damping `c` and backlash
+/// half-width `b`, at twist `delta` and twist rate `rate`.
+///
+/// With `b > 0` one flank touches at a time: the torque is k·dz + c·rate while in
+/// contact, clamped to the sign of the contact (a separating flank pushes nothing,
+/// it does not pull), and 0 inside the gap. With `b = 0` (a preloaded mesh, both
+/// flanks engaged) it is the linear spring-damper k·δ + c·rate in both directions.
+#[inline(always)]
+pub fn mesh_torque(k: f64, c: f64, b: f64, delta: f64, rate: f64) -> f64 {
+    if b == 0.0 {
+        return k * delta + c * rate;
+    }
+    let dz = dead_zone(delta, b);
+    let t = k * dz + c * rate;
+    if dz > 0.0 {
+        t.max(0.0)
+    } else if dz < 0.0 {
+        t.min(0.0)
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_torque_inside_the_gap_whatever_the_rate() {
+        for &d in &[-0.99e-4, -3e-5, 0.0, 2e-5, 0.99e-4] {
+            for &v in &[-10.0, 0.0, 10.0] {
+                assert_eq!(mesh_torque(3e5, 0.1, 1e-4, d, v), 0.0, "d={d} v={v}");
+            }
+        }
+    }
+
+    #[test]
+    fn contact_transmits_spring_plus_damper() {
+        let t = mesh_torque(3e5, 0.1, 1e-4, 3e-4, 2.0);
+        assert!((t - (3e5 * 2e-4 + 0.2)).abs() < 1e-12);
+        let t = mesh_torque(3e5, 0.1, 1e-4, -3e-4, -2.0);
+        assert!((t + (3e5 * 2e-4 + 0.2)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_separating_flank_never_pulls() {
+        // In contact on the positive flank but separating fast: damping would pull.
+        assert_eq!(mesh_torque(3e5, 100.0, 1e-4, 1.01e-4, -50.0), 0.0);
+        assert_eq!(mesh_torque(3e5, 100.0, 1e-4, -1.01e-4, 50.0), 0.0);
+    }
+
+    #[test]
+    fn a_preloaded_mesh_is_linear_both_ways() {
+        assert_eq!(mesh_torque(1e6, 2.0, 0.0, 1e-6, -5.0), 1e6 * 1e-6 - 10.0);
+    }
+}

@@ -1,0 +1,154 @@
+//! [`Drive`]: the validated parameters compiled into the constants the kernel reads
+//! (inverse inertias, merged bodies of the direct topology, flags for the optional
+//! terms). A plain `Copy` struct, built once per simulation.
+
+use super::backlash::dead_zone;
+use super::params::{ParamError, Params, Topology, GRAVITY};
+
+/// Index of each state in the kernel's state vector. For the direct topology the
+/// shaft slots mirror the motor (θw ≡ θm).
+pub mod idx {
+    /// Motor angle θm, rad.
+    pub const THETA_M: usize = 0;
+    /// Motor velocity ωm, rad/s.
+    pub const OMEGA_M: usize = 1;
+    /// Driving-shaft angle θw, rad.
+    pub const THETA_W: usize = 2;
+    /// Driving-shaft velocity ωw, rad/s.
+    pub const OMEGA_W: usize = 3;
+    /// Axial displacement of the driving unit xw, m.
+    pub const X_W: usize = 4;
+    /// Axial velocity vw, m/s.
+    pub const V_W: usize = 5;
+    /// Table angle θt, rad.
+    pub const THETA_T: usize = 6;
+    /// Table velocity ωt, rad/s.
+    pub const OMEGA_T: usize = 7;
+}
+
+/// Number of states.
+pub const NSTATE: usize = 8;
+
+/// The model's constants in the form the kernel uses them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Drive {
+    /// Whether a spur-gear stage separates motor and driving shaft (4 DOF).
+    pub spur: bool,
+    pub(crate) inv_jm: f64,
+    pub(crate) inv_jw: f64,
+    pub(crate) inv_jt: f64,
+    pub(crate) inv_mw: f64,
+    pub(crate) cm: f64,
+    pub(crate) cw: f64,
+    pub(crate) cb: f64,
+    pub(crate) ct: f64,
+    pub(crate) cig: f64,
+    pub(crate) ciw: f64,
+    /// Coulomb friction of motor, shaft, table (direct: motor includes the shaft's).
+    pub(crate) fc: [f64; 3],
+    pub(crate) kg: f64,
+    pub(crate) kw: f64,
+    pub(crate) kb: f64,
+    pub(crate) rg: f64,
+    pub(crate) rw: f64,
+    pub(crate) inv_r: f64,
+    pub(crate) bg: f64,
+    pub(crate) bw: f64,
+    pub(crate) fluct: bool,
+    pub(crate) w: f64,
+    pub(crate) n: f64,
+    pub(crate) phase: f64,
+    pub(crate) unbalance: bool,
+    /// m·g·e of the unbalance, N·m.
+    pub(crate) mge: f64,
+    pub(crate) psi: f64,
+}
+
+impl Drive {
+    /// Validates `p` and compiles it.
+    pub fn new(p: &Params) -> Result<Self, ParamError> {
+        p.validate()?;
+        let spur = p.topology == Topology::SpurGear;
+        // Direct drive: the shaft is part of the motor body.
+        let (jm, cm, fm) = if spur {
+            (p.jm, p.cm, p.fm)
+        } else {
+            (p.jm + p.jw, p.cm + p.cw, p.fm + p.fw)
+        };
+        Ok(Drive {
+            spur,
+            inv_jm: 1.0 / jm,
+            inv_jw: if spur { 1.0 / p.jw } else { 0.0 },
+            inv_jt: 1.0 / p.jt,
+            inv_mw: 1.0 / p.mw,
+            cm,
+            cw: if spur { p.cw } else { 0.0 },
+            cb: p.cb,
+            ct: p.ct,
+            cig: p.cig.unwrap_or(0.0),
+            ciw: p.ciw,
+            fc: [fm, if spur { p.fw } else { 0.0 }, p.ft],
+            kg: p.kg.unwrap_or(0.0),
+            kw: p.kw,
+            kb: p.kb,
+            rg: p.rg.unwrap_or(1.0),
+            rw: p.rw,
+            inv_r: 1.0 / p.r,
+            bg: p.theta_bg.unwrap_or(0.0),
+            bw: p.theta_bw,
+            fluct: p.w != 0.0,
+            w: p.w,
+            n: p.fluct_order,
+            phase: p.fluct_phase,
+            unbalance: p.unbalance_mass > 0.0,
+            mge: p.unbalance_mass * GRAVITY * p.unbalance_radius,
+            psi: p.unbalance_phase,
+        })
+    }
+
+    /// Total drive ratio, table turns per motor turn.
+    pub fn ratio(&self) -> f64 {
+        self.rg * self.rw
+    }
+
+    /// Coulomb friction torques of motor, shaft and table bodies, N·m.
+    pub fn friction(&self) -> [f64; 3] {
+        self.fc
+    }
+
+    /// Total mechanical energy (kinetic + mesh and bearing springs + unbalance
+    /// potential), J. Conserved by the equations without damping, friction and
+    /// input; the kernel's energy test measures its drift.
+    pub fn energy(&self, y: &[f64; NSTATE]) -> f64 {
+        let [tm, wm, tw, ww, xw, vw, tt, wt] = *y;
+        let mut e = 0.5 * wm * wm / self.inv_jm
+            + 0.5 * vw * vw / self.inv_mw
+            + 0.5 * wt * wt / self.inv_jt
+            + 0.5 * self.kb * xw * xw;
+        let shaft = if self.spur {
+            e += 0.5 * ww * ww / self.inv_jw;
+            let dg = dead_zone(self.rg * tm - tw, self.bg);
+            e += 0.5 * self.kg * dg * dg;
+            tw
+        } else {
+            tm
+        };
+        let dw = self.rw * shaft + self.fluctuation(shaft).0 + xw * self.inv_r - tt;
+        let dz = dead_zone(dw, self.bw);
+        e += 0.5 * self.kw * dz * dz;
+        if self.unbalance {
+            e -= self.mge * (tt + self.psi).cos();
+        }
+        e
+    }
+
+    /// Gear fluctuation e(θw) = W·sin(N·θw + φ) and its slope e'(θw), table rad.
+    #[inline(always)]
+    pub fn fluctuation(&self, shaft_angle: f64) -> (f64, f64) {
+        if !self.fluct {
+            return (0.0, 0.0);
+        }
+        let (s, c) = (self.n * shaft_angle + self.phase).sin_cos();
+        (self.w * s, self.w * self.n * c)
+    }
+}
