@@ -5,5 +5,10 @@
 //! results → report.
 #![forbid(unsafe_code)]
 
+pub mod cli;
+pub mod controller;
+pub mod input;
 pub mod io;
 pub mod model;
+pub mod recorder;
+pub mod sim;

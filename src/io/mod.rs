@@ -2,3 +2,4 @@
 
 pub mod atomic;
 pub mod params_file;
+pub mod torque_file;

@@ -2,7 +2,7 @@
 //! (inverse inertias, merged bodies of the direct topology, flags for the optional
 //! terms). A plain `Copy` struct, built once per simulation.
 
-use super::backlash::dead_zone;
+use super::backlash::{dead_zone, mesh_torque};
 use super::params::{ParamError, Params, Topology, GRAVITY};
 
 /// Index of each state in the kernel's state vector. For the direct topology the
@@ -140,6 +140,43 @@ impl Drive {
             e -= self.mge * (tt + self.psi).cos();
         }
         e
+    }
+
+    /// Mesh torques [Tg, Tw] at state `y` (Tg = 0 without a spur stage), N·m: what
+    /// the kernel applies, for diagnostics and contact statistics.
+    pub fn mesh_torques(&self, y: &[f64; NSTATE]) -> [f64; 2] {
+        let [tm, wm, tw, ww, xw, vw, tt, wt] = *y;
+        let (shaft, ws) = if self.spur { (tw, ww) } else { (tm, wm) };
+        let (e, ep) = self.fluctuation(shaft);
+        let dw = self.rw * shaft + e + xw * self.inv_r - tt;
+        let dw_rate = (self.rw + ep) * ws + vw * self.inv_r - wt;
+        let t_w = mesh_torque(self.kw, self.ciw, self.bw, dw, dw_rate);
+        let t_g = if self.spur {
+            mesh_torque(
+                self.kg,
+                self.cig,
+                self.bg,
+                self.rg * tm - tw,
+                self.rg * wm - ww,
+            )
+        } else {
+            0.0
+        };
+        [t_g, t_w]
+    }
+
+    /// Dead-zone deflections [dz(δg), dz(δw)] at state `y`: zero while a mesh is
+    /// inside its gap (out of contact).
+    pub fn mesh_deflections(&self, y: &[f64; NSTATE]) -> [f64; 2] {
+        let [tm, _, tw, _, xw, _, tt, _] = *y;
+        let shaft = if self.spur { tw } else { tm };
+        let dw = self.rw * shaft + self.fluctuation(shaft).0 + xw * self.inv_r - tt;
+        let dg = if self.spur {
+            dead_zone(self.rg * tm - tw, self.bg)
+        } else {
+            0.0
+        };
+        [dg, dead_zone(dw, self.bw)]
     }
 
     /// Gear fluctuation e(θw) = W·sin(N·θw + φ) and its slope e'(θw), table rad.

@@ -1,0 +1,107 @@
+//! `--preset`, `--params`, `--set`: the mechanism every command works on.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context};
+use clap::Args;
+
+use crate::io::params_file;
+use crate::model::{presets, Params};
+
+/// Which parameter set to use, and overrides.
+#[derive(Debug, Clone, Args)]
+pub struct ModelArgs {
+    /// Shipped parameter set: worm-gear or roller-gear-cam (IMECE2008-66108 Table 1).
+    #[arg(long, value_name = "NAME", conflicts_with = "params")]
+    pub preset: Option<String>,
+    /// Parameter file (JSON, SI units), e.g. one written by `rtid params --out`.
+    #[arg(long, value_name = "FILE.json")]
+    pub params: Option<PathBuf>,
+    /// Override one parameter, SI units; repeatable: --set Kw=3.5e5 --set theta_bw=5e-5.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+}
+
+impl ModelArgs {
+    /// The validated parameter set.
+    pub fn load(&self) -> anyhow::Result<Params> {
+        let mut p = match (&self.preset, &self.params) {
+            (Some(name), None) => presets::load(name)?,
+            (None, Some(path)) => params_file::read(path)?,
+            (None, None) => bail!(
+                "no mechanism given: use --preset {} or --params FILE.json",
+                presets::names().collect::<Vec<_>>().join("|")
+            ),
+            (Some(_), Some(_)) => bail!("give either --preset or --params, not both"),
+        };
+        for assignment in &self.set {
+            let (name, value) = parse_assignment(assignment)?;
+            p.set(name, value)
+                .with_context(|| format!("--set {assignment}"))?;
+        }
+        p.validate().context("after --set")?;
+        Ok(p)
+    }
+}
+
+/// `NAME=VALUE` with a finite number.
+pub fn parse_assignment(s: &str) -> anyhow::Result<(&str, f64)> {
+    let Some((name, value)) = s.split_once('=') else {
+        bail!("--set {s}: expected NAME=VALUE, e.g. Kw=3.5e5");
+    };
+    let v: f64 = value
+        .trim()
+        .parse()
+        .with_context(|| format!("--set {s}: `{value}` is not a number"))?;
+    Ok((name.trim(), v))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(preset: &str, set: &[&str]) -> ModelArgs {
+        ModelArgs {
+            preset: Some(preset.into()),
+            params: None,
+            set: set.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    #[test]
+    fn set_overrides_a_preset_value() {
+        let p = args("worm-gear", &["Kw=3.5e5", "theta_bw = 0"])
+            .load()
+            .unwrap();
+        assert_eq!((p.kw, p.theta_bw), (3.5e5, 0.0));
+    }
+
+    #[test]
+    fn bad_assignments_are_named() {
+        for (set, expect) in [
+            ("Kw", "expected NAME=VALUE"),
+            ("Kw=abc", "`abc` is not a number"),
+            ("Kx=1", "unknown parameter `Kx`"),
+            ("Kw=-1", "Kw = -1"),
+            ("Kg=1", "does not apply"),
+        ] {
+            let preset = if set.starts_with("Kg") {
+                "roller-gear-cam"
+            } else {
+                "worm-gear"
+            };
+            let err = format!("{:#}", args(preset, &[set]).load().unwrap_err());
+            assert!(err.contains(expect), "{set}: {err}");
+        }
+    }
+
+    #[test]
+    fn a_mechanism_is_required() {
+        let a = ModelArgs {
+            preset: None,
+            params: None,
+            set: vec![],
+        };
+        assert!(a.load().unwrap_err().to_string().contains("--preset"));
+    }
+}

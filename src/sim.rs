@@ -1,0 +1,252 @@
+//! Running one simulation: the kernel at a fixed step, driven open loop by a
+//! [`TorqueInput`] or closed loop by the [`Controller`] following a [`Trajectory`],
+//! with every step checked for divergence and reported to a [`Recorder`].
+
+use std::fmt::Write as _;
+
+use crate::controller::{Controller, ControllerError, Gains};
+use crate::input::{TorqueInput, Trajectory};
+use crate::model::drive::idx::*;
+use crate::model::{Drive, Kernel, ParamError, Params, States, NSTATE};
+use crate::recorder::Recorder;
+
+/// The RK4 step is chosen so that |λ|·dt ≤ this for the fastest eigenvalue λ of the
+/// linearised model (docs/model.md gives the resulting errors).
+pub const STEP_ACCURACY: f64 = 0.1;
+/// Beyond |λ|·dt = this a step is refused (RK4's stability limit is ≈ 2.8; past 1
+/// the fastest mode is badly resolved).
+pub const STEP_LIMIT: f64 = 1.0;
+/// |velocity| (rad/s or m/s) above which a run is declared diverged.
+pub const VELOCITY_LIMIT: f64 = 1e6;
+
+/// The names of the states, as in the CSV output.
+pub const STATE_NAMES: [&str; NSTATE] = [
+    "motor_angle_rad",
+    "motor_velocity_rad_per_s",
+    "shaft_angle_rad",
+    "shaft_velocity_rad_per_s",
+    "axial_displacement_m",
+    "axial_velocity_m_per_s",
+    "table_angle_rad",
+    "table_velocity_rad_per_s",
+];
+
+/// Why a simulation cannot run or did not finish.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SimError {
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    #[error(transparent)]
+    Controller(#[from] ControllerError),
+    #[error("integration step dt = {dt} s must be positive and finite")]
+    BadStep { dt: f64 },
+    #[error("integration step dt = {dt} s is too large for the stiffest mode of this model (|λ| = {rate:.4e} rad/s): use dt ≤ {max:.3e} s")]
+    StepTooLarge { dt: f64, rate: f64, max: f64 },
+    #[error("control period Tc = {tc} s is not a whole number of integration steps dt = {dt} s")]
+    ControlPeriod { tc: f64, dt: f64 },
+    #[error("simulation diverged at t = {time:.6} s: {state}")]
+    Diverged { time: f64, state: String },
+}
+
+/// The default integration step for `params`: the largest of 1e-5 s, 5e-6 s, 2e-6 s,
+/// 1e-6 s, … with |λ|·dt ≤ [`STEP_ACCURACY`] for the fastest eigenvalue λ of the
+/// linearised model, and a whole number of steps per control period.
+pub fn default_step(params: &Params) -> Result<f64, SimError> {
+    let rate = crate::model::modes::max_rate(params)?;
+    let tc = params.controller.tc;
+    let mut decade = 1e-5;
+    loop {
+        for m in [1.0, 0.5, 0.25, 0.2] {
+            let dt = decade * m;
+            if rate * dt <= STEP_ACCURACY && whole_steps(tc, dt).is_some() {
+                return Ok(dt);
+            }
+        }
+        decade *= 0.1;
+        if decade < 1e-12 {
+            return Err(SimError::StepTooLarge {
+                dt: decade,
+                rate,
+                max: STEP_ACCURACY / rate,
+            });
+        }
+    }
+}
+
+/// `Some(n)` if `period` is `n` steps of `dt` (to 1e-9 relative).
+fn whole_steps(period: f64, dt: f64) -> Option<usize> {
+    let n = (period / dt).round();
+    (n >= 1.0 && (n * dt - period).abs() <= 1e-9 * period).then_some(n as usize)
+}
+
+/// One simulated rotary table.
+#[derive(Clone, Debug)]
+pub struct Simulation {
+    drive: Drive,
+    dt: f64,
+    steps: u64,
+    y: States<1>,
+    kernel: Kernel<1>,
+    load: f64,
+}
+
+impl Simulation {
+    /// A table at rest at zero angles, integrated with step `dt` (checked against the
+    /// model's stiffest mode).
+    pub fn new(params: &Params, dt: f64) -> Result<Self, SimError> {
+        let drive = Drive::new(params)?;
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(SimError::BadStep { dt });
+        }
+        let rate = crate::model::modes::max_rate(params)?;
+        if rate * dt > STEP_LIMIT {
+            return Err(SimError::StepTooLarge {
+                dt,
+                rate,
+                max: STEP_ACCURACY / rate,
+            });
+        }
+        Ok(Simulation {
+            drive,
+            dt,
+            steps: 0,
+            y: [[0.0]; NSTATE],
+            kernel: Kernel::default(),
+            load: 0.0,
+        })
+    }
+
+    /// As [`Simulation::new`] with the [`default_step`].
+    pub fn with_default_step(params: &Params) -> Result<Self, SimError> {
+        Self::new(params, default_step(params)?)
+    }
+
+    /// The integration step, s.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// The simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.steps as f64 * self.dt
+    }
+
+    /// The compiled model.
+    pub fn drive(&self) -> &Drive {
+        &self.drive
+    }
+
+    /// The current state (see `model::idx`).
+    pub fn state(&self) -> [f64; NSTATE] {
+        self.y.map(|s| s[0])
+    }
+
+    /// Sets the state. In the direct topology the shaft follows the motor.
+    pub fn set_state(&mut self, mut y: [f64; NSTATE]) {
+        if !self.drive.spur {
+            y[THETA_W] = y[THETA_M];
+            y[OMEGA_W] = y[OMEGA_M];
+        }
+        self.y = y.map(|v| [v]);
+    }
+
+    /// Sets the external table torque Tload (e.g. a brake), N·m.
+    pub fn set_load(&mut self, torque: f64) {
+        self.load = torque;
+    }
+
+    /// Whether motor, shaft and table stuck in the last step.
+    pub fn stuck(&self) -> [bool; 3] {
+        self.kernel.stuck(0)
+    }
+
+    /// A controller for this table, at rest at the current angles.
+    pub fn controller(&self, params: &Params) -> Result<Controller, SimError> {
+        let gains = Gains::new(params)?;
+        Ok(Controller::new(
+            gains,
+            self.y[THETA_M][0],
+            self.y[THETA_T][0],
+        ))
+    }
+
+    /// Runs `duration` seconds open loop.
+    pub fn run_open_loop<I: TorqueInput, R: Recorder>(
+        &mut self,
+        input: &mut I,
+        duration: f64,
+        recorder: &mut R,
+    ) -> Result<(), SimError> {
+        let n = (duration / self.dt).round() as u64;
+        if self.steps == 0 {
+            recorder.record(0.0, &self.state(), input.step_torques(0.0, self.dt)[0]);
+        }
+        for _ in 0..n {
+            let motor = input.step_torques(self.time(), self.dt);
+            self.advance(&motor.map(|m| [m]))?;
+            recorder.record(self.time(), &self.state(), motor[2]);
+        }
+        Ok(())
+    }
+
+    /// Runs `duration` seconds under `controller`, which follows `trajectory` (table
+    /// angle command, rad) and updates every control period, holding its torque.
+    pub fn run_closed_loop<T: Trajectory + ?Sized, R: Recorder>(
+        &mut self,
+        controller: &mut Controller,
+        trajectory: &T,
+        duration: f64,
+        recorder: &mut R,
+    ) -> Result<(), SimError> {
+        let tc = controller.gains().tc;
+        let per =
+            whole_steps(tc, self.dt).ok_or(SimError::ControlPeriod { tc, dt: self.dt })? as u64;
+        let n = (duration / self.dt).round() as u64;
+        if self.steps == 0 {
+            recorder.record(0.0, &self.state(), controller.torque());
+        }
+        for _ in 0..n {
+            if self.steps % per == 0 {
+                let t = self.time();
+                controller.update(trajectory.angle(t), self.y[THETA_M][0], self.y[THETA_T][0]);
+            }
+            let u = controller.torque();
+            self.advance(&[[u]; 3])?;
+            recorder.record(self.time(), &self.state(), u);
+        }
+        Ok(())
+    }
+
+    /// One step, then the divergence check.
+    #[inline]
+    fn advance(&mut self, motor: &[[f64; 1]; 3]) -> Result<(), SimError> {
+        self.kernel
+            .step(&self.drive, &mut self.y, motor, &[self.load], self.dt);
+        self.steps += 1;
+        let ok = self.y.iter().all(|s| s[0].is_finite())
+            && [OMEGA_M, OMEGA_W, V_W, OMEGA_T]
+                .iter()
+                .all(|&i| self.y[i][0].abs() < VELOCITY_LIMIT);
+        if ok {
+            Ok(())
+        } else {
+            Err(SimError::Diverged {
+                time: self.time(),
+                state: describe(&self.state()),
+            })
+        }
+    }
+}
+
+/// "motor_angle_rad = …, …" for error messages.
+fn describe(y: &[f64; NSTATE]) -> String {
+    let mut s = String::new();
+    for (name, v) in STATE_NAMES.iter().zip(y) {
+        if !s.is_empty() {
+            s.push_str(", ");
+        }
+        let _ = write!(s, "{name} = {v:.6e}");
+    }
+    s
+}
