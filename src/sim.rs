@@ -55,23 +55,19 @@ pub enum SimError {
 pub fn default_step(params: &Params) -> Result<f64, SimError> {
     let rate = crate::model::modes::max_rate(params)?;
     let tc = params.controller.tc;
-    let mut decade = 1e-5;
-    loop {
+    for exponent in 5..12 {
         for m in [1.0, 0.5, 0.25, 0.2] {
-            let dt = decade * m;
+            let dt = m / 10f64.powi(exponent);
             if rate * dt <= STEP_ACCURACY && whole_steps(tc, dt).is_some() {
                 return Ok(dt);
             }
         }
-        decade *= 0.1;
-        if decade < 1e-12 {
-            return Err(SimError::StepTooLarge {
-                dt: decade,
-                rate,
-                max: STEP_ACCURACY / rate,
-            });
-        }
     }
+    Err(SimError::StepTooLarge {
+        dt: 1e-12,
+        rate,
+        max: STEP_ACCURACY / rate,
+    })
 }
 
 /// `Some(n)` if `period` is `n` steps of `dt` (to 1e-9 relative).

@@ -188,4 +188,56 @@ impl Drive {
         let (s, c) = (self.n * shaft_angle + self.phase).sin_cos();
         (self.w * s, self.w * self.n * c)
     }
+
+    /// sin and cos of the fluctuation phase N·θ + φ (exact, for a step's start).
+    #[inline(always)]
+    pub(crate) fn fluctuation_phase(&self, shaft_angle: f64) -> (f64, f64) {
+        (self.n * shaft_angle + self.phase).sin_cos()
+    }
+
+    /// The fluctuation at `shaft_angle` from the phase (sin, cos) known at the
+    /// nearby angle `base`: a rotation by the small angle N·(θ − θ0), exact to
+    /// rounding for the sub-step distances of one integration step.
+    #[inline(always)]
+    pub(crate) fn fluctuation_near(
+        &self,
+        shaft_angle: f64,
+        base: f64,
+        (s0, c0): (f64, f64),
+    ) -> (f64, f64) {
+        let (sx, cx) = small_sin_cos(self.n * (shaft_angle - base));
+        let (s, c) = (s0 * cx + c0 * sx, c0 * cx - s0 * sx);
+        (self.w * s, self.w * self.n * c)
+    }
+}
+
+/// sin and cos of `x`: a Taylor polynomial (error < 1e-17) for |x| < 0.05, the
+/// library functions otherwise.
+#[inline(always)]
+fn small_sin_cos(x: f64) -> (f64, f64) {
+    if x.abs() < 0.05 {
+        let x2 = x * x;
+        let s = x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)));
+        let c = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
+        (s, c)
+    } else {
+        x.sin_cos()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn small_angle_sin_cos_is_exact_to_rounding() {
+        for i in -1000..=1000 {
+            let x = i as f64 * 1e-4;
+            let (s, c) = small_sin_cos(x);
+            assert!(
+                (s - x.sin()).abs() < 2e-17 && (c - x.cos()).abs() < 2e-16,
+                "{x}"
+            );
+        }
+    }
 }
