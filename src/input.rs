@@ -72,7 +72,9 @@ impl TorqueInput for Sine {
             self.half = (0.5 * self.omega * h).sin_cos();
             self.count = 0;
         }
-        if self.count == 0 || t != self.next_t {
+        // Resynchronise periodically, and whenever the caller's clock jumps (its
+        // time is steps·h, which differs from the running t + h only by rounding).
+        if self.count == 0 || (t - self.next_t).abs() > 1e-6 * h {
             self.sc = (self.omega * t).sin_cos();
             self.count = Self::RESYNC;
         }

@@ -157,6 +157,11 @@ impl Simulation {
         self.kernel.stuck(0)
     }
 
+    /// Steps split at a contact event so far (diagnostics; docs/model.md).
+    pub fn contact_events(&self) -> u64 {
+        self.kernel.events()
+    }
+
     /// A controller for this table, at rest at the current angles.
     pub fn controller(&self, params: &Params) -> Result<Controller, SimError> {
         let gains = Gains::new(params)?;
@@ -220,10 +225,16 @@ impl Simulation {
         self.kernel
             .step(&self.drive, &mut self.y, motor, &[self.load], self.dt);
         self.steps += 1;
-        let ok = self.y.iter().all(|s| s[0].is_finite())
-            && [OMEGA_M, OMEGA_W, V_W, OMEGA_T]
-                .iter()
-                .all(|&i| self.y[i][0].abs() < VELOCITY_LIMIT);
+        // A NaN or infinity anywhere reaches the velocities within a step; checking
+        // them (and the angles' sum) catches every divergence at little cost.
+        let y = &self.y;
+        let speed = y[OMEGA_M][0]
+            .abs()
+            .max(y[OMEGA_W][0].abs())
+            .max(y[V_W][0].abs())
+            .max(y[OMEGA_T][0].abs());
+        let ok = speed < VELOCITY_LIMIT
+            && (y[THETA_M][0] + y[THETA_W][0] + y[X_W][0] + y[THETA_T][0]).is_finite();
         if ok {
             Ok(())
         } else {

@@ -5,7 +5,13 @@
 /// The dead-zone deflection: δ − b above the gap, δ + b below it, 0 inside.
 #[inline(always)]
 pub fn dead_zone(delta: f64, b: f64) -> f64 {
-    delta - delta.clamp(-b, b)
+    if delta > b {
+        delta - b
+    } else if delta < -b {
+        delta + b
+    } else {
+        0.0
+    }
 }
 
 /// Torque transmitted by a mesh of stiffness `k`, internal damping `c` and backlash

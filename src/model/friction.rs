@@ -23,7 +23,13 @@ pub fn net_torque(t: f64, w: f64, fc: f64, stuck: &mut bool, decide: bool) -> f6
         t - fc.copysign(w)
     } else {
         // Breaking away from rest: friction opposes the applied torque.
-        t - t.clamp(-fc, fc)
+        if t > fc {
+            t - fc
+        } else if t < -fc {
+            t + fc
+        } else {
+            0.0
+        }
     }
 }
 

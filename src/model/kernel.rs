@@ -46,7 +46,7 @@ pub type States<const L: usize> = [[f64; L]; NSTATE];
 
 /// Values at the start of the current (sub)step, per lane, computed by the first
 /// stage and used by the later stages and the event check.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 struct StepStart<const L: usize> {
     /// Shaft angle, and sin, cos of the fluctuation phase there.
     shaft: [f64; L],
@@ -57,11 +57,9 @@ struct StepStart<const L: usize> {
     rate: [[f64; L]; 2],
 }
 
-/// Integrator scratch and the per-step stick decisions of motor, shaft and table.
+/// The per-step stick decisions of motor, shaft and table.
 #[derive(Clone, Debug)]
 pub struct Kernel<const L: usize> {
-    k: [States<L>; 4],
-    tmp: States<L>,
     stuck: [[bool; L]; 3],
     start: StepStart<L>,
     /// Number of steps split at a contact event (all lanes), for diagnostics.
@@ -71,8 +69,6 @@ pub struct Kernel<const L: usize> {
 impl<const L: usize> Default for Kernel<L> {
     fn default() -> Self {
         Kernel {
-            k: [[[0.0; L]; NSTATE]; 4],
-            tmp: [[0.0; L]; NSTATE],
             stuck: [[false; L]; 3],
             start: StepStart {
                 shaft: [0.0; L],
@@ -245,6 +241,8 @@ impl<const L: usize> Kernel<L> {
     }
 
     /// One classical RK4 step of length `h[l]` for each lane (0 leaves a lane as is).
+    /// Stage values are locals, not fields, so the compiler can keep them in
+    /// registers: the step is a chain of dependent stages, bound by latency.
     #[inline(always)]
     fn rk4<const SPUR: bool>(
         &mut self,
@@ -256,52 +254,36 @@ impl<const L: usize> Kernel<L> {
     ) {
         let y0 = *y;
         let half = h.map(|h| 0.5 * h);
-        let st = &mut self.start;
-        derivative::<L, SPUR>(
+        let mut stuck = self.stuck;
+        let mut st = self.start;
+        let k1 = derivative::<L, SPUR, true>(d, &y0, &motor[0], load, &mut stuck, &mut st);
+        let k2 = derivative::<L, SPUR, false>(
             d,
-            &y0,
-            &motor[0],
-            load,
-            &mut self.stuck,
-            st,
-            true,
-            &mut self.k[0],
-        );
-        axpy(&mut self.tmp, &y0, &half, &self.k[0]);
-        derivative::<L, SPUR>(
-            d,
-            &self.tmp,
+            &axpy(&y0, &half, &k1),
             &motor[1],
             load,
-            &mut self.stuck,
-            st,
-            false,
-            &mut self.k[1],
+            &mut stuck,
+            &mut st,
         );
-        axpy(&mut self.tmp, &y0, &half, &self.k[1]);
-        derivative::<L, SPUR>(
+        let k3 = derivative::<L, SPUR, false>(
             d,
-            &self.tmp,
+            &axpy(&y0, &half, &k2),
             &motor[1],
             load,
-            &mut self.stuck,
-            st,
-            false,
-            &mut self.k[2],
+            &mut stuck,
+            &mut st,
         );
-        axpy(&mut self.tmp, &y0, h, &self.k[2]);
-        derivative::<L, SPUR>(
+        let k4 = derivative::<L, SPUR, false>(
             d,
-            &self.tmp,
+            &axpy(&y0, h, &k3),
             &motor[2],
             load,
-            &mut self.stuck,
-            st,
-            false,
-            &mut self.k[3],
+            &mut stuck,
+            &mut st,
         );
+        self.stuck = stuck;
+        self.start = st;
         let sixth = h.map(|h| h / 6.0);
-        let [k1, k2, k3, k4] = &self.k;
         for i in 0..NSTATE {
             for l in 0..L {
                 y[i][l] = y0[i][l] + sixth[l] * (k1[i][l] + 2.0 * (k2[i][l] + k3[i][l]) + k4[i][l]);
@@ -363,14 +345,23 @@ fn quadratic(m: &[f64; 3], s: f64) -> f64 {
     a + s * (-3.0 * a + 4.0 * b - c) + s * s * (2.0 * a - 4.0 * b + 2.0 * c)
 }
 
-/// `out = y + a·k`, lane-wise.
+/// Tu = −m·g·e·sin(θt + ψ). Out of line on purpose: inlined, the compiler may
+/// evaluate the `sin` for every stage and discard it when there is no unbalance.
+#[inline(never)]
+fn unbalance_torque(d: &Drive, table_angle: f64) -> f64 {
+    -d.mge * (table_angle + d.psi).sin()
+}
+
+/// `y + a·k`, lane-wise.
 #[inline(always)]
-fn axpy<const L: usize>(out: &mut States<L>, y: &States<L>, a: &[f64; L], k: &States<L>) {
+fn axpy<const L: usize>(y: &States<L>, a: &[f64; L], k: &States<L>) -> States<L> {
+    let mut out = *y;
     for i in 0..NSTATE {
         for l in 0..L {
-            out[i][l] = y[i][l] + a[l] * k[i][l];
+            out[i][l] += a[l] * k[i][l];
         }
     }
+    out
 }
 
 /// The right-hand side of the equations of motion for every lane. With `first`
@@ -378,16 +369,16 @@ fn axpy<const L: usize>(out: &mut States<L>, y: &States<L>, a: &[f64; L], k: &St
 /// `y`, and the step-start values are stored in `st` for the later stages.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn derivative<const L: usize, const SPUR: bool>(
+fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
     d: &Drive,
     y: &States<L>,
     motor: &[f64; L],
     load: &[f64; L],
     stuck: &mut [[bool; L]; 3],
     st: &mut StepStart<L>,
-    first: bool,
-    out: &mut States<L>,
-) {
+) -> States<L> {
+    let first = FIRST;
+    let mut out = [[0.0; L]; NSTATE];
     for l in 0..L {
         let (wm, xw, vw, tt, wt) = (
             y[OMEGA_M][l],
@@ -418,7 +409,7 @@ fn derivative<const L: usize, const SPUR: bool>(
         let tw = mesh_torque(d.kw, d.ciw, d.bw, dw, dw_rate);
 
         let unbalance = if d.unbalance {
-            -d.mge * (tt + d.psi).sin()
+            unbalance_torque(d, tt)
         } else {
             0.0
         };
@@ -457,6 +448,7 @@ fn derivative<const L: usize, const SPUR: bool>(
         out[THETA_T][l] = wt;
         out[OMEGA_T][l] = at;
     }
+    out
 }
 
 #[cfg(test)]
