@@ -1,0 +1,633 @@
+//! The real `rtid` binary, run in temporary folders: what each command prints and
+//! writes, and how it fails.
+
+use std::path::Path;
+use std::process::Output;
+
+use support::*;
+
+/// Running the binary and reading what it leaves behind.
+mod support {
+    use std::path::Path;
+    use std::process::{Command, Output};
+
+    /// Runs `rtid ARGS…` with `dir` as the working directory.
+    pub fn rtid(args: &[&str], dir: &Path) -> Output {
+        Command::new(env!("CARGO_BIN_EXE_rtid"))
+            .args(args)
+            .current_dir(dir)
+            .output()
+            .expect("the rtid binary runs")
+    }
+
+    pub fn stdout(out: &Output) -> String {
+        String::from_utf8(out.stdout.clone()).expect("stdout is UTF-8")
+    }
+
+    pub fn stderr(out: &Output) -> String {
+        String::from_utf8(out.stderr.clone()).expect("stderr is UTF-8")
+    }
+
+    /// Runs `rtid ARGS…`, requires exit code 0 and returns stdout.
+    pub fn rtid_ok(args: &[&str], dir: &Path) -> String {
+        let out = rtid(args, dir);
+        assert!(
+            out.status.success(),
+            "rtid {args:?} failed ({}): {}",
+            out.status,
+            stderr(&out)
+        );
+        stdout(&out)
+    }
+
+    /// Runs `rtid ARGS…` and parses its stdout as JSON.
+    pub fn rtid_json(args: &[&str], dir: &Path) -> serde_json::Value {
+        let text = rtid_ok(args, dir);
+        serde_json::from_str(&text).unwrap_or_else(|e| panic!("rtid {args:?}: {e}\n{text}"))
+    }
+
+    /// A failure reported by `main`: exit code 1, one line `error: …` on stderr naming
+    /// every one of `needles`, no panic. Returns that line.
+    pub fn assert_one_line_error(out: &Output, needles: &[&str]) -> String {
+        let err = stderr(out);
+        assert_eq!(out.status.code(), Some(1), "exit status; stderr: {err}");
+        assert!(!err.contains("panicked"), "panic: {err}");
+        let lines: Vec<&str> = err.lines().collect();
+        assert_eq!(lines.len(), 1, "stderr is one line: {err:?}");
+        assert!(lines[0].starts_with("error: "), "{err}");
+        for needle in needles {
+            assert!(lines[0].contains(needle), "`{needle}` not in: {err}");
+        }
+        lines[0].to_string()
+    }
+
+    /// A CSV of numbers: the header and every row parsed as finite `f64`.
+    pub struct Table {
+        pub header: Vec<String>,
+        pub rows: Vec<Vec<f64>>,
+    }
+
+    impl Table {
+        pub fn read(path: &Path) -> Table {
+            let mut reader =
+                csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            let header = reader
+                .headers()
+                .unwrap()
+                .iter()
+                .map(String::from)
+                .collect::<Vec<_>>();
+            let mut rows = Vec::new();
+            for (i, record) in reader.records().enumerate() {
+                let record = record.unwrap();
+                assert_eq!(record.len(), header.len(), "row {i}: {record:?}");
+                let row: Vec<f64> = record
+                    .iter()
+                    .map(|cell| {
+                        let v: f64 = cell
+                            .parse()
+                            .unwrap_or_else(|_| panic!("row {i}: `{cell}` is not a number"));
+                        assert!(v.is_finite(), "row {i}: `{cell}` is not finite");
+                        v
+                    })
+                    .collect();
+                rows.push(row);
+            }
+            Table { header, rows }
+        }
+
+        /// The index of column `name`.
+        pub fn col(&self, name: &str) -> usize {
+            self.header
+                .iter()
+                .position(|h| h == name)
+                .unwrap_or_else(|| panic!("no column `{name}` in {:?}", self.header))
+        }
+
+        /// Every value of column `name`.
+        pub fn column(&self, name: &str) -> Vec<f64> {
+            let i = self.col(name);
+            self.rows.iter().map(|r| r[i]).collect()
+        }
+
+        /// The last value of column `name`.
+        pub fn last(&self, name: &str) -> f64 {
+            *self.column(name).last().expect("at least one row")
+        }
+    }
+
+    /// The numbers of a JSON array.
+    pub fn numbers(v: &serde_json::Value, key: &str) -> Vec<f64> {
+        v[key]
+            .as_array()
+            .unwrap_or_else(|| panic!("`{key}` is not an array: {v}"))
+            .iter()
+            .map(|x| {
+                x.as_f64()
+                    .unwrap_or_else(|| panic!("{key}: {x} not a number"))
+            })
+            .collect()
+    }
+
+    /// `actual` and `expected` have the same length and agree within `tol`.
+    pub fn assert_close(actual: &[f64], expected: &[f64], tol: f64, what: &str) {
+        assert_eq!(actual.len(), expected.len(), "{what}: {actual:?}");
+        for (a, e) in actual.iter().zip(expected) {
+            assert!((a - e).abs() <= tol, "{what}: {actual:?} vs {expected:?}");
+        }
+    }
+}
+
+const ARCSEC: f64 = std::f64::consts::PI / 180.0 / 3600.0;
+
+const STATE_HEADER: [&str; 10] = [
+    "time_s",
+    "motor_torque_nm",
+    "motor_angle_rad",
+    "motor_velocity_rad_per_s",
+    "shaft_angle_rad",
+    "shaft_velocity_rad_per_s",
+    "axial_displacement_m",
+    "axial_velocity_m_per_s",
+    "table_angle_rad",
+    "table_velocity_rad_per_s",
+];
+
+fn tempdir() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+/// `rtid simulate --preset worm-gear ARGS…` in `dir`.
+fn simulate_worm(args: &[&str], dir: &Path) -> Output {
+    let mut all = vec!["simulate", "--preset", "worm-gear"];
+    all.extend(args);
+    rtid(&all, dir)
+}
+
+mod modes {
+    use super::*;
+
+    fn modes_json(preset: &str) -> serde_json::Value {
+        rtid_json(&["modes", "--preset", preset, "--json"], tempdir().path())
+    }
+
+    #[test]
+    fn worm_gear_frequencies_ascend_and_match_the_linear_model() {
+        let m = modes_json("worm-gear");
+        let clamped = numbers(&m, "clamped_hz");
+        let free = numbers(&m, "free_hz");
+        for hz in [&clamped, &free] {
+            assert!(hz.windows(2).all(|w| w[0] < w[1]), "ascending: {hz:?}");
+        }
+        assert_close(&clamped, &[186.5, 236.9, 1510.7], 0.1, "clamped_hz");
+        assert_close(&free, &[192.0, 253.0, 1510.7], 0.1, "free_hz");
+        assert!(
+            free.iter().all(|&f| f > 1.0),
+            "rigid-body mode listed: {free:?}"
+        );
+    }
+
+    #[test]
+    fn roller_gear_cam_clamped_frequencies() {
+        let m = modes_json("roller-gear-cam");
+        assert_close(
+            &numbers(&m, "clamped_hz"),
+            &[166.9, 932.0],
+            0.1,
+            "clamped_hz",
+        );
+    }
+
+    #[test]
+    fn table_output_names_the_motor_held_modes() {
+        let text = rtid_ok(&["modes", "--preset", "worm-gear"], tempdir().path());
+        assert!(text.contains("motor held"), "{text}");
+        assert!(text.contains("186.5"), "{text}");
+    }
+}
+
+mod simulate {
+    use super::*;
+
+    #[test]
+    fn sine_writes_every_state_at_the_sample_period() {
+        let dir = tempdir();
+        let out = simulate_worm(
+            &[
+                "--input",
+                "sine:freq_hz=100,amp_nm=5",
+                "--duration-s",
+                "0.05",
+                "--out",
+                "run.csv",
+            ],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let csv = Table::read(&dir.path().join("run.csv"));
+        assert_eq!(csv.header, STATE_HEADER);
+        assert_eq!(csv.rows.len(), 501, "0.05 s every 1e-4 s, with t = 0");
+        let time = csv.column("time_s");
+        assert_eq!(time[0], 0.0);
+        assert!((time[500] - 0.05).abs() < 1e-9, "last t = {}", time[500]);
+        assert!(time.windows(2).all(|w| w[1] > w[0]), "time increases");
+        let torque = csv.column("motor_torque_nm");
+        for i in [0, 1, 7, 25, 123, 250, 401, 500] {
+            let expected = 5.0 * (2.0 * std::f64::consts::PI * 100.0 * time[i]).sin();
+            assert!(
+                (torque[i] - expected).abs() < 1e-6,
+                "t = {}: {} vs {expected}",
+                time[i],
+                torque[i]
+            );
+        }
+    }
+
+    #[test]
+    fn json_summary_reports_steps_and_step_size() {
+        let dir = tempdir();
+        let summary = rtid_json(
+            &[
+                "simulate",
+                "--preset",
+                "worm-gear",
+                "--input",
+                "sine:freq_hz=100,amp_nm=5",
+                "--duration-s",
+                "0.05",
+                "--out",
+                "run.csv",
+                "--json",
+            ],
+            dir.path(),
+        );
+        assert_eq!(summary["steps"].as_f64(), Some(5000.0), "{summary}");
+        assert_eq!(summary["dt_s"].as_f64(), Some(1e-5), "{summary}");
+        assert!(dir.path().join("run.csv").is_file());
+    }
+
+    fn move_to_10_degrees(input: &str) {
+        let dir = tempdir();
+        let out = simulate_worm(
+            &["--input", input, "--duration-s", "0.6", "--out", "move.csv"],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let csv = Table::read(&dir.path().join("move.csv"));
+        let mut header = STATE_HEADER.to_vec();
+        header.push("reference_rad");
+        assert_eq!(csv.header, header);
+        let target = 10f64.to_radians();
+        assert!((csv.last("reference_rad") - target).abs() < 1e-12);
+        let error = (csv.last("table_angle_rad") - target) / ARCSEC;
+        assert!(
+            error.abs() < 40.0,
+            "{input}: final error {error:.1} arc-sec"
+        );
+    }
+
+    #[test]
+    fn semi_closed_move_reaches_10_degrees() {
+        move_to_10_degrees("move:target_deg=10");
+    }
+
+    #[test]
+    fn full_closed_move_reaches_10_degrees() {
+        move_to_10_degrees("move:target_deg=10,loop=full_closed");
+    }
+
+    #[test]
+    fn step_torque_switches_on_at_its_time_and_turns_the_table() {
+        let dir = tempdir();
+        let out = simulate_worm(
+            &[
+                "--input",
+                "step:torque_nm=1,at_s=0.01",
+                "--duration-s",
+                "0.03",
+                "--out",
+                "step.csv",
+            ],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let csv = Table::read(&dir.path().join("step.csv"));
+        assert_eq!(csv.rows.len(), 301);
+        for (t, q) in csv
+            .column("time_s")
+            .iter()
+            .zip(csv.column("motor_torque_nm"))
+        {
+            if *t < 0.0099 {
+                assert_eq!(q, 0.0, "t = {t}");
+            } else if *t > 0.0101 {
+                assert_eq!(q, 1.0, "t = {t}");
+            }
+        }
+        assert!(csv.last("motor_angle_rad") > 0.0);
+        assert!(csv.last("table_angle_rad") > 0.0);
+    }
+
+    #[test]
+    fn torque_file_is_interpolated_and_held() {
+        let dir = tempdir();
+        std::fs::write(
+            dir.path().join("torque.csv"),
+            "time_s,motor_torque_nm\n0,0\n0.01,2\n0.02,2\n",
+        )
+        .unwrap();
+        let out = simulate_worm(
+            &[
+                "--input",
+                "file:torque.csv",
+                "--duration-s",
+                "0.03",
+                "--out",
+                "file.csv",
+            ],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let csv = Table::read(&dir.path().join("file.csv"));
+        assert_eq!(csv.rows.len(), 301);
+        let (time, torque) = (csv.column("time_s"), csv.column("motor_torque_nm"));
+        for i in [0, 25, 50, 150, 250, 300] {
+            let expected = (time[i] / 0.01).min(1.0) * 2.0;
+            assert!(
+                (torque[i] - expected).abs() < 1e-9,
+                "t = {}: {} vs {expected}",
+                time[i],
+                torque[i]
+            );
+        }
+    }
+
+    #[test]
+    fn torque_file_with_a_bad_cell_names_file_and_line() {
+        let dir = tempdir();
+        std::fs::write(
+            dir.path().join("torque.csv"),
+            "time_s,motor_torque_nm\n0,0\n0.01,abc\n",
+        )
+        .unwrap();
+        let out = simulate_worm(
+            &[
+                "--input",
+                "file:torque.csv",
+                "--duration-s",
+                "0.03",
+                "--out",
+                "file.csv",
+            ],
+            dir.path(),
+        );
+        assert_one_line_error(&out, &["torque.csv", "line 3", "abc"]);
+        assert!(!dir.path().join("file.csv").exists());
+    }
+}
+
+mod params {
+    use super::*;
+
+    #[test]
+    fn a_saved_override_feeds_modes_and_reads_back() {
+        let dir = tempdir();
+        let out = rtid(
+            &[
+                "params",
+                "--preset",
+                "worm-gear",
+                "--set",
+                "Kw=5e5",
+                "--out",
+                "p.json",
+            ],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(dir.path().join("p.json").is_file());
+
+        let preset = numbers(
+            &rtid_json(&["modes", "--preset", "worm-gear", "--json"], dir.path()),
+            "clamped_hz",
+        )[0];
+        let stiffer = numbers(
+            &rtid_json(&["modes", "--params", "p.json", "--json"], dir.path()),
+            "clamped_hz",
+        )[0];
+        assert!((preset - 186.5).abs() < 0.1, "{preset}");
+        assert!(stiffer > preset + 1.0, "{stiffer} vs {preset}");
+
+        let text = rtid_ok(&["params", "--params", "p.json", "--json"], dir.path());
+        assert!(text.contains("\"Kw\": 500000.0"), "{text}");
+    }
+}
+
+mod errors {
+    use super::*;
+
+    fn modes(args: &[&str]) -> Output {
+        let mut all = vec!["modes"];
+        all.extend(args);
+        rtid(&all, tempdir().path())
+    }
+
+    /// The worm-gear preset as a parameter file in `dir`, changed by `edit`.
+    fn params_file(dir: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value)) {
+        let mut p = rtid_json(&["params", "--preset", "worm-gear", "--json"], dir);
+        edit(&mut p);
+        std::fs::write(dir.join(name), serde_json::to_string_pretty(&p).unwrap()).unwrap();
+    }
+
+    #[test]
+    fn unknown_preset_lists_the_known_ones() {
+        assert_one_line_error(&modes(&["--preset", "worm"]), &["worm-gear"]);
+    }
+
+    #[test]
+    fn negative_stiffness_names_the_parameter() {
+        assert_one_line_error(
+            &modes(&["--preset", "worm-gear", "--set", "Kw=-1"]),
+            &["Kw"],
+        );
+    }
+
+    #[test]
+    fn spur_gear_stiffness_does_not_apply_to_the_roller_cam() {
+        assert_one_line_error(
+            &modes(&["--preset", "roller-gear-cam", "--set", "Kg=1"]),
+            &["Kg", "does not apply"],
+        );
+    }
+
+    #[test]
+    fn params_file_syntax_error_names_file_and_line() {
+        let dir = tempdir();
+        std::fs::write(
+            dir.path().join("broken.json"),
+            "{\n  \"name\": \"x\",\n  \"Jm\": ,\n}\n",
+        )
+        .unwrap();
+        let out = rtid(&["modes", "--params", "broken.json"], dir.path());
+        assert_one_line_error(&out, &["broken.json", "line 3"]);
+    }
+
+    #[test]
+    fn params_file_with_zero_table_inertia_names_it() {
+        let dir = tempdir();
+        params_file(dir.path(), "zero-jt.json", |p| p["Jt"] = 0.0.into());
+        let out = rtid(&["modes", "--params", "zero-jt.json"], dir.path());
+        assert_one_line_error(&out, &["zero-jt.json", "Jt"]);
+    }
+
+    #[test]
+    fn a_mechanism_is_required() {
+        assert_one_line_error(&modes(&[]), &["--preset", "--params"]);
+    }
+
+    #[test]
+    fn sine_without_amplitude_is_rejected_by_the_parser() {
+        let out = simulate_worm(
+            &[
+                "--input",
+                "sine:freq_hz=1",
+                "--duration-s",
+                "0.01",
+                "--out",
+                "x.csv",
+            ],
+            tempdir().path(),
+        );
+        let err = stderr(&out);
+        assert!(!out.status.success());
+        assert!(err.contains("amp_nm"), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+
+    #[test]
+    fn negative_duration_is_rejected() {
+        let dir = tempdir();
+        let out = simulate_worm(
+            &[
+                "--input",
+                "sine:freq_hz=100,amp_nm=5",
+                "--duration-s",
+                "-1",
+                "--out",
+                "x.csv",
+            ],
+            dir.path(),
+        );
+        assert_one_line_error(&out, &["--duration-s"]);
+        assert!(!dir.path().join("x.csv").exists());
+    }
+
+    #[test]
+    fn negative_duration_after_an_equals_sign_is_rejected() {
+        let dir = tempdir();
+        let out = simulate_worm(
+            &[
+                "--input",
+                "sine:freq_hz=100,amp_nm=5",
+                "--duration-s=-1",
+                "--out",
+                "x.csv",
+            ],
+            dir.path(),
+        );
+        assert_one_line_error(&out, &["--duration-s -1", "positive"]);
+        assert!(!dir.path().join("x.csv").exists());
+    }
+
+    #[test]
+    fn too_large_a_step_is_rejected() {
+        let dir = tempdir();
+        let out = simulate_worm(
+            &[
+                "--input",
+                "sine:freq_hz=100,amp_nm=5",
+                "--duration-s",
+                "0.01",
+                "--dt-s",
+                "1e-2",
+                "--out",
+                "x.csv",
+            ],
+            dir.path(),
+        );
+        assert_one_line_error(&out, &["too large"]);
+        assert!(!dir.path().join("x.csv").exists());
+    }
+}
+
+mod atomic_output {
+    use super::*;
+
+    const OLD: &str = "an earlier run\n";
+
+    /// Runs a failing `simulate` over an existing `run.csv`; it must be left as it was,
+    /// with no temporary file beside it.
+    fn failing_run_keeps_old_output(args: &[&str]) -> String {
+        let dir = tempdir();
+        let path = dir.path().join("run.csv");
+        std::fs::write(&path, OLD).unwrap();
+        let mut all = args.to_vec();
+        all.extend(["--out", "run.csv"]);
+        let out = simulate_worm(&all, dir.path());
+        let line = assert_one_line_error(&out, &[]);
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), OLD);
+        let files: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(files, ["run.csv"]);
+        line
+    }
+
+    #[test]
+    fn a_rejected_step_leaves_the_previous_output() {
+        let line = failing_run_keeps_old_output(&[
+            "--input",
+            "sine:freq_hz=100,amp_nm=5",
+            "--duration-s",
+            "0.01",
+            "--dt-s",
+            "1e-2",
+        ]);
+        assert!(line.contains("too large"), "{line}");
+    }
+
+    /// A control period that is not a whole number of steps fails inside the
+    /// simulation, after the CSV header has been written to the temporary file.
+    #[test]
+    fn a_failure_mid_write_leaves_the_previous_output() {
+        let line = failing_run_keeps_old_output(&[
+            "--input",
+            "move:target_deg=10",
+            "--duration-s",
+            "0.01",
+            "--dt-s",
+            "3e-6",
+        ]);
+        assert!(line.contains("run.csv"), "{line}");
+    }
+}
+
+mod help {
+    use super::*;
+
+    #[test]
+    fn top_level_help_names_the_presets() {
+        let text = rtid_ok(&["--help"], tempdir().path());
+        assert!(text.contains("worm-gear"), "{text}");
+        assert!(text.contains("roller-gear-cam"), "{text}");
+    }
+
+    #[test]
+    fn simulate_help_lists_the_inputs() {
+        let text = rtid_ok(&["simulate", "--help"], tempdir().path());
+        for input in ["sine:", "step:", "file:", "move:"] {
+            assert!(text.contains(input), "{input}: {text}");
+        }
+    }
+}
