@@ -46,19 +46,29 @@ pub struct Args {
     #[arg(long, value_name = "SPEC")]
     pub input: InputSpec,
     /// Simulated time, s.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub duration_s: f64,
     /// Output CSV (written atomically).
     #[arg(long, value_name = "FILE.csv")]
     pub out: PathBuf,
     /// Integration step, s (default: from the stiffest mode).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub dt_s: Option<f64>,
     /// Period of the output samples, s (rounded to whole steps).
-    #[arg(long, value_name = "SECONDS", default_value_t = 1e-4)]
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 1e-4,
+        allow_negative_numbers = true
+    )]
     pub sample_s: f64,
     /// Constant external torque on the table (e.g. a brake), N·m.
-    #[arg(long, value_name = "NM", default_value_t = 0.0)]
+    #[arg(
+        long,
+        value_name = "NM",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
     pub load_nm: f64,
     /// Print a JSON summary instead of a table.
     #[arg(long)]
@@ -218,6 +228,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         None => Simulation::with_default_step(&p)?,
     };
     sim.set_load(a.load_nm);
+    if !(a.sample_s > 0.0 && a.sample_s.is_finite()) {
+        bail!(
+            "--sample-s {}: must be a positive number of seconds",
+            a.sample_s
+        );
+    }
+    if !a.load_nm.is_finite() {
+        bail!("--load-nm {}: must be a finite torque in N·m", a.load_nm);
+    }
     let every = ((a.sample_s / sim.dt()).round() as u64).max(1);
     let started = Instant::now();
     let closed = matches!(a.input, InputSpec::Move { .. });

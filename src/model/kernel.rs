@@ -52,6 +52,8 @@ struct StepStart<const L: usize> {
     shaft: [f64; L],
     sin: [f64; L],
     cos: [f64; L],
+    /// Steps left before the phase is computed afresh (0: compute now).
+    fresh: [u32; L],
     /// Twist and twist rate of the spur mesh (0) and the drive mesh (1).
     twist: [[f64; L]; 2],
     rate: [[f64; L]; 2],
@@ -74,6 +76,7 @@ impl<const L: usize> Default for Kernel<L> {
                 shaft: [0.0; L],
                 sin: [0.0; L],
                 cos: [1.0; L],
+                fresh: [0; L],
                 twist: [[0.0; L]; 2],
                 rate: [[0.0; L]; 2],
             },
@@ -395,7 +398,8 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
         let (e, ep) = if !d.fluct {
             (0.0, 0.0)
         } else if first {
-            let (s, c) = d.fluctuation_phase(shaft);
+            let (s, c) =
+                d.fluctuation_phase(shaft, st.shaft[l], (st.sin[l], st.cos[l]), &mut st.fresh[l]);
             st.shaft[l] = shaft;
             st.sin[l] = s;
             st.cos[l] = c;
