@@ -3,33 +3,54 @@
 //! other torque on it (the model's mass matrix is diagonal), lies within ±fc; it
 //! slides with fc opposing its motion otherwise.
 //!
-//! The kernel decides stick once per integration step, at the step's first stage,
-//! and holds that decision through the step's remaining stages. A sliding body whose
-//! velocity changes sign within a step is put to rest at the end of the step (its
-//! velocity set to exactly zero), so the next step decides between stick and
-//! reversal. A stuck body's velocity is exactly zero and stays so: it cannot creep.
+//! The kernel decides once per integration step, at the step's first stage, and
+//! holds the decision — stuck, or sliding against a friction torque of fixed sign —
+//! through the step's remaining stages. A sliding body whose velocity changes sign
+//! within a step is put to rest at the end of the step (its velocity set to exactly
+//! zero), so the next step decides between sticking and reversing. A stuck body's
+//! velocity is exactly zero and stays so: it cannot creep.
 
-/// Net torque on a body with Coulomb friction `fc`, given the sum `t` of all other
-/// torques on it and its velocity `w`. When `decide` is set, `stuck` is updated to
-/// whether the body sticks now; otherwise the earlier decision is kept.
-#[inline(always)]
-pub fn net_torque(t: f64, w: f64, fc: f64, stuck: &mut bool, decide: bool) -> f64 {
-    if decide {
-        *stuck = w == 0.0 && t.abs() <= fc;
-    }
-    if *stuck {
-        0.0
-    } else if w != 0.0 {
-        t - fc.copysign(w)
-    } else {
-        // Breaking away from rest: friction opposes the applied torque.
-        if t > fc {
-            t - fc
+/// The friction state of one body over one step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Friction {
+    /// Friction torque opposing the motion, N·m (signed; 0 when stuck).
+    pub torque: f64,
+    /// 1 while the body moves, 0 while it sticks (multiplies its acceleration).
+    pub free: f64,
+}
+
+impl Friction {
+    /// Decides, from the sum `t` of all other torques on a body, its velocity `w`
+    /// and its Coulomb friction `fc`, whether it sticks, and against which friction
+    /// torque it slides otherwise (breaking away from rest: opposing `t`).
+    #[inline(always)]
+    pub fn decide(t: f64, w: f64, fc: f64) -> Self {
+        let torque = if w > 0.0 {
+            fc
+        } else if w < 0.0 {
+            -fc
+        } else if t > fc {
+            fc
         } else if t < -fc {
-            t + fc
+            -fc
         } else {
-            0.0
-        }
+            return Friction {
+                torque: 0.0,
+                free: 0.0,
+            };
+        };
+        Friction { torque, free: 1.0 }
+    }
+
+    /// The net torque on the body (0 while stuck).
+    #[inline(always)]
+    pub fn net(self, t: f64) -> f64 {
+        (t - self.torque) * self.free
+    }
+
+    /// Whether the body sticks.
+    pub fn stuck(self) -> bool {
+        self.free == 0.0
     }
 }
 
@@ -48,24 +69,27 @@ mod tests {
 
     #[test]
     fn holds_within_the_friction_band() {
-        let mut stuck = false;
-        assert_eq!(net_torque(0.13, 0.0, 0.26, &mut stuck, true), 0.0);
-        assert!(stuck);
+        let f = Friction::decide(0.13, 0.0, 0.26);
+        assert!(f.stuck());
+        assert_eq!(f.net(0.13), 0.0);
     }
 
     #[test]
     fn breaks_away_above_it_with_exactly_fc_opposing() {
-        let mut stuck = false;
-        assert_eq!(net_torque(0.5, 0.0, 0.26, &mut stuck, true), 0.5 - 0.26);
-        assert_eq!(net_torque(-0.5, 0.0, 0.26, &mut stuck, true), -0.5 + 0.26);
-        assert!(!stuck);
+        assert_eq!(Friction::decide(0.5, 0.0, 0.26).net(0.5), 0.5 - 0.26);
+        assert_eq!(Friction::decide(-0.5, 0.0, 0.26).net(-0.5), -0.5 + 0.26);
     }
 
     #[test]
     fn slides_against_the_velocity() {
-        let mut stuck = false;
-        assert_eq!(net_torque(0.0, 1.0, 0.26, &mut stuck, true), -0.26);
-        assert_eq!(net_torque(0.0, -1e-9, 0.26, &mut stuck, true), 0.26);
+        assert_eq!(Friction::decide(0.0, 1.0, 0.26).net(0.0), -0.26);
+        assert_eq!(Friction::decide(0.0, -1e-9, 0.26).net(0.0), 0.26);
+    }
+
+    #[test]
+    fn without_friction_only_a_balanced_body_at_rest_sticks() {
+        assert!(Friction::decide(0.0, 0.0, 0.0).stuck());
+        assert_eq!(Friction::decide(1e-9, 0.0, 0.0).net(1e-9), 1e-9);
     }
 
     #[test]

@@ -31,15 +31,16 @@
 //! come from the quadratic through the three given values (exact for the held
 //! torque of the controller).
 //!
-//! **Fluctuation.** sin/cos of N·θw + φ is evaluated once per step (first stage);
-//! later stages rotate it by the small angle N·Δθw (drive.rs).
+//! **Fluctuation.** sin/cos of N·θw + φ is carried from step start to step start
+//! by small rotations (computed afresh every 1024 steps, drive.rs); later stages
+//! use the cubic Taylor polynomial of e about the step start.
 //!
 //! The step allocates nothing: stage derivatives and step-start values live in the
 //! [`Kernel`], which the caller owns and reuses.
 
 use super::backlash::mesh_torque;
 use super::drive::{idx::*, Drive, NSTATE};
-use super::friction::{net_torque, stop_at_reversal};
+use super::friction::{stop_at_reversal, Friction};
 
 /// The state of `L` lanes: `y[i][l]` is state `i` (see [`idx`](super::drive::idx)) of lane `l`.
 pub type States<const L: usize> = [[f64; L]; NSTATE];
@@ -54,6 +55,9 @@ struct StepStart<const L: usize> {
     cos: [f64; L],
     /// Steps left before the phase is computed afresh (0: compute now).
     fresh: [u32; L],
+    /// Taylor coefficients of e(θ0 + Δ) = e0 + e1·Δ + e2·Δ²/2 + e3·Δ³/6 at the
+    /// step start: [e0, e1, e2/2, e3/6, e2, e3/2].
+    taylor: [[f64; L]; 6],
     /// Twist and twist rate of the spur mesh (0) and the drive mesh (1).
     twist: [[f64; L]; 2],
     rate: [[f64; L]; 2],
@@ -62,7 +66,7 @@ struct StepStart<const L: usize> {
 /// The per-step stick decisions of motor, shaft and table.
 #[derive(Clone, Debug)]
 pub struct Kernel<const L: usize> {
-    stuck: [[bool; L]; 3],
+    friction: [[Friction; L]; 3],
     start: StepStart<L>,
     /// Number of steps split at a contact event (all lanes), for diagnostics.
     events: u64,
@@ -71,12 +75,13 @@ pub struct Kernel<const L: usize> {
 impl<const L: usize> Default for Kernel<L> {
     fn default() -> Self {
         Kernel {
-            stuck: [[false; L]; 3],
+            friction: [[Friction::default(); L]; 3],
             start: StepStart {
                 shaft: [0.0; L],
                 sin: [0.0; L],
                 cos: [1.0; L],
                 fresh: [0; L],
+                taylor: [[0.0; L]; 6],
                 twist: [[0.0; L]; 2],
                 rate: [[0.0; L]; 2],
             },
@@ -109,7 +114,7 @@ impl<const L: usize> Kernel<L> {
 
     /// Whether motor, shaft and table of lane `l` were stuck during the last step.
     pub fn stuck(&self, l: usize) -> [bool; 3] {
-        [self.stuck[0][l], self.stuck[1][l], self.stuck[2][l]]
+        [0, 1, 2].map(|b| self.friction[b][l].stuck())
     }
 
     /// Lane-steps split at a contact event so far.
@@ -257,36 +262,15 @@ impl<const L: usize> Kernel<L> {
     ) {
         let y0 = *y;
         let half = h.map(|h| 0.5 * h);
-        let mut stuck = self.stuck;
-        let mut st = self.start;
-        let k1 = derivative::<L, SPUR, true>(d, &y0, &motor[0], load, &mut stuck, &mut st);
-        let k2 = derivative::<L, SPUR, false>(
-            d,
-            &axpy(&y0, &half, &k1),
-            &motor[1],
-            load,
-            &mut stuck,
-            &mut st,
-        );
-        let k3 = derivative::<L, SPUR, false>(
-            d,
-            &axpy(&y0, &half, &k2),
-            &motor[1],
-            load,
-            &mut stuck,
-            &mut st,
-        );
-        let k4 = derivative::<L, SPUR, false>(
-            d,
-            &axpy(&y0, h, &k3),
-            &motor[2],
-            load,
-            &mut stuck,
-            &mut st,
-        );
-        self.stuck = stuck;
-        self.start = st;
-        let sixth = h.map(|h| h / 6.0);
+        let friction = &mut self.friction;
+        let st = &mut self.start;
+        let k1 = derivative::<L, SPUR, true>(d, &y0, &motor[0], load, friction, st);
+        let k2 =
+            derivative::<L, SPUR, false>(d, &axpy(&y0, &half, &k1), &motor[1], load, friction, st);
+        let k3 =
+            derivative::<L, SPUR, false>(d, &axpy(&y0, &half, &k2), &motor[1], load, friction, st);
+        let k4 = derivative::<L, SPUR, false>(d, &axpy(&y0, h, &k3), &motor[2], load, friction, st);
+        let sixth = h.map(|h| h * (1.0 / 6.0));
         for i in 0..NSTATE {
             for l in 0..L {
                 y[i][l] = y0[i][l] + sixth[l] * (k1[i][l] + 2.0 * (k2[i][l] + k3[i][l]) + k4[i][l]);
@@ -377,7 +361,7 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
     y: &States<L>,
     motor: &[f64; L],
     load: &[f64; L],
-    stuck: &mut [[bool; L]; 3],
+    friction: &mut [[Friction; L]; 3],
     st: &mut StepStart<L>,
 ) -> States<L> {
     let first = FIRST;
@@ -403,9 +387,29 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
             st.shaft[l] = shaft;
             st.sin[l] = s;
             st.cos[l] = c;
-            (d.w * s, d.w * d.n * c)
+            let (e0, e1) = (d.w * s, d.w * d.n * c);
+            let (e2, e3) = (-d.n * d.n * e0, -d.n * d.n * e1);
+            st.taylor[0][l] = e0;
+            st.taylor[1][l] = e1;
+            st.taylor[2][l] = 0.5 * e2;
+            st.taylor[3][l] = e3 * (1.0 / 6.0);
+            st.taylor[4][l] = e2;
+            st.taylor[5][l] = 0.5 * e3;
+            (e0, e1)
         } else {
-            d.fluctuation_near(shaft, st.shaft[l], (st.sin[l], st.cos[l]))
+            let dx = shaft - st.shaft[l];
+            if (d.n * dx).abs() < 0.01 {
+                // Cubic Taylor polynomial of e about the step start (error below
+                // W·(N·Δθ)⁴/24 < 4e-10·W); its slope is the polynomial's exact
+                // derivative, so the mesh energy stays consistent.
+                let t = &st.taylor;
+                (
+                    t[0][l] + dx * (t[1][l] + dx * (t[2][l] + dx * t[3][l])),
+                    t[1][l] + dx * (t[4][l] + dx * t[5][l]),
+                )
+            } else {
+                d.fluctuation_near(shaft, st.shaft[l], (st.sin[l], st.cos[l]))
+            }
         };
         let lever = d.rw + ep;
         let dw = d.rw * shaft + e + xw * d.inv_r - tt;
@@ -418,7 +422,10 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
             0.0
         };
         let table = tw - d.ct * wt + unbalance + load[l];
-        let at = net_torque(table, wt, d.fc[2], &mut stuck[2][l], first) * d.inv_jt;
+        if first {
+            friction[2][l] = Friction::decide(table, wt, d.fc[2]);
+        }
+        let at = friction[2][l].net(table) * d.inv_jt;
         let ax = (-d.cb * vw - d.kb * xw - tw * d.inv_r) * d.inv_mw;
 
         let am = if SPUR {
@@ -431,12 +438,19 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
             let tg = mesh_torque(d.kg, d.cig, d.bg, dg, dg_rate);
             let m = motor[l] - d.cm * wm - d.rg * tg;
             let s = tg - d.cw * ws - lever * tw;
-            out[OMEGA_W][l] = net_torque(s, ws, d.fc[1], &mut stuck[1][l], first) * d.inv_jw;
+            if first {
+                friction[0][l] = Friction::decide(m, wm, d.fc[0]);
+                friction[1][l] = Friction::decide(s, ws, d.fc[1]);
+            }
+            out[OMEGA_W][l] = friction[1][l].net(s) * d.inv_jw;
             out[THETA_W][l] = ws;
-            net_torque(m, wm, d.fc[0], &mut stuck[0][l], first) * d.inv_jm
+            friction[0][l].net(m) * d.inv_jm
         } else {
             let m = motor[l] - d.cm * wm - lever * tw;
-            let a = net_torque(m, wm, d.fc[0], &mut stuck[0][l], first) * d.inv_jm;
+            if first {
+                friction[0][l] = Friction::decide(m, wm, d.fc[0]);
+            }
+            let a = friction[0][l].net(m) * d.inv_jm;
             out[OMEGA_W][l] = a;
             out[THETA_W][l] = wm;
             a
