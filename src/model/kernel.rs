@@ -136,14 +136,12 @@ impl<const L: usize> Kernel<L> {
         if !(d.bw > 0.0 || (SPUR && d.bg > 0.0)) {
             return;
         }
-        let mut split = [1.0; L];
         let mut any = false;
-        for l in 0..L {
-            if let Some(s) = self.contact_event::<SPUR>(d, y, l, h) {
-                split[l] = s;
-                any = true;
-            }
-        }
+        let split: [f64; L] = std::array::from_fn(|l| {
+            let event = self.contact_event::<SPUR>(d, y, l, h);
+            any |= event.is_some();
+            event.unwrap_or(1.0)
+        });
         if any {
             self.split_step::<SPUR>(d, &y0, y, motor, load, h, &split);
         }
