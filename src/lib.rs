@@ -12,3 +12,4 @@ pub mod io;
 pub mod model;
 pub mod recorder;
 pub mod sim;
+pub mod report;

@@ -1,0 +1,146 @@
+//! The positioning accuracy and repeatability test as a virtual experiment (paper
+//! §4.3, MODEL.md §5.3): the ISO 230-2 standard test cycle run by the servo on the
+//! model, read by the table encoder at the end of each dwell.
+//!
+//! Cycle, per run: start `overrun` below the first target, approach every target in
+//! ascending order (direction up), dwell, read; continue `overrun` past the last
+//! target, approach every target in descending order (down), dwell, read; return to
+//! the start. Moves are ramps at `speed`; the reading is the table encoder's
+//! (quantised to its resolution) plus optional Gaussian measurement noise.
+
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+
+use super::iso230::{Direction, Measurement};
+use crate::input::Move;
+use crate::model::params::{LoopMode, Params};
+use crate::model::idx::THETA_T;
+use crate::recorder::NullRecorder;
+use crate::controller::quantise;
+use crate::sim::{SimError, Simulation};
+
+const ARCSEC: f64 = std::f64::consts::PI / 180.0 / 3600.0;
+
+/// Conditions of the test (defaults: MODEL.md §5.3).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PositioningTest {
+    /// Target table angles, rad (default every 30° from 0° to 360°).
+    pub targets: Vec<f64>,
+    /// Approaches of each target in each direction (default 5).
+    pub runs: u32,
+    /// Dwell before each reading, s (default 1).
+    pub dwell: f64,
+    /// Table speed of the moves, rad/s (default 3600°/min).
+    pub speed: f64,
+    /// Travel beyond the first and last target before reversing, rad (default 5°).
+    pub overrun: f64,
+    /// Standard deviation of added measurement noise, rad (default 0).
+    pub noise: f64,
+    /// Seed of the noise generator.
+    pub seed: u64,
+    /// Feedback arrangement (default semi-closed, as in the paper).
+    pub loop_mode: LoopMode,
+}
+
+impl Default for PositioningTest {
+    fn default() -> Self {
+        PositioningTest {
+            targets: (0..=12).map(|i| (30.0 * i as f64).to_radians()).collect(),
+            runs: 5,
+            dwell: 1.0,
+            speed: (3600.0f64 / 60.0).to_radians(),
+            overrun: 5f64.to_radians(),
+            noise: 0.0,
+            seed: 0,
+            loop_mode: LoopMode::SemiClosed,
+        }
+    }
+}
+
+impl PositioningTest {
+    /// The sequence of (commanded angle, reading taken there as which measurement).
+    fn cycle(&self) -> Vec<(f64, Option<(f64, Direction, u32)>)> {
+        let mut targets = self.targets.clone();
+        targets.sort_by(f64::total_cmp);
+        let (first, last) = (targets[0], targets[targets.len() - 1]);
+        let mut stops = vec![(first - self.overrun, None)];
+        for run in 1..=self.runs {
+            for &t in &targets {
+                stops.push((t, Some((t, Direction::Up, run))));
+            }
+            stops.push((last + self.overrun, None));
+            for &t in targets.iter().rev() {
+                stops.push((t, Some((t, Direction::Down, run))));
+            }
+            stops.push((first - self.overrun, None));
+        }
+        stops
+    }
+
+    /// Simulated time the cycle takes, s (moves plus dwells).
+    pub fn duration(&self) -> f64 {
+        let stops = self.cycle();
+        stops
+            .windows(2)
+            .map(|w| (w[1].0 - w[0].0).abs() / self.speed + self.dwell)
+            .sum()
+    }
+
+    /// Number of readings.
+    pub fn readings(&self) -> usize {
+        2 * self.targets.len() * self.runs as usize
+    }
+}
+
+/// Runs the cycle on the model. `progress(done, total)` is called after each reading.
+pub fn run(
+    params: &Params,
+    test: &PositioningTest,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<Vec<Measurement>, SimError> {
+    let mut p = params.clone();
+    p.controller.loop_mode = test.loop_mode;
+    let resolution = p.controller.table_encoder_resolution;
+    let mut sim = Simulation::with_default_step(&p)?;
+    let stops = test.cycle();
+    // Start at rest at the first stop, controller aligned with it.
+    let start = stops[0].0;
+    let mut y = sim.state();
+    y[crate::model::idx::THETA_M] = start / p.ratio();
+    y[crate::model::idx::THETA_W] = start / p.rw;
+    y[THETA_T] = start;
+    sim.set_state(y);
+    let mut controller = sim.controller(&p)?;
+    let noise = Normal::new(0.0, test.noise.max(0.0)).expect("σ ≥ 0 is a valid normal");
+    let mut rng = rand::rngs::StdRng::seed_from_u64(test.seed);
+    let total = test.readings();
+    let mut out = Vec::with_capacity(total);
+    for w in stops.windows(2) {
+        let (from, to) = (w[0].0, w[1].0);
+        let t0 = sim.time();
+        let m = Move {
+            from,
+            to,
+            speed: Some(test.speed),
+        };
+        let duration = (to - from).abs() / test.speed + test.dwell;
+        let reference = |t: f64| crate::input::Trajectory::angle(&m, t - t0);
+        sim.run_closed_loop(&mut controller, &reference, duration, &mut NullRecorder)?;
+        if let Some((target, direction, run)) = w[1].1 {
+            let reading = quantise(sim.state()[THETA_T], resolution) + noise.sample(&mut rng);
+            out.push(Measurement {
+                target,
+                direction,
+                run,
+                deviation: reading - target,
+            });
+            progress(out.len(), total);
+        }
+    }
+    Ok(out)
+}
+
+/// Deviations in arc-seconds, for reports.
+pub fn arcsec(rad: f64) -> f64 {
+    rad / ARCSEC
+}

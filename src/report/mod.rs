@@ -1,0 +1,3 @@
+//! Reports: SVG charts.
+
+pub mod plot;
