@@ -7,6 +7,7 @@
 
 pub mod cli;
 pub mod controller;
+pub mod experiments;
 pub mod input;
 pub mod io;
 pub mod model;

@@ -1,0 +1,3 @@
+//! The paper's five tests (MODEL.md §5): virtual experiments and the evaluation of their measured data.
+
+pub mod iso230;
