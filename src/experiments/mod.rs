@@ -1,3 +1,4 @@
 //! The paper's five tests (MODEL.md §5): virtual experiments and the evaluation of their measured data.
 
 pub mod iso230;
+pub mod positioning;

@@ -19,8 +19,6 @@ use crate::recorder::NullRecorder;
 use crate::controller::quantise;
 use crate::sim::{SimError, Simulation};
 
-const ARCSEC: f64 = std::f64::consts::PI / 180.0 / 3600.0;
-
 /// Conditions of the test (defaults: MODEL.md §5.3).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PositioningTest {
@@ -138,9 +136,4 @@ pub fn run(
         }
     }
     Ok(out)
-}
-
-/// Deviations in arc-seconds, for reports.
-pub fn arcsec(rad: f64) -> f64 {
-    rad / ARCSEC
 }
