@@ -1,0 +1,348 @@
+//! The writing half of an experiment file: the CSV, then the manifest, each atomically,
+//! after checking that everything written will read back.
+
+use std::borrow::Cow;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::{
+    Conditions, Data, Direction, ExperimentFileError, Kind, Manifest, ANGLE_UNITS, ARCSEC, DEG,
+};
+
+/// Writes an experiment: the CSV (unless resonance) beside the manifest, named by
+/// `manifest.data` or after the manifest, then the manifest as pretty JSON, each
+/// atomically. The written manifest has `data` set to the CSV's name and, for a
+/// resonance, `peaks_hz` and `peak_gain_db` from `data`. Angles are written in degrees
+/// (positioning deviations in arc-seconds), numbers in Rust's shortest round-trip form.
+/// Data that would not read back (unequal lengths, non-finite values, times not
+/// increasing, run 0, extra columns named like a column the reader uses) is refused
+/// before anything is written.
+pub fn write(
+    manifest_path: &Path,
+    manifest: &Manifest,
+    data: &Data,
+) -> Result<(), ExperimentFileError> {
+    let invalid = |path: &Path, message: String| ExperimentFileError::Invalid {
+        path: path.to_path_buf(),
+        message,
+    };
+    if data.kind() != manifest.kind {
+        return Err(invalid(
+            manifest_path,
+            format!(
+                "the manifest says `{}` but the data is `{}`",
+                manifest.kind,
+                data.kind()
+            ),
+        ));
+    }
+    check_manifest(manifest).map_err(|m| invalid(manifest_path, m))?;
+    let mut out = manifest.clone();
+    if let Data::Resonance {
+        peaks_hz,
+        peak_gain_db,
+    } = data
+    {
+        check_peaks(peaks_hz, peak_gain_db.as_deref()).map_err(|m| invalid(manifest_path, m))?;
+        out.peaks_hz = Some(peaks_hz.clone());
+        out.peak_gain_db = peak_gain_db.clone();
+    } else {
+        let name = match &manifest.data {
+            Some(name) => name.clone(),
+            None => match manifest_path.with_extension("csv").file_name() {
+                Some(name) => name.to_string_lossy().into_owned(),
+                None => return Err(invalid(manifest_path, "no file name".into())),
+            },
+        };
+        let csv_path = manifest_path.parent().unwrap_or(Path::new("")).join(&name);
+        if csv_path == manifest_path {
+            return Err(invalid(
+                manifest_path,
+                "the data file would overwrite the manifest".into(),
+            ));
+        }
+        let columns = out_columns(data);
+        check_columns(data, &columns).map_err(|m| invalid(&csv_path, m))?;
+        crate::io::atomic::write_with(&csv_path, |w| write_csv(w, data.kind(), &columns)).map_err(
+            |source| ExperimentFileError::Write {
+                path: csv_path.clone(),
+                source,
+            },
+        )?;
+        out.data = Some(name);
+    }
+    let mut text =
+        serde_json::to_string_pretty(&out).map_err(|e| invalid(manifest_path, e.to_string()))?;
+    text.push('\n');
+    crate::io::atomic::write(manifest_path, text.as_bytes()).map_err(|source| {
+        ExperimentFileError::Write {
+            path: manifest_path.to_path_buf(),
+            source,
+        }
+    })
+}
+
+/// Refuses what would not survive JSON: extra keys that repeat a typed key (the file
+/// would have a duplicate key) and non-finite numbers (JSON has none; they would read
+/// back as absent).
+fn check_manifest(m: &Manifest) -> Result<(), String> {
+    if let Some(key) = m
+        .extra
+        .keys()
+        .find(|k| Manifest::KEYS.contains(&k.as_str()))
+    {
+        return Err(format!("extra key `{key}` repeats a manifest key"));
+    }
+    let c = &m.conditions;
+    if let Some(key) = c
+        .extra
+        .keys()
+        .find(|k| Conditions::KEYS.contains(&k.as_str()))
+    {
+        return Err(format!("extra condition `{key}` repeats a condition key"));
+    }
+    if let Some((key, Some(v))) = c
+        .numbers()
+        .into_iter()
+        .find(|(_, v)| v.is_some_and(|v| !v.is_finite()))
+    {
+        return Err(format!("condition `{key}` is {v}"));
+    }
+    for (key, values) in [("peaks_hz", &m.peaks_hz), ("peak_gain_db", &m.peak_gain_db)] {
+        if let Some(v) = values.iter().flatten().find(|v| !v.is_finite()) {
+            return Err(format!("`{key}` holds {v}"));
+        }
+    }
+    Ok(())
+}
+
+fn check_peaks(peaks_hz: &[f64], peak_gain_db: Option<&[f64]>) -> Result<(), String> {
+    if peaks_hz.is_empty() {
+        return Err("`peaks_hz` is empty".into());
+    }
+    if let Some(g) = peak_gain_db {
+        if g.len() != peaks_hz.len() {
+            return Err(format!(
+                "`peaks_hz` has {} values but `peak_gain_db` has {}",
+                peaks_hz.len(),
+                g.len()
+            ));
+        }
+    }
+    match peaks_hz
+        .iter()
+        .chain(peak_gain_db.unwrap_or(&[]))
+        .find(|v| !v.is_finite())
+    {
+        Some(v) => Err(format!("a peak value is {v}")),
+        None => Ok(()),
+    }
+}
+
+/// The cells of one column to write, in the file's unit.
+enum Cells<'a> {
+    Numbers(Cow<'a, [f64]>),
+    Directions(&'a [Direction]),
+    Runs(&'a [u32]),
+}
+
+impl Cells<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Cells::Numbers(v) => v.len(),
+            Cells::Directions(v) => v.len(),
+            Cells::Runs(v) => v.len(),
+        }
+    }
+}
+
+/// The columns [`write`] writes for `data`, extra columns last (none for resonance).
+fn out_columns(data: &Data) -> Vec<(Cow<'_, str>, Cells<'_>)> {
+    fn plain<'a>(name: &'static str, v: &'a [f64]) -> (Cow<'a, str>, Cells<'a>) {
+        (name.into(), Cells::Numbers(v.into()))
+    }
+    fn angle(name: &'static str, v: &[f64], per_unit: f64) -> (Cow<'static, str>, Cells<'static>) {
+        let converted = v.iter().map(|x| x / per_unit).collect::<Vec<f64>>();
+        (name.into(), Cells::Numbers(converted.into()))
+    }
+    let (mut columns, extra) = match data {
+        Data::Resonance { .. } => return Vec::new(),
+        Data::FrequencyResponse {
+            frequency_hz,
+            gain_db,
+            phase_rad,
+            extra,
+        } => {
+            let mut c = vec![
+                plain("frequency_hz", frequency_hz),
+                plain("gain_db", gain_db),
+            ];
+            c.extend(phase_rad.as_deref().map(|p| angle("phase_deg", p, DEG)));
+            (c, extra)
+        }
+        Data::TorqueCurve {
+            time_s,
+            motor_torque_nm,
+            table_angle_rad,
+            extra,
+        } => {
+            let mut c = vec![
+                plain("time_s", time_s),
+                plain("motor_torque_nm", motor_torque_nm),
+            ];
+            c.extend(
+                table_angle_rad
+                    .as_deref()
+                    .map(|a| angle("table_angle_deg", a, DEG)),
+            );
+            (c, extra)
+        }
+        Data::Positioning {
+            target_rad,
+            direction,
+            run,
+            deviation_rad,
+            extra,
+        } => (
+            vec![
+                angle("target_deg", target_rad, DEG),
+                ("direction".into(), Cells::Directions(direction)),
+                ("run".into(), Cells::Runs(run)),
+                angle("deviation_arcsec", deviation_rad, ARCSEC),
+            ],
+            extra,
+        ),
+        Data::Fluctuation {
+            time_s,
+            motor_angle_rad,
+            table_angle_rad,
+            extra,
+        }
+        | Data::Unbalance {
+            time_s,
+            motor_angle_rad,
+            table_angle_rad,
+            extra,
+        } => (
+            vec![
+                plain("time_s", time_s),
+                angle("motor_angle_deg", motor_angle_rad, DEG),
+                angle("table_angle_deg", table_angle_rad, DEG),
+            ],
+            extra,
+        ),
+    };
+    for (name, v) in extra {
+        columns.push((name.as_str().into(), Cells::Numbers(v.as_slice().into())));
+    }
+    columns
+}
+
+/// The column names the reader interprets for `kind`: an extra column must not take one.
+fn reserved(kind: Kind) -> Vec<String> {
+    let (plain, angles): (&[&str], &[&str]) = match kind {
+        Kind::FrequencyResponse => (&["frequency_hz", "gain_db"], &["phase"]),
+        Kind::Resonance => (&[], &[]),
+        Kind::TorqueCurve => (&["time_s", "motor_torque_nm"], &["table_angle"]),
+        Kind::Positioning => (&["direction", "run"], &["target", "deviation"]),
+        Kind::Fluctuation | Kind::Unbalance => (&["time_s"], &["motor_angle", "table_angle"]),
+    };
+    let angle_names = angles.iter().flat_map(|base| {
+        ANGLE_UNITS
+            .iter()
+            .map(move |(unit, _)| format!("{base}_{unit}"))
+    });
+    plain
+        .iter()
+        .map(|s| s.to_string())
+        .chain(angle_names)
+        .collect()
+}
+
+/// Everything the reader would refuse, checked before a byte is written.
+fn check_columns(data: &Data, columns: &[(Cow<'_, str>, Cells<'_>)]) -> Result<(), String> {
+    let Some((first, cells)) = columns.first() else {
+        return Err("no columns".into());
+    };
+    let rows = cells.len();
+    if rows == 0 {
+        return Err("no rows".into());
+    }
+    let fixed = columns.len() - data.extra().map_or(0, |e| e.len());
+    let reserved = reserved(data.kind());
+    for (i, (name, cells)) in columns.iter().enumerate() {
+        if i >= fixed {
+            if name.is_empty() || name.trim() != name || name.starts_with('#') {
+                return Err(format!("`{name}` cannot be a column name"));
+            }
+            if reserved.iter().any(|r| r == name) {
+                return Err(format!("extra column `{name}` clashes with a data column"));
+            }
+        }
+        if cells.len() != rows {
+            return Err(format!(
+                "column `{name}` has {} values, `{first}` has {rows}",
+                cells.len()
+            ));
+        }
+        match cells {
+            Cells::Numbers(v) => {
+                if let Some((row, x)) = v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+                    return Err(format!(
+                        "column `{name}`, row {}: {x} is not finite",
+                        row + 1
+                    ));
+                }
+                if i == 0 && (name == "time_s" || name == "frequency_hz") {
+                    if let Some(row) = v.windows(2).position(|w| w[1] <= w[0]) {
+                        return Err(format!(
+                            "column `{name}`, row {}: {} does not increase",
+                            row + 2,
+                            v[row + 1]
+                        ));
+                    }
+                }
+            }
+            Cells::Runs(v) => {
+                if let Some(row) = v.iter().position(|&r| r == 0) {
+                    return Err(format!(
+                        "column `{name}`, row {}: run 0 (runs start at 1)",
+                        row + 1
+                    ));
+                }
+            }
+            Cells::Directions(_) => {}
+        }
+    }
+    Ok(())
+}
+
+fn write_csv(
+    w: &mut impl std::io::Write,
+    kind: Kind,
+    columns: &[(Cow<'_, str>, Cells<'_>)],
+) -> std::io::Result<()> {
+    writeln!(
+        w,
+        "# {kind} experiment, written by rtid {} (docs/experiment-files.md)",
+        env!("CARGO_PKG_VERSION")
+    )?;
+    let mut csv = csv::Writer::from_writer(w);
+    csv.write_record(columns.iter().map(|(name, _)| name.as_bytes()))?;
+    let rows = columns.first().map_or(0, |(_, c)| c.len());
+    let mut cell = String::new();
+    for row in 0..rows {
+        for (_, cells) in columns {
+            cell.clear();
+            match cells {
+                Cells::Numbers(v) => write!(cell, "{:?}", v[row]),
+                Cells::Directions(v) => write!(cell, "{}", v[row]),
+                Cells::Runs(v) => write!(cell, "{}", v[row]),
+            }
+            .map_err(std::io::Error::other)?;
+            csv.write_field(&cell)?;
+        }
+        csv.write_record(None::<&[u8]>)?;
+    }
+    csv.flush()
+}
