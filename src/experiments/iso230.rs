@@ -69,7 +69,6 @@
 //! - Means and s are computed about the first value of each series, so a series of
 //!   equal values has exactly that mean and s = 0.
 
-use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
@@ -79,24 +78,8 @@ pub const ARCSEC_PER_RAD: f64 = 648_000.0 / std::f64::consts::PI;
 /// Targets closer than this (rad) are one target position (about 2e-4″).
 pub const SAME_TARGET_RAD: f64 = 1e-9;
 
-/// The sense in which a target was approached.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Direction {
-    /// Approach in the positive (CCW) sense, ↑.
-    Up,
-    /// Approach in the negative (CW) sense, ↓.
-    Down,
-}
-
-impl fmt::Display for Direction {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Direction::Up => "up (positive, CCW)",
-            Direction::Down => "down (negative, CW)",
-        })
-    }
-}
+/// The sense in which a target was approached (defined with the experiment files).
+pub use crate::io::experiment_file::Direction;
 
 /// One positioning of the table: where it was sent and how far off it stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

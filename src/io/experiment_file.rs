@@ -89,7 +89,8 @@ impl fmt::Display for Kind {
 }
 
 /// The sense in which a positioning target was approached.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Direction {
     /// Approach in the positive (counter-clockwise) sense: `up` or `ccw` in a file.
     Up,
