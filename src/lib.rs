@@ -12,5 +12,5 @@ pub mod input;
 pub mod io;
 pub mod model;
 pub mod recorder;
-pub mod sim;
 pub mod report;
+pub mod sim;

@@ -1,9 +1,12 @@
 //! The command line: clap parses raw arguments here, each command's module validates
 //! them into a run configuration and runs it.
 
+mod evaluate;
+mod experiment;
 mod model_args;
 mod modes;
 mod params_cmd;
+mod progress;
 mod simulate;
 
 use clap::{Parser, Subcommand};
@@ -27,7 +30,9 @@ Examples:
   rtid modes --preset worm-gear
   rtid simulate --preset worm-gear --input sine:freq_hz=100,amp_nm=5 --duration-s 0.5 --out run.csv
   rtid simulate --preset roller-gear-cam --input move:target_deg=30,loop=full_closed --duration-s 1 --out move.csv
-  rtid params --preset worm-gear --set Kw=3.5e5 --out my-table.json";
+  rtid params --preset worm-gear --set Kw=3.5e5 --out my-table.json
+  rtid experiment positioning --preset worm-gear --out runs/worm
+  rtid evaluate runs/worm/positioning.json";
 
 /// Top-level arguments.
 #[derive(Debug, Parser)]
@@ -49,6 +54,15 @@ pub enum Command {
     /// List, check or save a parameter set (names, values, units, notes).
     #[command(long_about = params_cmd::LONG_ABOUT)]
     Params(params_cmd::Args),
+    /// Run one of the paper's tests on the model; writes an experiment file and a plot.
+    #[command(long_about = experiment::LONG_ABOUT)]
+    Experiment {
+        #[command(subcommand)]
+        test: experiment::Test,
+    },
+    /// Evaluate a measured or virtual experiment file (statistics, plot).
+    #[command(long_about = evaluate::LONG_ABOUT)]
+    Evaluate(evaluate::Args),
 }
 
 /// Runs one parsed command line.
@@ -57,5 +71,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Modes(a) => modes::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::Params(a) => params_cmd::run(a),
+        Command::Experiment { test } => experiment::run(test),
+        Command::Evaluate(a) => evaluate::run(a),
     }
 }

@@ -69,7 +69,6 @@
 //! - Means and s are computed about the first value of each series, so a series of
 //!   equal values has exactly that mean and s = 0.
 
-
 use serde::{Deserialize, Serialize};
 
 /// Arc-seconds per radian, 180·3600/π.

@@ -11,12 +11,13 @@
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
-use super::iso230::{Direction, Measurement};
-use crate::input::Move;
-use crate::model::params::{LoopMode, Params};
-use crate::model::idx::THETA_T;
-use crate::recorder::NullRecorder;
+use super::iso230::{Direction, Iso230Report, Measurement, ARCSEC_PER_RAD};
 use crate::controller::quantise;
+use crate::input::Move;
+use crate::io::experiment_file::{Data, Kind, Manifest};
+use crate::model::idx::THETA_T;
+use crate::model::params::{LoopMode, Params};
+use crate::recorder::NullRecorder;
 use crate::sim::{SimError, Simulation};
 
 /// Conditions of the test (defaults: MODEL.md §5.3).
@@ -136,4 +137,172 @@ pub fn run(
         }
     }
     Ok(out)
+}
+
+/// The experiment-file form of a positioning test's readings.
+pub fn to_data(measurements: &[Measurement]) -> Data {
+    Data::Positioning {
+        target_rad: measurements.iter().map(|m| m.target).collect(),
+        direction: measurements.iter().map(|m| m.direction).collect(),
+        run: measurements.iter().map(|m| m.run).collect(),
+        deviation_rad: measurements.iter().map(|m| m.deviation).collect(),
+        extra: Default::default(),
+    }
+}
+
+/// The readings of a positioning experiment file (`None` for another kind).
+pub fn from_data(data: &Data) -> Option<Vec<Measurement>> {
+    let Data::Positioning {
+        target_rad,
+        direction,
+        run,
+        deviation_rad,
+        ..
+    } = data
+    else {
+        return None;
+    };
+    Some(
+        (0..target_rad.len())
+            .map(|i| Measurement {
+                target: target_rad[i],
+                direction: direction[i],
+                run: run[i],
+                deviation: deviation_rad[i],
+            })
+            .collect(),
+    )
+}
+
+/// The manifest of a virtual positioning test.
+pub fn manifest(params: &Params, test: &PositioningTest) -> Manifest {
+    let mut m = Manifest::new(Kind::Positioning);
+    m.mechanism = Some(params.name.clone());
+    m.conditions.loop_mode = Some(test.loop_mode);
+    m.conditions.dwell_s = Some(test.dwell);
+    m.conditions.speed_deg_per_min = Some(test.speed.to_degrees() * 60.0);
+    m.notes = Some(format!(
+        "virtual ISO 230-2 test by rtid: {} targets, {} runs each way, table encoder {:.6}° {}",
+        test.targets.len(),
+        test.runs,
+        params.controller.table_encoder_resolution.to_degrees(),
+        if test.noise > 0.0 {
+            format!(
+                "plus {:.3}″ rms noise (seed {})",
+                test.noise * ARCSEC_PER_RAD,
+                test.seed
+            )
+        } else {
+            "without added noise".into()
+        }
+    ));
+    m
+}
+
+/// A readable ISO 230-2 summary in arc-seconds.
+pub fn table(report: &Iso230Report) -> String {
+    use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header([
+        "target °",
+        "x̄↑ ″",
+        "x̄↓ ″",
+        "s↑ ″",
+        "s↓ ″",
+        "Bi ″",
+        "R↑i ″",
+        "R↓i ″",
+        "Ri ″",
+    ]);
+    for s in &report.targets {
+        let a = s.in_arcsec();
+        t.add_row(
+            [
+                s.target.to_degrees(),
+                a.mean_up,
+                a.mean_down,
+                a.s_up,
+                a.s_down,
+                a.reversal,
+                a.repeat_up,
+                a.repeat_down,
+                a.repeat,
+            ]
+            .map(|v| format!("{v:.2}")),
+        );
+    }
+    let x = report.axis.in_arcsec();
+    let mut axis = Table::new();
+    axis.load_preset(UTF8_FULL_CONDENSED);
+    axis.set_header(["axis, arc-sec", "↑", "↓", "bidirectional"]);
+    axis.add_row([
+        "reversal B / mean B̄".to_string(),
+        "".into(),
+        "".into(),
+        format!("{:.2} / {:.2}", x.b, x.b_mean),
+    ]);
+    axis.add_row([
+        "repeatability R".to_string(),
+        format!("{:.2}", x.r_up),
+        format!("{:.2}", x.r_down),
+        format!("{:.2}", x.r),
+    ]);
+    axis.add_row([
+        "systematic deviation E".to_string(),
+        format!("{:.2}", x.e_up),
+        format!("{:.2}", x.e_down),
+        format!("{:.2}", x.e),
+    ]);
+    axis.add_row([
+        "mean deviation M".to_string(),
+        "".into(),
+        "".into(),
+        format!("{:.2}", x.m),
+    ]);
+    axis.add_row([
+        "accuracy A".to_string(),
+        format!("{:.2}", x.a_up),
+        format!("{:.2}", x.a_down),
+        format!("{:.2}", x.a),
+    ]);
+    format!("{t}\n{axis}")
+}
+
+/// The paper's Fig. 10: x̄↑, x̄↓, x̄↑ ± 2s↑, x̄↓ ± 2s↓ and x̄ over the target angle.
+pub fn plot(report: &Iso230Report, title: &str, path: &std::path::Path) -> std::io::Result<()> {
+    use crate::report::plot::{write, Chart, Series, Style};
+    let pts = |f: &dyn Fn(&super::iso230::TargetStats) -> f64| -> Vec<(f64, f64)> {
+        report
+            .targets
+            .iter()
+            .map(|s| (s.target.to_degrees(), f(s) * ARCSEC_PER_RAD))
+            .collect()
+    };
+    let series = [
+        Series::new("x̄↑", pts(&|s| s.mean_up), Style::Line),
+        Series::new(
+            "x̄↑ ± 2s↑",
+            pts(&|s| s.mean_up + 2.0 * s.s_up),
+            Style::Dashed,
+        ),
+        Series::new("", pts(&|s| s.mean_up - 2.0 * s.s_up), Style::Dashed),
+        Series::new("x̄↓", pts(&|s| s.mean_down), Style::Line),
+        Series::new(
+            "x̄↓ ± 2s↓",
+            pts(&|s| s.mean_down + 2.0 * s.s_down),
+            Style::Dashed,
+        ),
+        Series::new("", pts(&|s| s.mean_down - 2.0 * s.s_down), Style::Dashed),
+        Series::new("x̄", pts(&|s| s.mean_bidirectional), Style::Markers),
+    ];
+    write(
+        path,
+        &Chart {
+            title,
+            x_label: "target angle, deg",
+            y_label: "positional deviation, arc-sec",
+        },
+        &series,
+    )
 }

@@ -63,7 +63,11 @@ pub fn render(chart: &Chart, series: &[Series]) -> Result<String, String> {
         return Err("nothing to plot: no finite points".into());
     }
     let pad = |a: f64, b: f64| {
-        let m = if b > a { 0.05 * (b - a) } else { a.abs().max(1.0) * 0.05 };
+        let m = if b > a {
+            0.05 * (b - a)
+        } else {
+            a.abs().max(1.0) * 0.05
+        };
         (a - m, b + m)
     };
     let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
@@ -84,8 +88,13 @@ pub fn render(chart: &Chart, series: &[Series]) -> Result<String, String> {
             .light_line_style(RGBColor(235, 235, 235))
             .draw()
             .map_err(text)?;
+        // A series without a name continues the previous one (same colour, no legend).
+        let mut colour_index = 0;
         for (i, s) in series.iter().enumerate() {
-            let colour = COLOURS[i % COLOURS.len()];
+            if i > 0 && !s.name.is_empty() {
+                colour_index += 1;
+            }
+            let colour = COLOURS[colour_index % COLOURS.len()];
             let pts: Vec<(f64, f64)> = s
                 .points
                 .iter()
@@ -94,12 +103,19 @@ pub fn render(chart: &Chart, series: &[Series]) -> Result<String, String> {
                 .collect();
             let anno = match s.style {
                 Style::Line => c.draw_series(LineSeries::new(pts, colour.stroke_width(2))),
-                Style::Dashed => c.draw_series(DashedLineSeries::new(pts, 6, 4, colour.stroke_width(1))),
-                Style::Markers => c.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, colour.filled()))),
+                Style::Dashed => {
+                    c.draw_series(DashedLineSeries::new(pts, 6, 4, colour.stroke_width(1)))
+                }
+                Style::Markers => {
+                    c.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, colour.filled())))
+                }
             }
             .map_err(text)?;
-            anno.label(s.name.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
+            if !s.name.is_empty() {
+                anno.label(s.name.as_str()).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
+                });
+            }
         }
         c.configure_series_labels()
             .background_style(WHITE.mix(0.85))
@@ -146,7 +162,15 @@ mod tests {
 
     #[test]
     fn an_empty_chart_is_an_error_not_a_panic() {
-        let chart = Chart { title: "", x_label: "", y_label: "" };
-        assert!(render(&chart, &[Series::new("x", vec![(f64::NAN, 1.0)], Style::Line)]).is_err());
+        let chart = Chart {
+            title: "",
+            x_label: "",
+            y_label: "",
+        };
+        assert!(render(
+            &chart,
+            &[Series::new("x", vec![(f64::NAN, 1.0)], Style::Line)]
+        )
+        .is_err());
     }
 }

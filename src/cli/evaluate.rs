@@ -1,0 +1,51 @@
+//! `rtid evaluate`: the statistics of a measured (or virtual) experiment file.
+
+use std::path::PathBuf;
+
+use anyhow::bail;
+
+use super::experiment::positioning;
+use crate::io::experiment_file::{self, Kind};
+
+pub const LONG_ABOUT: &str = "\
+Evaluates an experiment file (a JSON manifest with its CSV, docs/experiment-files.md), \
+measured on a real table or written by `rtid experiment`, and writes a plot beside it.
+
+Kinds evaluated:
+  positioning   ISO 230-2 statistics in arc-seconds: per target x̄↑, x̄↓, s↑, s↓, Bi, R↑i, \
+R↓i, Ri; for the axis the reversal B and mean reversal B̄, repeatability R↑, R↓, R, \
+systematic deviation E↑, E↓, E, mean deviation M, accuracy A↑, A↓, A. Plot: the paper's \
+Fig. 10.
+
+Example:
+  rtid evaluate runs/worm/positioning.json --json";
+
+/// Arguments of `rtid evaluate`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The experiment manifest.
+    #[arg(value_name = "FILE.json")]
+    pub file: PathBuf,
+    /// Print JSON instead of tables.
+    #[arg(long)]
+    pub json: bool,
+    /// Where to write the plot (default: beside the manifest, FILE.svg).
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let exp = experiment_file::read(&a.file)?;
+    let plot = a
+        .plot
+        .clone()
+        .unwrap_or_else(|| a.file.with_extension("svg"));
+    match exp.manifest.kind {
+        Kind::Positioning => positioning::report(&exp, &plot, a.json),
+        other => bail!(
+            "{}: evaluating `{}` experiments is not part of this version yet (positioning is)",
+            a.file.display(),
+            other.name()
+        ),
+    }
+}

@@ -1,0 +1,55 @@
+//! `rtid experiment <test>`: the paper's tests run on the model, written as
+//! experiment files (the same format as measured data, so the two compare directly)
+//! with a plot. One file per test.
+
+pub mod positioning;
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+
+use super::ModelArgs;
+
+pub const LONG_ABOUT: &str = "\
+Runs one of the paper's tests on the model and writes it as an experiment file — a JSON \
+manifest and a CSV in the format `rtid evaluate` reads (docs/experiment-files.md) — plus \
+an SVG plot, into --out DIR. Virtual and measured experiments compare directly. \
+`rtid experiment TEST --help` describes each test and its conditions.";
+
+/// The tests.
+#[derive(Debug, clap::Subcommand)]
+pub enum Test {
+    /// ISO 230-2 positioning accuracy and repeatability (paper §4.3, Fig. 10).
+    #[command(long_about = positioning::LONG_ABOUT)]
+    Positioning(positioning::Args),
+}
+
+/// Arguments every test takes.
+#[derive(Debug, clap::Args)]
+pub struct Common {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Folder for the manifest, CSV and plot (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Print the evaluation as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl Common {
+    /// Creates the output folder.
+    pub fn create_out(&self) -> anyhow::Result<()> {
+        std::fs::create_dir_all(&self.out)
+            .with_context(|| format!("creating {}", self.out.display()))
+    }
+}
+
+pub fn run(test: Test) -> anyhow::Result<()> {
+    match test {
+        Test::Positioning(a) => positioning::run(a),
+    }
+}
