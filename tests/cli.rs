@@ -631,3 +631,93 @@ mod help {
         }
     }
 }
+
+mod experiments {
+    use super::*;
+
+    #[test]
+    fn a_virtual_positioning_test_evaluates_to_the_same_statistics() {
+        let dir = tempdir();
+        let out = rtid(
+            &[
+                "experiment",
+                "positioning",
+                "--preset",
+                "roller-gear-cam",
+                "--runs",
+                "2",
+                "--target-step-deg",
+                "180",
+                "--out",
+                "pos",
+                "--json",
+            ],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let made: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        for f in ["positioning.json", "positioning.csv", "positioning.svg"] {
+            assert!(dir.path().join("pos").join(f).exists(), "{f}");
+        }
+        let again = rtid(&["evaluate", "pos/positioning.json", "--json"], dir.path());
+        assert!(again.status.success(), "{}", stderr(&again));
+        let read: serde_json::Value = serde_json::from_slice(&again.stdout).unwrap();
+        assert_eq!(made["axis"], read["axis"]);
+        for key in [
+            "B", "B_mean", "R_up", "R_down", "R", "E_up", "E_down", "E", "M", "A_up", "A_down", "A",
+        ] {
+            assert!(read["axis"][key].is_number(), "{key}");
+        }
+    }
+
+    #[test]
+    fn a_linear_frequency_response_finds_the_motor_held_modes() {
+        let dir = tempdir();
+        let out = rtid(
+            &[
+                "experiment",
+                "frequency-response",
+                "--preset",
+                "worm-gear",
+                "--linear",
+                "--out",
+                "fr",
+                "--json",
+            ],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let peaks: Vec<f64> = v["peaks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["frequency_hz"].as_f64().unwrap())
+            .collect();
+        // The damped peaks of the table/motor ratio sit near the motor-held modes
+        // (186.5 and 236.9 Hz), shifted by the damping.
+        assert_eq!(peaks.len(), 2, "{peaks:?}");
+        assert!(
+            (peaks[0] - 186.5).abs() < 3.0 && (peaks[1] - 236.9).abs() < 5.0,
+            "{peaks:?}"
+        );
+        assert!(dir.path().join("fr/frequency_response.svg").exists());
+    }
+
+    #[test]
+    fn evaluating_a_malformed_experiment_names_file_and_line() {
+        let dir = tempdir();
+        std::fs::write(
+            dir.path().join("fr.json"),
+            r#"{"kind": "frequency_response", "data": "fr.csv"}"#,
+        )
+        .unwrap();
+        std::fs::write(
+            dir.path().join("fr.csv"),
+            "frequency_hz,gain_db\n10,0.1\n20,abc\n",
+        )
+        .unwrap();
+        let out = rtid(&["evaluate", "fr.json"], dir.path());
+        assert_one_line_error(&out, &["fr.csv", "line 3", "gain_db"]);
+    }
+}

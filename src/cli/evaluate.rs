@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 
-use super::experiment::positioning;
+use super::experiment::{frequency_response, positioning};
 use crate::io::experiment_file::{self, Kind};
 
 pub const LONG_ABOUT: &str = "\
@@ -12,6 +12,9 @@ Evaluates an experiment file (a JSON manifest with its CSV, docs/experiment-file
 measured on a real table or written by `rtid experiment`, and writes a plot beside it.
 
 Kinds evaluated:
+  frequency_response   the resonances: local maxima of the gain, located by parabolic \
+interpolation (Hz, dB). Plot: gain over frequency, with the linear model's curve when the \
+file carries one.
   positioning   ISO 230-2 statistics in arc-seconds: per target x̄↑, x̄↓, s↑, s↓, Bi, R↑i, \
 R↓i, Ri; for the axis the reversal B and mean reversal B̄, repeatability R↑, R↓, R, \
 systematic deviation E↑, E↓, E, mean deviation M, accuracy A↑, A↓, A. Plot: the paper's \
@@ -42,8 +45,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .unwrap_or_else(|| a.file.with_extension("svg"));
     match exp.manifest.kind {
         Kind::Positioning => positioning::report(&exp, &plot, a.json),
+        Kind::FrequencyResponse => frequency_response::report(&exp, &plot, a.json),
         other => bail!(
-            "{}: evaluating `{}` experiments is not part of this version yet (positioning is)",
+            "{}: evaluating `{}` experiments is not part of this version yet (positioning and frequency_response are)",
             a.file.display(),
             other.name()
         ),

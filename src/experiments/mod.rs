@@ -1,4 +1,5 @@
 //! The paper's five tests (MODEL.md §5): virtual experiments and the evaluation of their measured data.
 
+pub mod frequency_response;
 pub mod iso230;
 pub mod positioning;

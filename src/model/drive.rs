@@ -165,6 +165,12 @@ impl Drive {
         [t_g, t_w]
     }
 
+    /// Backlash half-widths [θbg, θbw] (0 for a preloaded or absent mesh, which can
+    /// never be out of contact).
+    pub fn gaps(&self) -> [f64; 2] {
+        [if self.spur { self.bg } else { 0.0 }, self.bw]
+    }
+
     /// Dead-zone deflections [dz(δg), dz(δw)] at state `y`: zero while a mesh is
     /// inside its gap (out of contact).
     pub fn mesh_deflections(&self, y: &[f64; NSTATE]) -> [f64; 2] {

@@ -2,6 +2,7 @@
 //! experiment files (the same format as measured data, so the two compare directly)
 //! with a plot. One file per test.
 
+pub mod frequency_response;
 pub mod positioning;
 
 use std::path::PathBuf;
@@ -19,6 +20,9 @@ an SVG plot, into --out DIR. Virtual and measured experiments compare directly. 
 /// The tests.
 #[derive(Debug, clap::Subcommand)]
 pub enum Test {
+    /// Frequency response, 10–600 Hz, nonlinear simulation per frequency (paper §4.1, Fig. 8).
+    #[command(long_about = frequency_response::LONG_ABOUT)]
+    FrequencyResponse(frequency_response::Args),
     /// ISO 230-2 positioning accuracy and repeatability (paper §4.3, Fig. 10).
     #[command(long_about = positioning::LONG_ABOUT)]
     Positioning(positioning::Args),
@@ -50,6 +54,7 @@ impl Common {
 
 pub fn run(test: Test) -> anyhow::Result<()> {
     match test {
+        Test::FrequencyResponse(a) => frequency_response::run(a),
         Test::Positioning(a) => positioning::run(a),
     }
 }
