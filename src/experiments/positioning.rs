@@ -56,9 +56,13 @@ impl Default for PositioningTest {
     }
 }
 
+/// A stop of the cycle: commanded angle, and the reading taken there (target,
+/// direction, run), if any.
+type Stop = (f64, Option<(f64, Direction, u32)>);
+
 impl PositioningTest {
     /// The sequence of (commanded angle, reading taken there as which measurement).
-    fn cycle(&self) -> Vec<(f64, Option<(f64, Direction, u32)>)> {
+    fn cycle(&self) -> Vec<Stop> {
         let mut targets = self.targets.clone();
         targets.sort_by(f64::total_cmp);
         let (first, last) = (targets[0], targets[targets.len() - 1]);
