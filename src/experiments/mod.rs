@@ -2,3 +2,4 @@
 
 pub mod iso230;
 pub mod positioning;
+pub mod torque_curve;

@@ -3,6 +3,7 @@
 //! with a plot. One file per test.
 
 pub mod positioning;
+pub mod torque_curve;
 
 use std::path::PathBuf;
 
@@ -22,6 +23,9 @@ pub enum Test {
     /// ISO 230-2 positioning accuracy and repeatability (paper §4.3, Fig. 10).
     #[command(long_about = positioning::LONG_ABOUT)]
     Positioning(positioning::Args),
+    /// Friction torque curve: motor torque under harmonic table motion (paper §4.2, Fig. 9).
+    #[command(long_about = torque_curve::LONG_ABOUT)]
+    TorqueCurve(torque_curve::Args),
 }
 
 /// Arguments every test takes.
@@ -51,5 +55,6 @@ impl Common {
 pub fn run(test: Test) -> anyhow::Result<()> {
     match test {
         Test::Positioning(a) => positioning::run(a),
+        Test::TorqueCurve(a) => torque_curve::run(a),
     }
 }
