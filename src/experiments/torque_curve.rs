@@ -333,7 +333,9 @@ pub fn evaluate(curve: &TorqueCurve, test: &TorqueTest) -> Result<TorqueReport, 
         )
     } else {
         // The command A·sin(2πt/T) reverses at T/4 + k·T/2 (time restarted at a whole
-        // number of periods); direction before: + at T/4, − at 3T/4.
+        // number of periods); direction before: + at T/4, − at 3T/4. The table follows
+        // with the servo's lag (≈ 40 ms for the presets), so this estimate is poorer:
+        // ~15 % low on the worm preset. Record the table angle when you can.
         let half = 0.5 * test.period;
         let first = ((t0 - 0.25 * test.period) / half).ceil() as i64;
         let times = (first..)
