@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 
-use super::experiment::{frequency_response, positioning};
+use super::experiment::{frequency_response, positioning, torque_curve};
 use crate::io::experiment_file::{self, Kind};
 
 pub const LONG_ABOUT: &str = "\
@@ -19,9 +19,11 @@ file carries one.
 R↓i, Ri; for the axis the reversal B and mean reversal B̄, repeatability R↑, R↓, R, \
 systematic deviation E↑, E↓, E, mean deviation M, accuracy A↑, A↓, A. Plot: the paper's \
 Fig. 10.
+  torque_curve  RMS and peak motor torque, N·m, and the Coulomb friction torque at the motor: half the torque jump across each reversal of the table velocity (reversals from the table angle, or from the commanded motion's period when the file has no angle), averaged. Plot: torque over time (the paper's Fig. 9), and over table angle in FILE-vs-angle.svg when the file has the angle.
 
 Example:
-  rtid evaluate runs/worm/positioning.json --json";
+  rtid evaluate runs/worm/positioning.json --json
+  rtid evaluate runs/worm/torque_curve.json";
 
 /// Arguments of `rtid evaluate`.
 #[derive(Debug, clap::Args)]
@@ -46,8 +48,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     match exp.manifest.kind {
         Kind::Positioning => positioning::report(&exp, &plot, a.json),
         Kind::FrequencyResponse => frequency_response::report(&exp, &plot, a.json),
+        Kind::TorqueCurve => torque_curve::report(&exp, &plot, a.json),
         other => bail!(
-            "{}: evaluating `{}` experiments is not part of this version yet (positioning and frequency_response are)",
+            "{}: evaluating `{}` experiments is not part of this version yet",
             a.file.display(),
             other.name()
         ),

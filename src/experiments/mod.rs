@@ -3,3 +3,4 @@
 pub mod frequency_response;
 pub mod iso230;
 pub mod positioning;
+pub mod torque_curve;

@@ -4,6 +4,7 @@
 
 pub mod frequency_response;
 pub mod positioning;
+pub mod torque_curve;
 
 use std::path::PathBuf;
 
@@ -26,6 +27,9 @@ pub enum Test {
     /// ISO 230-2 positioning accuracy and repeatability (paper §4.3, Fig. 10).
     #[command(long_about = positioning::LONG_ABOUT)]
     Positioning(positioning::Args),
+    /// Friction torque curve: motor torque under harmonic table motion (paper §4.2, Fig. 9).
+    #[command(long_about = torque_curve::LONG_ABOUT)]
+    TorqueCurve(torque_curve::Args),
 }
 
 /// Arguments every test takes.
@@ -56,5 +60,6 @@ pub fn run(test: Test) -> anyhow::Result<()> {
     match test {
         Test::FrequencyResponse(a) => frequency_response::run(a),
         Test::Positioning(a) => positioning::run(a),
+        Test::TorqueCurve(a) => torque_curve::run(a),
     }
 }

@@ -1,0 +1,156 @@
+//! `rtid experiment torque-curve` and the evaluation of torque-curve files.
+
+use std::path::Path;
+
+use anyhow::bail;
+
+use super::Common;
+use crate::cli::progress;
+use crate::experiments::torque_curve::{self, TorqueTest};
+use crate::io::experiment_file::{self, Experiment};
+use crate::model::{LoopMode, Params};
+
+pub const LONG_ABOUT: &str = "\
+Friction torque curve (paper §4.2, Fig. 9): the servo, in full-closed loop by default, \
+moves the table harmonically, 30°·sin(2πt/3 s), and the motor torque command over time is \
+the measured curve — inertia, viscous damping and Coulomb friction of motor, shaft and \
+table, all seen at the motor. The first period (the servo's start-up transient) is not \
+recorded; then --periods periods are sampled every 1 ms, time restarted at 0. Writes \
+torque_curve.json/.csv (time_s, motor_torque_nm, table_angle_deg), torque_curve.svg \
+(torque over time, like Fig. 9) and torque_curve-vs-angle.svg, and prints:
+
+  RMS torque    root mean square of the motor torque, N·m
+  peak torque   largest |motor torque|, N·m
+  friction      the Coulomb friction torque at the motor, N·m: half the jump of the torque \
+across each reversal of the table velocity (lines fitted on either side, outside a guard \
+of T/100, over T·6/100), averaged. On the model it is fm + fw·Rg + ft·Rg·Rw (roller \
+gear cam: fm + ft·Rw) — the table's friction reaches the motor divided by the ratio.
+
+Example:
+  rtid experiment torque-curve --preset worm-gear --out runs/worm
+  rtid experiment torque-curve --preset roller-gear-cam --period-s 6 --periods 3 --json --out runs/roller";
+
+/// Arguments of `rtid experiment torque-curve`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub common: Common,
+    /// Feedback loop.
+    #[arg(
+        long = "loop",
+        value_name = "semi_closed|full_closed",
+        default_value = "full_closed"
+    )]
+    pub loop_mode: LoopMode,
+    /// Amplitude of the commanded table motion, degrees.
+    #[arg(long, value_name = "DEG", default_value_t = 30.0)]
+    pub amplitude_deg: f64,
+    /// Period of the commanded table motion, s.
+    #[arg(long, value_name = "SECONDS", default_value_t = 3.0)]
+    pub period_s: f64,
+    /// Periods recorded after the one-period run-in.
+    #[arg(long, value_name = "N", default_value_t = 2.0)]
+    pub periods: f64,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let p = a.common.model.load()?;
+    a.common.create_out()?;
+    run_torque_curve(&a, &p)
+}
+
+/// The test the flags describe, or why they do not describe one.
+fn test(a: &Args) -> anyhow::Result<TorqueTest> {
+    let positive = |v: f64, flag: &str| -> anyhow::Result<f64> {
+        if v > 0.0 && v.is_finite() {
+            Ok(v)
+        } else {
+            bail!("{flag} {v}: must be a positive number")
+        }
+    };
+    Ok(TorqueTest {
+        amplitude: positive(a.amplitude_deg, "--amplitude-deg")?.to_radians(),
+        period: positive(a.period_s, "--period-s")?,
+        periods: positive(a.periods, "--periods")?,
+        loop_mode: a.loop_mode,
+        ..Default::default()
+    })
+}
+
+fn run_torque_curve(a: &Args, p: &Params) -> anyhow::Result<()> {
+    let test = test(a)?;
+    let total = (test.run_in_periods + test.periods).ceil() as u64;
+    let bar = progress::bar(total, "torque curve", a.common.quiet);
+    let curve = torque_curve::run(p, &test, |done, _| bar.set_position(done as u64))?;
+    bar.finish_and_clear();
+    let manifest_path = a.common.out.join("torque_curve.json");
+    let mut manifest = torque_curve::manifest(p, &test);
+    manifest.data = Some("torque_curve.csv".into());
+    experiment_file::write(&manifest_path, &manifest, &torque_curve::to_data(&curve))?;
+    report(
+        &experiment_file::read(&manifest_path)?,
+        &a.common.out.join("torque_curve.svg"),
+        a.common.json,
+    )
+}
+
+/// Evaluates a torque-curve experiment: RMS, peak and friction printed (table or
+/// JSON); torque over time written to `plot`, and, when the file has the table angle,
+/// torque over angle beside it (`STEM-vs-angle.svg`).
+pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
+    let curve = torque_curve::from_data(&exp.data).expect("a torque-curve experiment");
+    let test = TorqueTest::from_conditions(&exp.manifest.conditions);
+    let report = torque_curve::evaluate(&curve, &test)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", exp.path.display()))?;
+    let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
+    let title = format!("{mechanism}: motor torque");
+    torque_curve::plot(&curve, &report, &title, plot)
+        .map_err(|e| anyhow::anyhow!("writing {}: {e}", plot.display()))?;
+    if !curve.table_angle.is_empty() {
+        let stem = plot.file_stem().unwrap_or_default().to_string_lossy();
+        let angle_plot = plot.with_file_name(format!("{stem}-vs-angle.svg"));
+        torque_curve::plot_vs_angle(&curve, &title, &angle_plot)
+            .map_err(|e| anyhow::anyhow!("writing {}: {e}", angle_plot.display()))?;
+    }
+    if json {
+        let mut value = serde_json::to_value(&report)?;
+        value["kind"] = serde_json::json!("torque_curve");
+        value["source"] = serde_json::json!(exp.path);
+        println!("{}", serde_json::to_string_pretty(&value)?);
+    } else {
+        println!(
+            "{}: torque curve, {:.0}° amplitude, {} s period",
+            exp.path.display(),
+            test.amplitude.to_degrees(),
+            test.period
+        );
+        println!("{}", torque_curve::table(&report));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    #[test]
+    fn defaults_are_the_papers_conditions_and_bad_values_are_refused() {
+        let cli = Cli::parse_from(["t", "--preset", "worm-gear", "--out", "x"]);
+        let t = test(&cli.args).unwrap();
+        assert_eq!(t, TorqueTest::default());
+        let cli = Cli::parse_from(["t", "--preset", "worm-gear", "--out", "x", "--periods", "0"]);
+        assert!(test(&cli.args)
+            .unwrap_err()
+            .to_string()
+            .contains("--periods"));
+        let cli = Cli::try_parse_from(["t", "--out", "x", "--loop", "open"]);
+        assert!(cli.is_err());
+    }
+}
