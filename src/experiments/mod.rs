@@ -1,4 +1,6 @@
 //! The paper's five tests (MODEL.md §5): virtual experiments and the evaluation of their measured data.
 
+pub mod fluctuation;
 pub mod iso230;
 pub mod positioning;
+pub mod spectrum;

@@ -2,7 +2,9 @@
 //! experiment files (the same format as measured data, so the two compare directly)
 //! with a plot. One file per test.
 
+pub mod fluctuation;
 pub mod positioning;
+pub mod unbalance;
 
 use std::path::PathBuf;
 
@@ -22,6 +24,12 @@ pub enum Test {
     /// ISO 230-2 positioning accuracy and repeatability (paper §4.3, Fig. 10).
     #[command(long_about = positioning::LONG_ABOUT)]
     Positioning(positioning::Args),
+    /// Rotational fluctuation at constant speed and its spectrum (paper §4.4, Figs. 11, 12).
+    #[command(long_about = fluctuation::LONG_ABOUT)]
+    Fluctuation(fluctuation::Args),
+    /// Vertical table with an offset mass: the backlash step (paper §4.5, Fig. 14).
+    #[command(long_about = unbalance::LONG_ABOUT)]
+    Unbalance(unbalance::Args),
 }
 
 /// Arguments every test takes.
@@ -51,5 +59,7 @@ impl Common {
 pub fn run(test: Test) -> anyhow::Result<()> {
     match test {
         Test::Positioning(a) => positioning::run(a),
+        Test::Fluctuation(a) => fluctuation::run(a),
+        Test::Unbalance(a) => unbalance::run(a),
     }
 }
