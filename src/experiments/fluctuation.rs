@@ -305,7 +305,8 @@ pub enum FluctuationError {
 /// A step of the deviation.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Step {
-    /// Change of the deviation across [`STEP_WINDOW`], arc-sec (signed).
+    /// Change of the deviation across [`STEP_WINDOW`] in the order travelled (later
+    /// minus earlier), arc-sec.
     pub size_arcsec: f64,
     /// Table angle at the middle of the window, deg.
     pub angle_deg: f64,
