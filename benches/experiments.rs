@@ -23,13 +23,18 @@ fn experiments(c: &mut Criterion) {
     let mut group = c.benchmark_group("experiments");
     group.sample_size(10);
     for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         group.bench_function(format!("fixed_work/{threads}_threads"), |b| {
             b.iter(|| pool.install(|| sweep(&p, &fixed, &|| {}).unwrap()))
         });
     }
     let full = FrequencyTest::default();
-    group.bench_function("sweep/worm-gear", |b| b.iter(|| sweep(&p, &full, &|| {}).unwrap()));
+    group.bench_function("sweep/worm-gear", |b| {
+        b.iter(|| sweep(&p, &full, &|| {}).unwrap())
+    });
     group.finish();
 }
 

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 
-use super::experiment::{frequency_response, positioning, torque_curve};
+use super::experiment::{fluctuation, frequency_response, positioning, torque_curve};
 use crate::io::experiment_file::{self, Kind};
 
 pub const LONG_ABOUT: &str = "\
@@ -20,10 +20,19 @@ R↓i, Ri; for the axis the reversal B and mean reversal B̄, repeatability R↑
 systematic deviation E↑, E↓, E, mean deviation M, accuracy A↑, A↓, A. Plot: the paper's \
 Fig. 10.
   torque_curve  RMS and peak motor torque, N·m, and the Coulomb friction torque at the motor: half the torque jump across each reversal of the table velocity (reversals from the table angle, or from the commanded motion's period when the file has no angle), averaged. Plot: torque over time (the paper's Fig. 9), and over table angle in FILE-vs-angle.svg when the file has the angle.
+  fluctuation   deviation θt − θm·ratio over table angle per direction (ratio: the \
+manifest's conditions.ratio, else Rg·Rw of the preset named in `mechanism`): mean, \
+peak-to-peak, the gap between the directions (lost motion), the power spectrum over \
+cycles per revolution and its dominant orders with amplitudes, the largest step. Plots: \
+FILE.svg (Fig. 11) and FILE-spectrum.svg (Fig. 12).
+  unbalance     as fluctuation; the step (largest change of the deviation across 0.5° of \
+table angle, and where) is the backlash crossed when the unbalance moment overcomes the \
+friction. Plots: FILE.svg (Fig. 14) and FILE-spectrum.svg.
 
 Example:
   rtid evaluate runs/worm/positioning.json --json
-  rtid evaluate runs/worm/torque_curve.json";
+  rtid evaluate runs/worm/torque_curve.json
+  rtid evaluate runs/worm/fluctuation.json";
 
 /// Arguments of `rtid evaluate`.
 #[derive(Debug, clap::Args)]
@@ -49,6 +58,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Kind::Positioning => positioning::report(&exp, &plot, a.json),
         Kind::FrequencyResponse => frequency_response::report(&exp, &plot, a.json),
         Kind::TorqueCurve => torque_curve::report(&exp, &plot, a.json),
+        Kind::Fluctuation | Kind::Unbalance => fluctuation::report(&exp, &plot, a.json),
         other => bail!(
             "{}: evaluating `{}` experiments is not part of this version yet",
             a.file.display(),

@@ -1,6 +1,8 @@
 //! The paper's five tests (MODEL.md §5): virtual experiments and the evaluation of their measured data.
 
+pub mod fluctuation;
 pub mod frequency_response;
 pub mod iso230;
 pub mod positioning;
+pub mod spectrum;
 pub mod torque_curve;

@@ -2,9 +2,11 @@
 //! experiment files (the same format as measured data, so the two compare directly)
 //! with a plot. One file per test.
 
+pub mod fluctuation;
 pub mod frequency_response;
 pub mod positioning;
 pub mod torque_curve;
+pub mod unbalance;
 
 use std::path::PathBuf;
 
@@ -30,6 +32,12 @@ pub enum Test {
     /// Friction torque curve: motor torque under harmonic table motion (paper §4.2, Fig. 9).
     #[command(long_about = torque_curve::LONG_ABOUT)]
     TorqueCurve(torque_curve::Args),
+    /// Rotational fluctuation at constant speed and its spectrum (paper §4.4, Figs. 11, 12).
+    #[command(long_about = fluctuation::LONG_ABOUT)]
+    Fluctuation(fluctuation::Args),
+    /// Vertical table with an offset mass: the backlash step (paper §4.5, Fig. 14).
+    #[command(long_about = unbalance::LONG_ABOUT)]
+    Unbalance(unbalance::Args),
 }
 
 /// Arguments every test takes.
@@ -61,5 +69,7 @@ pub fn run(test: Test) -> anyhow::Result<()> {
         Test::FrequencyResponse(a) => frequency_response::run(a),
         Test::Positioning(a) => positioning::run(a),
         Test::TorqueCurve(a) => torque_curve::run(a),
+        Test::Fluctuation(a) => fluctuation::run(a),
+        Test::Unbalance(a) => unbalance::run(a),
     }
 }

@@ -1,0 +1,168 @@
+//! `rtid experiment fluctuation` and the evaluation of fluctuation and unbalance files.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::bail;
+
+use super::Common;
+use crate::cli::progress;
+use crate::experiments::fluctuation::{self, Evaluation, FluctuationTest};
+use crate::io::experiment_file::{self, Experiment, Kind};
+use crate::model::{LoopMode, Params};
+
+pub const LONG_ABOUT: &str = "\
+Rotational fluctuation (paper §4.4, Figs. 11 and 12): the servo, in semi-closed loop by \
+default, turns the table at a constant 180°/min through one revolution counter-clockwise \
+(up) and one clockwise (down), with 10° of run-in at both ends of each pass so the speed \
+is steady. Both encoders are recorded (every 4 ms, quantised to their resolutions).
+
+Outputs, in --out DIR: fluctuation.json/.csv (time_s, motor_angle_deg, table_angle_deg), \
+fluctuation.svg (the deviation θt − θm·Rg·Rw over table angle, one curve per direction: \
+Fig. 11; the gap between the curves is the lost motion, i.e. the backlash) and \
+fluctuation-spectrum.svg (its power spectrum over cycles per revolution: Fig. 12). \
+Printed: per direction the mean and peak-to-peak deviation (arc-sec) and the dominant \
+orders (cycles/rev with their amplitude in arc-sec). A worm wheel of 72 teeth shows its \
+fluctuation at order 72; a roller gear cam shows none.
+
+Example:
+  rtid experiment fluctuation --preset worm-gear --out runs/worm
+  rtid experiment fluctuation --preset roller-gear-cam --json --out runs/roller";
+
+/// Arguments of `rtid experiment fluctuation`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub common: Common,
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Table speed, degrees per minute.
+    #[arg(long, value_name = "DEG_PER_MIN", default_value_t = 180.0)]
+    pub speed_deg_per_min: f64,
+}
+
+/// The run settings fluctuation and unbalance share.
+#[derive(Debug, clap::Args)]
+pub struct RunArgs {
+    /// Feedback loop.
+    #[arg(
+        long = "loop",
+        value_name = "semi_closed|full_closed",
+        default_value = "semi_closed"
+    )]
+    pub loop_mode: LoopMode,
+    /// Whole revolutions measured in each direction.
+    #[arg(long, default_value_t = 1)]
+    pub revolutions: u32,
+    /// Extra travel at both ends of each pass, degrees.
+    #[arg(long, value_name = "DEG", default_value_t = 10.0)]
+    pub run_in_deg: f64,
+    /// Recording interval, seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = 4e-3)]
+    pub sample_period_s: f64,
+}
+
+/// A positive finite flag value.
+pub fn positive(v: f64, flag: &str) -> anyhow::Result<f64> {
+    if v > 0.0 && v.is_finite() {
+        Ok(v)
+    } else {
+        bail!("{flag} {v}: must be a positive number")
+    }
+}
+
+impl RunArgs {
+    /// The test at `speed_deg_per_min`.
+    pub fn test(&self, speed_deg_per_min: f64) -> anyhow::Result<FluctuationTest> {
+        if self.revolutions == 0 {
+            bail!("--revolutions 0: at least one revolution is needed");
+        }
+        if !(self.run_in_deg >= 0.0 && self.run_in_deg.is_finite()) {
+            bail!("--run-in-deg {}: must be zero or positive", self.run_in_deg);
+        }
+        Ok(FluctuationTest {
+            speed: positive(speed_deg_per_min, "--speed-deg-per-min")?.to_radians() / 60.0,
+            revolutions: self.revolutions,
+            run_in: self.run_in_deg.to_radians(),
+            sample_period: positive(self.sample_period_s, "--sample-period-s")?,
+            loop_mode: self.loop_mode,
+            ..Default::default()
+        })
+    }
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let p = a.common.model.load()?;
+    a.common.create_out()?;
+    let test = a.run.test(a.speed_deg_per_min)?;
+    run_test(&a.common, &p, &test)
+}
+
+/// Runs `test`, writes its experiment file and reports it (fluctuation and unbalance).
+pub fn run_test(common: &Common, p: &Params, test: &FluctuationTest) -> anyhow::Result<()> {
+    let name = test.kind().name();
+    let bar = progress::bar(test.duration().ceil() as u64, name, common.quiet);
+    let record = fluctuation::run(p, test, |done, _| bar.set_position(done as u64))?;
+    bar.finish_and_clear();
+    let manifest_path = common.out.join(format!("{name}.json"));
+    let mut manifest = fluctuation::manifest(p, test);
+    manifest.data = Some(format!("{name}.csv"));
+    experiment_file::write(
+        &manifest_path,
+        &manifest,
+        &fluctuation::to_data(&record, test.kind()),
+    )?;
+    report(
+        &experiment_file::read(&manifest_path)?,
+        &common.out.join(format!("{name}.svg")),
+        common.json,
+    )
+}
+
+/// `FILE.svg` → `FILE-spectrum.svg`.
+fn spectrum_path(plot: &Path) -> PathBuf {
+    let stem = plot
+        .file_stem()
+        .map_or("plot".into(), |s| s.to_string_lossy());
+    plot.with_file_name(format!("{stem}-spectrum.svg"))
+}
+
+/// Evaluates a fluctuation or unbalance experiment: printed (table or JSON), the
+/// deviation plot written to `plot` and the spectrum beside it (`…-spectrum.svg`).
+pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
+    let kind = exp.manifest.kind;
+    let e = fluctuation::evaluate_experiment(exp).map_err(|e| match e {
+        fluctuation::FluctuationError::NoRatio { .. } => anyhow::anyhow!("{e}"),
+        other => anyhow::anyhow!("{}: {other}", exp.path.display()),
+    })?;
+    let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
+    let what = if kind == Kind::Unbalance {
+        "influence of unbalance mass"
+    } else {
+        "rotational fluctuation"
+    };
+    fluctuation::plot_deviation(&e, &format!("{mechanism}: {what}"), plot)
+        .map_err(|err| anyhow::anyhow!("writing {}: {err}", plot.display()))?;
+    let spectrum = spectrum_path(plot);
+    fluctuation::plot_spectrum(
+        &e,
+        &format!("{mechanism}: power spectrum of the {what}"),
+        200.0,
+        &spectrum,
+    )
+    .map_err(|err| anyhow::anyhow!("writing {}: {err}", spectrum.display()))?;
+    print(&e, kind, json, &exp.path)
+}
+
+fn print(e: &Evaluation, kind: Kind, json: bool, source: &Path) -> anyhow::Result<()> {
+    if json {
+        let mut value = serde_json::to_value(e)?;
+        value["kind"] = serde_json::json!(kind.name());
+        value["source"] = serde_json::json!(source);
+        value["unit"] = serde_json::json!("arcsec");
+        println!("{}", serde_json::to_string_pretty(&value)?);
+    } else {
+        println!("{}: {kind} evaluation, arc-seconds", source.display());
+        println!("{}", fluctuation::table(e, kind));
+    }
+    Ok(())
+}
