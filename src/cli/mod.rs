@@ -1,6 +1,7 @@
 //! The command line: clap parses raw arguments here, each command's module validates
 //! them into a run configuration and runs it.
 
+mod compare;
 mod evaluate;
 mod experiment;
 mod model_args;
@@ -32,7 +33,8 @@ Examples:
   rtid simulate --preset roller-gear-cam --input move:target_deg=30,loop=full_closed --duration-s 1 --out move.csv
   rtid params --preset worm-gear --set Kw=3.5e5 --out my-table.json
   rtid experiment positioning --preset worm-gear --out runs/worm
-  rtid evaluate runs/worm/positioning.json";
+  rtid evaluate runs/worm/positioning.json
+  rtid compare runs/worm runs/roller";
 
 /// Top-level arguments.
 #[derive(Debug, Parser)]
@@ -63,6 +65,9 @@ pub enum Command {
     /// Evaluate a measured or virtual experiment file (statistics, plot).
     #[command(long_about = evaluate::LONG_ABOUT)]
     Evaluate(evaluate::Args),
+    /// The paper's Table 3: two folders of experiment files side by side.
+    #[command(long_about = compare::LONG_ABOUT)]
+    Compare(compare::Args),
 }
 
 /// Runs one parsed command line.
@@ -73,5 +78,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Params(a) => params_cmd::run(a),
         Command::Experiment { test } => experiment::run(test),
         Command::Evaluate(a) => evaluate::run(a),
+        Command::Compare(a) => compare::run(a),
     }
 }

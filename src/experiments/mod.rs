@@ -1,5 +1,6 @@
 //! The paper's five tests (MODEL.md §5): virtual experiments and the evaluation of their measured data.
 
+pub mod compare;
 pub mod fluctuation;
 pub mod frequency_response;
 pub mod iso230;
