@@ -7,7 +7,7 @@ use anyhow::bail;
 use super::Common;
 use crate::cli::progress;
 use crate::experiments::fluctuation::{self, Evaluation, FluctuationTest};
-use crate::io::experiment_file::{self, Experiment, Kind};
+use crate::io::experiment_file::{Experiment, Kind};
 use crate::model::{LoopMode, Params};
 
 pub const LONG_ABOUT: &str = "\
@@ -103,18 +103,11 @@ pub fn run_test(common: &Common, p: &Params, test: &FluctuationTest) -> anyhow::
     let bar = progress::bar(test.duration().ceil() as u64, name, common.quiet);
     let record = fluctuation::run(p, test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
-    let manifest_path = common.out.join(format!("{name}.json"));
-    let mut manifest = fluctuation::manifest(p, test);
-    manifest.data = Some(format!("{name}.csv"));
-    experiment_file::write(
-        &manifest_path,
-        &manifest,
+    common.write_and_report(
+        name,
+        fluctuation::manifest(p, test),
         &fluctuation::to_data(&record, test.kind()),
-    )?;
-    report(
-        &experiment_file::read(&manifest_path)?,
-        &common.out.join(format!("{name}.svg")),
-        common.json,
+        report,
     )
 }
 

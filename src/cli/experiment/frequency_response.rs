@@ -169,7 +169,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let mut manifest = Manifest::new(Kind::FrequencyResponse);
     manifest.mechanism = Some(p.name.clone());
-    manifest.data = Some("frequency_response.csv".into());
     manifest.conditions.torque_amplitude_nm = Some(test.amplitude_nm);
     manifest.conditions.preload_nm = Some(test.preload_nm);
     manifest.notes = Some(if a.linear {
@@ -177,13 +176,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else {
         "virtual test by rtid: nonlinear time simulation per frequency".into()
     });
-    let path = a.common.out.join("frequency_response.json");
-    experiment_file::write(&path, &manifest, &data)?;
-    report(
-        &experiment_file::read(&path)?,
-        &a.common.out.join("frequency_response.svg"),
-        a.common.json,
-    )
+    a.common
+        .write_and_report("frequency_response", manifest, &data, report)
 }
 
 /// Warns on stderr where a mesh lost contact, and where the table did not move.

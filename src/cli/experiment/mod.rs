@@ -8,11 +8,12 @@ pub mod positioning;
 pub mod torque_curve;
 pub mod unbalance;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
 use super::ModelArgs;
+use crate::io::experiment_file::{self, Data, Experiment, Manifest};
 
 pub const LONG_ABOUT: &str = "\
 Runs one of the paper's tests on the model and writes it as an experiment file — a JSON \
@@ -56,7 +57,31 @@ pub struct Common {
     pub json: bool,
 }
 
+/// How a test reports an experiment file: print the evaluation (table or JSON) and
+/// write the plot to the given path.
+pub type Report = fn(&Experiment, &Path, bool) -> anyhow::Result<()>;
+
 impl Common {
+    /// Writes the test's experiment file as `STEM.json` + `STEM.csv` in the output
+    /// folder, reads it back — so the report is exactly what `rtid evaluate` says of
+    /// the file — and reports it with the plot `STEM.svg`.
+    pub fn write_and_report(
+        &self,
+        stem: &str,
+        mut manifest: Manifest,
+        data: &Data,
+        report: Report,
+    ) -> anyhow::Result<()> {
+        let path = self.out.join(format!("{stem}.json"));
+        manifest.data = Some(format!("{stem}.csv"));
+        experiment_file::write(&path, &manifest, data)?;
+        report(
+            &experiment_file::read(&path)?,
+            &self.out.join(format!("{stem}.svg")),
+            self.json,
+        )
+    }
+
     /// Creates the output folder.
     pub fn create_out(&self) -> anyhow::Result<()> {
         std::fs::create_dir_all(&self.out)

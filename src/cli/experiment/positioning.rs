@@ -7,7 +7,7 @@ use anyhow::bail;
 use super::Common;
 use crate::cli::progress;
 use crate::experiments::{iso230, positioning};
-use crate::io::experiment_file::{self, Experiment};
+use crate::io::experiment_file::Experiment;
 use crate::model::{LoopMode, Params};
 
 pub const LONG_ABOUT: &str = "\
@@ -96,14 +96,11 @@ fn run_positioning(a: &Args, p: &Params) -> anyhow::Result<()> {
     let bar = progress::bar(test.readings() as u64, "positioning", a.common.quiet);
     let readings = positioning::run(p, &test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
-    let manifest_path = a.common.out.join("positioning.json");
-    let mut manifest = positioning::manifest(p, &test);
-    manifest.data = Some("positioning.csv".into());
-    experiment_file::write(&manifest_path, &manifest, &positioning::to_data(&readings))?;
-    report(
-        &experiment_file::read(&manifest_path)?,
-        &a.common.out.join("positioning.svg"),
-        a.common.json,
+    a.common.write_and_report(
+        "positioning",
+        positioning::manifest(p, &test),
+        &positioning::to_data(&readings),
+        report,
     )
 }
 

@@ -7,7 +7,7 @@ use anyhow::bail;
 use super::Common;
 use crate::cli::progress;
 use crate::experiments::torque_curve::{self, TorqueTest};
-use crate::io::experiment_file::{self, Experiment};
+use crate::io::experiment_file::Experiment;
 use crate::model::{LoopMode, Params};
 
 pub const LONG_ABOUT: &str = "\
@@ -83,14 +83,11 @@ fn run_torque_curve(a: &Args, p: &Params) -> anyhow::Result<()> {
     let bar = progress::bar(total, "torque curve", a.common.quiet);
     let curve = torque_curve::run(p, &test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
-    let manifest_path = a.common.out.join("torque_curve.json");
-    let mut manifest = torque_curve::manifest(p, &test);
-    manifest.data = Some("torque_curve.csv".into());
-    experiment_file::write(&manifest_path, &manifest, &torque_curve::to_data(&curve))?;
-    report(
-        &experiment_file::read(&manifest_path)?,
-        &a.common.out.join("torque_curve.svg"),
-        a.common.json,
+    a.common.write_and_report(
+        "torque_curve",
+        torque_curve::manifest(p, &test),
+        &torque_curve::to_data(&curve),
+        report,
     )
 }
 
