@@ -8,9 +8,11 @@
 pub mod cli;
 pub mod controller;
 pub mod experiments;
+pub mod identify;
 pub mod input;
 pub mod io;
 pub mod model;
+pub mod objectives;
 pub mod recorder;
 pub mod report;
 pub mod sim;

@@ -4,6 +4,7 @@
 mod compare;
 mod evaluate;
 mod experiment;
+mod identify;
 mod model_args;
 mod modes;
 mod params_cmd;
@@ -62,6 +63,9 @@ pub enum Command {
         #[command(subcommand)]
         test: experiment::Test,
     },
+    /// Identify stiffness, damping and friction from experiment files.
+    #[command(long_about = identify::LONG_ABOUT)]
+    Identify(identify::Args),
     /// Evaluate a measured or virtual experiment file (statistics, plot).
     #[command(long_about = evaluate::LONG_ABOUT)]
     Evaluate(evaluate::Args),
@@ -77,6 +81,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Simulate(a) => simulate::run(a),
         Command::Params(a) => params_cmd::run(a),
         Command::Experiment { test } => experiment::run(test),
+        Command::Identify(a) => identify::run(a),
         Command::Evaluate(a) => evaluate::run(a),
         Command::Compare(a) => compare::run(a),
     }

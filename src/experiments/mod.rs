@@ -4,6 +4,7 @@ pub mod compare;
 pub mod fluctuation;
 pub mod frequency_response;
 pub mod iso230;
+pub mod measurement_noise;
 pub mod positioning;
 pub mod spectrum;
 pub mod torque_curve;

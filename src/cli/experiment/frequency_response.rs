@@ -64,6 +64,13 @@ pub struct Args {
     /// Only the linear response solved in the frequency domain (no time simulation).
     #[arg(long)]
     pub linear: bool,
+    /// Measurement noise: each amplitude ratio × (1 + ε), ε Gaussian with this
+    /// standard deviation in percent (0: none).
+    #[arg(long, value_name = "PERCENT", default_value_t = 0.0)]
+    pub noise_percent: f64,
+    /// Seed of the measurement noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -161,9 +168,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             .collect(),
     );
     extra.insert("linear_gain_db".into(), linear_db);
+    anyhow::ensure!(
+        a.noise_percent >= 0.0 && a.noise_percent.is_finite(),
+        "--noise-percent {}: must be zero or positive",
+        a.noise_percent
+    );
+    let mut gain_db: Vec<f64> = points.iter().map(|q| q.gain_db).collect();
+    crate::experiments::measurement_noise::perturb_gain_db(&mut gain_db, a.noise_percent, a.seed);
     let data = Data::FrequencyResponse {
         frequency_hz: freqs,
-        gain_db: points.iter().map(|q| q.gain_db).collect(),
+        gain_db,
         phase_rad: Some(points.iter().map(|q| q.phase_deg.to_radians()).collect()),
         extra,
     };
@@ -171,11 +185,22 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     manifest.mechanism = Some(p.name.clone());
     manifest.conditions.torque_amplitude_nm = Some(test.amplitude_nm);
     manifest.conditions.preload_nm = Some(test.preload_nm);
-    manifest.notes = Some(if a.linear {
-        "virtual test by rtid: linear response solved in the frequency domain".into()
-    } else {
-        "virtual test by rtid: nonlinear time simulation per frequency".into()
-    });
+    manifest.notes = Some(format!(
+        "{}{}",
+        if a.linear {
+            "virtual test by rtid: linear response solved in the frequency domain"
+        } else {
+            "virtual test by rtid: nonlinear time simulation per frequency"
+        },
+        if a.noise_percent > 0.0 {
+            format!(
+                "; {} % Gaussian noise on the amplitude ratio (seed {})",
+                a.noise_percent, a.seed
+            )
+        } else {
+            String::new()
+        }
+    ));
     a.common
         .write_and_report("frequency_response", manifest, &data, report)
 }

@@ -51,6 +51,12 @@ pub struct Args {
     /// Periods recorded after the one-period run-in.
     #[arg(long, value_name = "N", default_value_t = 2.0)]
     pub periods: f64,
+    /// Measurement noise on the torque: Gaussian, this percentage of the record's RMS.
+    #[arg(long, value_name = "PERCENT", default_value_t = 0.0)]
+    pub noise_percent: f64,
+    /// Seed of the measurement noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -81,11 +87,30 @@ fn run_torque_curve(a: &Args, p: &Params) -> anyhow::Result<()> {
     let test = test(a)?;
     let total = (test.run_in_periods + test.periods).ceil() as u64;
     let bar = progress::bar(total, "torque curve", a.common.quiet);
-    let curve = torque_curve::run(p, &test, |done, _| bar.set_position(done as u64))?;
+    let mut curve = torque_curve::run(p, &test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
+    anyhow::ensure!(
+        a.noise_percent >= 0.0 && a.noise_percent.is_finite(),
+        "--noise-percent {}: must be zero or positive",
+        a.noise_percent
+    );
+    crate::experiments::measurement_noise::perturb_by_rms(
+        &mut curve.motor_torque,
+        a.noise_percent,
+        a.seed,
+    );
+    let mut manifest = torque_curve::manifest(p, &test);
+    if a.noise_percent > 0.0 {
+        manifest.notes = Some(format!(
+            "{}; {} % (of the RMS) Gaussian noise on the torque (seed {})",
+            manifest.notes.unwrap_or_default(),
+            a.noise_percent,
+            a.seed
+        ));
+    }
     a.common.write_and_report(
         "torque_curve",
-        torque_curve::manifest(p, &test),
+        manifest,
         &torque_curve::to_data(&curve),
         report,
     )

@@ -1,0 +1,417 @@
+//! `rtid identify`: parameters from experiment files.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::Context;
+use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+
+use super::ModelArgs;
+use crate::identify::setup::ObjectiveKind;
+use crate::identify::space::parse_bound;
+use crate::identify::{identify, Config, FidelityChoice, Identified, Method, Monitor, Settings};
+use crate::io::experiment_file::{self, Data, Experiment};
+use crate::io::params_file;
+use crate::model::Params;
+use crate::objectives::peak_search::LinearGain;
+use crate::report::plot::{self, Chart, Series, Style};
+
+pub const LONG_ABOUT: &str = "\
+Identifies physical parameters of the drive — torsional stiffnesses Kw, Kg, Kb, internal \
+damping Ciw, Cig, Coulomb friction fm, fw, ft, viscous damping Cm, Cw, Ct, inertias… any \
+subset by name — from one or more experiment files (docs/experiment-files.md), measured on a \
+rig or written by `rtid experiment`. The other parameters stay at the --preset / --params \
+values.
+
+What each experiment feeds (--objective to choose):
+  frequency_response  resonance: the measured resonance frequencies (peaks of the gain curve) \
+against the model's; also peak-amplitude (peak heights, dB: for Ciw, Cig) and gain-curve (the \
+whole gain curve, dB).
+  resonance           resonance (and peak-amplitude when the manifest has peak_gain_db).
+  torque_curve        torque-curve: the motor torque of the closed-loop torque test, sample by \
+sample. A torque curve determines one Coulomb and one viscous sum (fm + fw·Rg + ft·Rg·Rw, and \
+the viscous alike): fit one of each.
+Default --fit: Kw (and Kg with a spur stage) from resonances; fm and Cm from a torque curve \
+(the table's friction reaches the motor divided by the ratio — 1/90 for the worm — and \
+hardly shows in its torque).
+
+The model's frequency response (--model): `linear` is the exact linear response with damping \
+(no backlash, no friction; microseconds); `nonlinear` searches on the linear one, then polishes \
+the best with Gauss–Newton on the virtual test at the experiment's conditions (amplitude, \
+preload; a time simulation per frequency, minutes); `auto` (default) searches on the linear \
+one and then checks the result on the nonlinear test, warning when backlash or friction move \
+the resonances by more than 1 %. By default a gain curve feeds the resonance frequencies and, \
+at weight 0.01, the peak heights: the worm's two resonances alone admit two (Kw, Kg) pairs, \
+the heights tell them apart. Resonances are peaks of the damped response, never undamped eigenvalues (that \
+biases Kw by ~6 %).
+
+Search: positive parameters in log space inside --bound (default 0.1×..10× the start); \
+--starts N starts (the preset's values, then a Latin hypercube in the bounds) in parallel; \
+--method lsq (Gauss–Newton with line search; default), nelder-mead (default with a torque \
+curve, whose quantised encoders make finite differences rough) or pso. Ctrl-C ends the \
+search and still writes the best result; with --checkpoint FILE, --resume continues.
+
+Output: a table of parameter, start, identified ± standard error; warnings when the data \
+cannot separate parameters (|correlation| > 0.95 or a singular JᵀJ), when a parameter ends \
+on a bound, or when the fit misses the measured resonances; --out result.json with \
+everything (parameters, initial, bounds, cost, residuals per experiment, evaluations, \
+wall_time_s, termination, uncertainty); an SVG per experiment of the fit against the data; \
+--save-params FILE for `--params FILE` everywhere.
+
+Examples:
+  rtid identify fixtures/worm-gear/frequency_response.json --preset worm-gear --out fit.json
+  rtid identify fixtures/worm-gear/frequency_response.json fixtures/worm-gear/torque_curve.json \\
+      --preset worm-gear --fit Kw,Kg,ft,Ct --out fit.json --save-params worm-fit.json
+  rtid identify fixtures/paper/worm-gear.json --preset worm-gear --fit Kw,Kg,Jt --model linear
+  rtid modes --params worm-fit.json";
+
+/// Arguments of `rtid identify`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Experiment manifests (JSON).
+    #[arg(value_name = "EXP.json", required = true)]
+    pub experiments: Vec<PathBuf>,
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Parameters to fit, comma-separated names (`rtid params` lists them).
+    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+    pub fit: Vec<String>,
+    /// Bounds of a fitted parameter, SI units; repeatable: --bound Kw=1e5..1e7.
+    #[arg(long = "bound", value_name = "NAME=LO..HI")]
+    pub bounds: Vec<String>,
+    /// Objectives to use (default: by experiment kind, see above).
+    #[arg(long, value_delimiter = ',', value_enum)]
+    pub objective: Option<Vec<ObjectiveKind>>,
+    /// Weight of each experiment in the joint cost, in the order given (default 1 each).
+    #[arg(long = "weight", value_delimiter = ',', allow_negative_numbers = true)]
+    pub weights: Vec<f64>,
+    /// Solver (default: lsq; nelder-mead when a torque curve is fitted).
+    #[arg(long, value_enum)]
+    pub method: Option<Method>,
+    /// Frequency-response model of the objectives.
+    #[arg(long = "model", value_enum, default_value = "auto")]
+    pub fidelity: FidelityChoice,
+    /// Number of starts.
+    #[arg(long, default_value_t = 4)]
+    pub starts: usize,
+    /// Seed of the Latin hypercube and of the particle swarm.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Iteration limit of each local search.
+    #[arg(long, default_value_t = 50)]
+    pub max_iters: u64,
+    /// Result file (JSON).
+    #[arg(long, value_name = "FILE.json")]
+    pub out: Option<PathBuf>,
+    /// Write the complete identified parameter set (for --params).
+    #[arg(long, value_name = "FILE.json")]
+    pub save_params: Option<PathBuf>,
+    /// Checkpoint file, written after each finished start.
+    #[arg(long, value_name = "FILE.json")]
+    pub checkpoint: Option<PathBuf>,
+    /// Continue from --checkpoint.
+    #[arg(long, requires = "checkpoint")]
+    pub resume: bool,
+    /// Print the result as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let base = a.model.load()?;
+    let mut experiments = Vec::new();
+    for path in &a.experiments {
+        let exp = experiment_file::read(path)?;
+        experiments.push((path.display().to_string(), exp));
+    }
+    let mut bounds = Vec::new();
+    for b in &a.bounds {
+        bounds.push(parse_bound(b).map_err(anyhow::Error::msg)?);
+    }
+    anyhow::ensure!(a.starts >= 1, "--starts must be at least 1");
+    let has_torque = experiments.iter().any(|(_, e): &(String, Experiment)| {
+        e.manifest.kind == crate::io::experiment_file::Kind::TorqueCurve
+    });
+    let config = Config {
+        experiments,
+        base,
+        fit: a
+            .fit
+            .iter()
+            .map(|s| s.trim().to_string())
+            .filter(|s| !s.is_empty())
+            .collect(),
+        bounds,
+        objectives: a.objective.clone(),
+        weights: a.weights.clone(),
+        fidelity: a.fidelity,
+        settings: Settings {
+            method: a.method.unwrap_or(if has_torque {
+                Method::NelderMead
+            } else {
+                Method::Lsq
+            }),
+            starts: a.starts,
+            seed: a.seed,
+            max_iters: a.max_iters,
+            ..Settings::default()
+        },
+        checkpoint: a.checkpoint.clone(),
+        resume: a.resume,
+    };
+    let monitor = Arc::new(Monitor::default());
+    {
+        let m = Arc::clone(&monitor);
+        // A second handler cannot be installed (tests run commands in-process): then
+        // Ctrl-C simply ends the process, as it would without rtid's handling.
+        let _ = ctrlc::set_handler(move || {
+            if m.stopped() {
+                std::process::exit(130);
+            }
+            m.stop();
+            eprintln!("\nstopping: finishing the current evaluations, then writing the best result (Ctrl-C again to quit)");
+        });
+    }
+    let spinner = spinner(&monitor, a.quiet);
+    let outcome = identify(&config, &monitor);
+    if let Some((bar, done, handle)) = spinner {
+        done.store(true, std::sync::atomic::Ordering::Relaxed);
+        let _ = handle.join();
+        bar.finish_and_clear();
+    }
+    let Identified { result, params } = outcome?;
+    if let Some(path) = &a.out {
+        result
+            .write(path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        write_plots(path, &config.experiments, &config.base, &params)?;
+    }
+    if let Some(path) = &a.save_params {
+        let mut p = params.clone();
+        for name in result.parameters.keys() {
+            p.notes.insert(
+                name.clone(),
+                format!(
+                    "identified by rtid from {} ({} model)",
+                    result.experiments.join(", "),
+                    result.fidelity
+                ),
+            );
+        }
+        params_file::write(path, &p).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&result)?);
+    } else {
+        print_summary(&result);
+    }
+    Ok(())
+}
+
+type Spinner = (
+    indicatif::ProgressBar,
+    Arc<std::sync::atomic::AtomicBool>,
+    std::thread::JoinHandle<()>,
+);
+
+/// A live line: evaluations and the best cost so far.
+fn spinner(monitor: &Arc<Monitor>, quiet: bool) -> Option<Spinner> {
+    if quiet || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {elapsed} identifying: {msg}")
+            .expect("a valid template"),
+    );
+    let done = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let (b, d, m) = (bar.clone(), Arc::clone(&done), Arc::clone(monitor));
+    let handle = std::thread::spawn(move || {
+        while !d.load(std::sync::atomic::Ordering::Relaxed) {
+            let best = m.best().map_or("—".into(), |b| format!("{:.4e}", b.cost));
+            b.set_message(format!("{} evaluations, best cost {best}", m.evaluations()));
+            b.tick();
+            std::thread::sleep(Duration::from_millis(150));
+        }
+    });
+    Some((bar, done, handle))
+}
+
+fn print_summary(r: &crate::identify::result::IdentifyResult) {
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header([
+        "parameter",
+        "start",
+        "identified",
+        "± standard error",
+        "bounds",
+    ]);
+    let se = |name: &str| {
+        r.uncertainty
+            .as_ref()
+            .and_then(|u| u.standard_errors.iter().find(|(n, _)| n == name))
+            .and_then(|(_, s)| *s)
+    };
+    for (name, v) in &r.parameters {
+        let b = r.bounds[name];
+        t.add_row([
+            name.clone(),
+            format!("{:.5e}", r.initial[name]),
+            format!("{v:.5e}"),
+            se(name).map_or("—".into(), |s| {
+                format!("{s:.2e} ({:.2} %)", 100.0 * s / v.abs())
+            }),
+            format!("{:.3e}..{:.3e}", b[0], b[1]),
+        ]);
+    }
+    println!("{t}");
+    for res in &r.residuals {
+        let extra = match &res.detail {
+            Some(d) if d.get("model_hz").is_some() => format!(
+                "  measured {} Hz, model {} Hz",
+                list(&d["measured_hz"]),
+                list(&d["model_hz"])
+            ),
+            Some(d) if d.get("error_db").is_some() => {
+                format!("  errors {} dB", list(&d["error_db"]))
+            }
+            Some(d) if d.get("rms_error_nm").is_some() => {
+                format!(
+                    "  RMS error {:.4} N·m",
+                    d["rms_error_nm"].as_f64().unwrap_or(f64::NAN)
+                )
+            }
+            _ => String::new(),
+        };
+        println!(
+            "{} [{}]: RMS scaled residual {:.3} (unit: {}){extra}",
+            res.source, res.objective, res.rms, res.scale
+        );
+    }
+    println!(
+        "cost {:.4e}, {} evaluations, {:.2} s, {} ({}, {} model)",
+        r.cost, r.evaluations, r.wall_time_s, r.termination, r.method, r.fidelity
+    );
+    if let Some(u) = &r.uncertainty {
+        if u.names.len() > 1 {
+            let mut c = Table::new();
+            c.load_preset(UTF8_FULL_CONDENSED);
+            let mut header = vec!["correlation".to_string()];
+            header.extend(u.names.iter().cloned());
+            c.set_header(header);
+            for (name, row) in u.names.iter().zip(&u.correlation) {
+                let mut cells = vec![name.clone()];
+                cells.extend(row.iter().map(|x| format!("{x:+.3}")));
+                c.add_row(cells);
+            }
+            println!("{c}");
+        }
+    }
+    for w in &r.warnings {
+        println!("warning: {w}");
+    }
+}
+
+fn list(v: &serde_json::Value) -> String {
+    v.as_array()
+        .map(|a| {
+            a.iter()
+                .map(|x| format!("{:.2}", x.as_f64().unwrap_or(f64::NAN)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
+        .unwrap_or_default()
+}
+
+/// One SVG per experiment beside the result: the data and the identified model.
+fn write_plots(
+    out: &Path,
+    experiments: &[(String, Experiment)],
+    start: &Params,
+    fitted: &Params,
+) -> anyhow::Result<()> {
+    let stem = out.with_extension("");
+    for (k, (file, exp)) in experiments.iter().enumerate() {
+        let path = PathBuf::from(format!("{}-{}.svg", stem.display(), k + 1));
+        let title = format!("identification: {file}");
+        match &exp.data {
+            Data::FrequencyResponse {
+                frequency_hz,
+                gain_db,
+                ..
+            } => {
+                let curve = |p: &Params| -> Vec<(f64, f64)> {
+                    let Ok(lin) = LinearGain::new(p) else {
+                        return Vec::new();
+                    };
+                    let (lo, hi) = (frequency_hz[0], frequency_hz[frequency_hz.len() - 1]);
+                    (0..=600)
+                        .map(|i| lo + (hi - lo) * i as f64 / 600.0)
+                        .map(|f| (f, lin.gain_db(f)))
+                        .collect()
+                };
+                let measured: Vec<(f64, f64)> = frequency_hz
+                    .iter()
+                    .copied()
+                    .zip(gain_db.iter().copied())
+                    .collect();
+                plot::write(
+                    &path,
+                    &Chart {
+                        title: &title,
+                        x_label: "frequency, Hz",
+                        y_label: "gain θt/(θm·Rg·Rw), dB",
+                    },
+                    &[
+                        Series::new("measured", measured, Style::Markers),
+                        Series::new("linear model, start", curve(start), Style::Dashed),
+                        Series::new("linear model, identified", curve(fitted), Style::Line),
+                    ],
+                )?;
+            }
+            Data::TorqueCurve {
+                time_s,
+                motor_torque_nm,
+                ..
+            } => {
+                let test = crate::experiments::torque_curve::TorqueTest::from_conditions(
+                    &exp.manifest.conditions,
+                );
+                let model =
+                    crate::experiments::torque_curve::simulate_torque(fitted, &test, time_s)?;
+                plot::write(
+                    &path,
+                    &Chart {
+                        title: &title,
+                        x_label: "time, s",
+                        y_label: "motor torque, N·m",
+                    },
+                    &[
+                        Series::new(
+                            "measured",
+                            time_s
+                                .iter()
+                                .copied()
+                                .zip(motor_torque_nm.iter().copied())
+                                .collect(),
+                            Style::Line,
+                        ),
+                        Series::new(
+                            "identified model",
+                            time_s.iter().copied().zip(model).collect(),
+                            Style::Dashed,
+                        ),
+                    ],
+                )?;
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}

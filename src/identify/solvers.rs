@@ -1,0 +1,177 @@
+//! One local search from one start, with an argmin solver (`--method`):
+//!
+//! - `lsq`: Gauss–Newton with a backtracking (Armijo) line search on the scaled
+//!   residuals, the Jacobian by forward differences computed in parallel — the
+//!   default: a least-squares problem converges in a few iterations;
+//! - `nelder-mead`: derivative-free simplex, robust to the noise of nonlinear
+//!   simulations;
+//! - `pso`: particle swarm over the whole bounded box (global, many evaluations).
+//!
+//! All run in the bound-respecting solver coordinates of [`super::space`].
+
+use argmin::core::{Executor, State, TerminationReason, TerminationStatus};
+use argmin::solver::gaussnewton::GaussNewtonLS;
+use argmin::solver::linesearch::{condition::ArmijoCondition, BacktrackingLineSearch};
+use argmin::solver::neldermead::NelderMead;
+use argmin::solver::particleswarm::ParticleSwarm;
+use nalgebra::DVector;
+use rand::{rngs::StdRng, SeedableRng};
+
+use super::problem::Problem;
+
+/// The solver.
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Gauss–Newton with line search, finite-difference Jacobian in parallel.
+    Lsq,
+    /// Nelder–Mead simplex.
+    NelderMead,
+    /// Particle swarm in the bounds.
+    Pso,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Lsq => "lsq",
+            Method::NelderMead => "nelder-mead",
+            Method::Pso => "pso",
+        }
+    }
+}
+
+/// Iteration limits.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    pub max_iters: u64,
+    /// Seed of the particle swarm.
+    pub seed: u64,
+}
+
+/// How one local search ended.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Outcome {
+    /// Solver coordinates of the result.
+    #[serde(skip)]
+    pub x: Vec<f64>,
+    pub cost: f64,
+    pub iterations: u64,
+    pub termination: String,
+    pub interrupted: bool,
+}
+
+/// Runs `method` from solver coordinates `x0`.
+pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limits) -> Outcome {
+    let monitor = problem.monitor;
+    let n = x0.len();
+    let result = match method {
+        Method::Lsq => {
+            let ls = BacktrackingLineSearch::new(ArmijoCondition::new(1e-4).expect("0 < c < 1"));
+            let solver = GaussNewtonLS::new(ls)
+                .with_tolerance(1e-10)
+                .expect("positive");
+            Executor::new(problem, solver)
+                .configure(|s| s.param(x0.clone()).max_iters(limits.max_iters))
+                .run()
+                .map(|r| {
+                    // Gauss–Newton's cost is ‖r‖; report Σr² like the other solvers.
+                    let (x, c, i, t) = summarize(r.state());
+                    (x, c * c, i, t)
+                })
+        }
+        Method::NelderMead => {
+            let mut simplex = vec![x0.clone()];
+            for j in 0..n {
+                let mut v = x0.clone();
+                // A quarter of the solver coordinate's range, towards the middle.
+                v[j] += if x0[j] > 0.0 { -0.4 } else { 0.4 };
+                simplex.push(v);
+            }
+            let solver = NelderMead::new(simplex)
+                .with_sd_tolerance(1e-8)
+                .expect("positive");
+            Executor::new(problem, solver)
+                .configure(|s| s.max_iters(limits.max_iters))
+                .run()
+                .map(|r| summarize(r.state()))
+        }
+        Method::Pso => {
+            let half = std::f64::consts::FRAC_PI_2;
+            let bounds = (
+                DVector::from_element(n, -half),
+                DVector::from_element(n, half),
+            );
+            let solver = ParticleSwarm::new(bounds, 10 + 5 * n)
+                .with_rng_generator(StdRng::seed_from_u64(limits.seed));
+            Executor::new(problem, solver)
+                .configure(|s| s.max_iters(limits.max_iters))
+                .run()
+                .map(|r| {
+                    let s = r.state();
+                    let x = s
+                        .get_best_param()
+                        .map(|p| p.position.iter().copied().collect())
+                        .unwrap_or_default();
+                    (
+                        x,
+                        s.get_best_cost(),
+                        s.get_iter(),
+                        reason(s.get_termination_status()),
+                    )
+                })
+        }
+    };
+    match result {
+        Ok((x, cost, iterations, termination)) => Outcome {
+            x,
+            cost,
+            iterations,
+            termination,
+            interrupted: false,
+        },
+        Err(e) => {
+            let interrupted = monitor.stopped();
+            Outcome {
+                x: Vec::new(),
+                cost: f64::INFINITY,
+                iterations: 0,
+                termination: if interrupted {
+                    "interrupted".into()
+                } else if e.to_string().contains("Non-invertible") {
+                    "stopped: JᵀJ singular at this start (the residuals do not depend on every parameter there)".into()
+                } else {
+                    format!("solver error: {e}")
+                },
+                interrupted,
+            }
+        }
+    }
+}
+
+fn summarize<S>(s: &S) -> (Vec<f64>, f64, u64, String)
+where
+    S: State<Param = DVector<f64>, Float = f64>,
+{
+    (
+        s.get_best_param()
+            .map(|p| p.iter().copied().collect())
+            .unwrap_or_default(),
+        s.get_best_cost(),
+        s.get_iter(),
+        reason(s.get_termination_status()),
+    )
+}
+
+fn reason(t: &TerminationStatus) -> String {
+    match t {
+        TerminationStatus::Terminated(TerminationReason::SolverConverged) => "converged".into(),
+        TerminationStatus::Terminated(TerminationReason::MaxItersReached) => {
+            "iteration limit reached".into()
+        }
+        TerminationStatus::Terminated(r) => r.text().to_string(),
+        TerminationStatus::NotTerminated => "not terminated".into(),
+    }
+}

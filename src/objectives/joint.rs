@@ -1,0 +1,100 @@
+//! Several objectives as one: the residual vectors stacked, each multiplied by
+//! √(weight / count), so that the cost is Σ weight · mean(scaled residual²). The mean
+//! keeps a 6000-sample torque curve from drowning two resonance frequencies; the
+//! weight (`--weight`) says how much each experiment should count.
+
+use super::{cost_function, Objective, ObjectiveError};
+use crate::model::Params;
+
+/// One weighted part of a joint objective.
+pub struct Part {
+    /// Where the data came from (file name), for reports.
+    pub source: String,
+    pub weight: f64,
+    pub objective: Box<dyn Objective>,
+}
+
+/// A weighted sum of objectives.
+#[derive(Default)]
+pub struct Joint {
+    pub parts: Vec<Part>,
+}
+
+impl Joint {
+    pub fn push(&mut self, source: impl Into<String>, weight: f64, objective: Box<dyn Objective>) {
+        self.parts.push(Part {
+            source: source.into(),
+            weight,
+            objective,
+        });
+    }
+
+    fn factor(part: &Part) -> f64 {
+        (part.weight / part.objective.len().max(1) as f64).sqrt()
+    }
+
+    /// Each part's own (unweighted) residuals, for reports.
+    pub fn part_residuals(&self, p: &Params) -> Result<Vec<Vec<f64>>, ObjectiveError> {
+        self.parts
+            .iter()
+            .map(|part| part.objective.residuals(p))
+            .collect()
+    }
+}
+
+impl Objective for Joint {
+    fn name(&self) -> &'static str {
+        "joint"
+    }
+
+    fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+        let mut all = Vec::with_capacity(self.len());
+        for part in &self.parts {
+            let k = Self::factor(part);
+            all.extend(part.objective.residuals(p)?.into_iter().map(|r| k * r));
+        }
+        Ok(all)
+    }
+
+    fn len(&self) -> usize {
+        self.parts.iter().map(|p| p.objective.len()).sum()
+    }
+
+    fn scale(&self) -> String {
+        "Σ weight · mean(scaled residual²) over the experiments".into()
+    }
+}
+
+cost_function!(Joint);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::objectives::sum_of_squares;
+
+    struct Constant(Vec<f64>);
+    impl Objective for Constant {
+        fn name(&self) -> &'static str {
+            "constant"
+        }
+        fn residuals(&self, _: &Params) -> Result<Vec<f64>, ObjectiveError> {
+            Ok(self.0.clone())
+        }
+        fn len(&self) -> usize {
+            self.0.len()
+        }
+        fn scale(&self) -> String {
+            String::new()
+        }
+    }
+
+    #[test]
+    fn the_joint_cost_is_the_weighted_sum_of_mean_squares() {
+        let p = crate::model::presets::load("worm-gear").unwrap();
+        let mut j = Joint::default();
+        j.push("a", 2.0, Box::new(Constant(vec![1.0, 3.0])));
+        j.push("b", 0.5, Box::new(Constant(vec![4.0; 8])));
+        let cost = sum_of_squares(&j.residuals(&p).unwrap());
+        assert!((cost - (2.0 * 5.0 + 0.5 * 16.0)).abs() < 1e-12, "{cost}");
+    }
+}

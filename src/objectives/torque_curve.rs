@@ -1,0 +1,82 @@
+//! Torque-curve residual: the error of the motor torque of the closed-loop virtual
+//! torque test against the measured curve, sample by sample (paper §4.2, MODEL.md §6:
+//! Coulomb friction and viscous damping from the torque curve).
+//!
+//! The model runs the test at the file's conditions (amplitude, period, loop) and is
+//! sampled at the measured times. Scale: 1 % of the measured curve's RMS per sample.
+//!
+//! What a torque curve can separate: the motor sees every friction reflected through
+//! the ratios — fm + fw·Rg + ft·Rg·Rw all multiply the sign of the same velocity, and
+//! Cm, Cw, Ct likewise add up — so at the test's slow motion a torque curve determines
+//! one Coulomb and one viscous sum. Fit one Coulomb and one viscous parameter (the
+//! rest fixed), or expect the identifiability warning.
+
+use super::{cost_function, Objective, ObjectiveError};
+use crate::experiments::torque_curve::{simulate_torque, TorqueTest};
+use crate::model::Params;
+
+/// One scaled residual is this fraction of the measured RMS torque.
+pub const SCALE_OF_RMS: f64 = 0.01;
+
+/// A measured torque curve.
+#[derive(Clone, Debug)]
+pub struct TorqueResidual {
+    /// s from the start of the record.
+    pub time_s: Vec<f64>,
+    pub motor_torque_nm: Vec<f64>,
+    pub test: TorqueTest,
+    /// N·m per unit of scaled residual.
+    pub scale_nm: f64,
+}
+
+impl TorqueResidual {
+    pub fn new(time_s: Vec<f64>, motor_torque_nm: Vec<f64>, test: TorqueTest) -> Self {
+        let n = motor_torque_nm.len().max(1) as f64;
+        let rms = (motor_torque_nm.iter().map(|t| t * t).sum::<f64>() / n).sqrt();
+        TorqueResidual {
+            time_s,
+            motor_torque_nm,
+            test,
+            scale_nm: (SCALE_OF_RMS * rms).max(1e-6),
+        }
+    }
+
+    /// The model's motor torque at the measured times, N·m.
+    pub fn model_nm(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+        Ok(simulate_torque(p, &self.test, &self.time_s)?)
+    }
+}
+
+impl Objective for TorqueResidual {
+    fn name(&self) -> &'static str {
+        "torque_curve"
+    }
+
+    fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+        Ok(self
+            .model_nm(p)?
+            .iter()
+            .zip(&self.motor_torque_nm)
+            .map(|(m, t)| (m - t) / self.scale_nm)
+            .collect())
+    }
+
+    fn len(&self) -> usize {
+        self.time_s.len()
+    }
+
+    fn scale(&self) -> String {
+        format!(
+            "{:.3e} N·m of motor torque per sample (1 % of the RMS)",
+            self.scale_nm
+        )
+    }
+
+    fn detail(&self, r: &[f64]) -> Option<serde_json::Value> {
+        let n = r.len().max(1) as f64;
+        let rms = (r.iter().map(|x| x * x).sum::<f64>() / n).sqrt() * self.scale_nm;
+        Some(serde_json::json!({ "rms_error_nm": rms }))
+    }
+}
+
+cost_function!(TorqueResidual);

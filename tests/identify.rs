@@ -1,0 +1,311 @@
+//! Identification (issue 4): parameters recovered from rtid's own virtual
+//! experiments (fixtures/), multi-start, identifiability warnings, the interrupt path.
+
+use std::path::Path;
+
+use rtid::identify::setup::ObjectiveKind;
+use rtid::identify::{
+    identify, Bound, Config, FidelityChoice, Identified, Method, Monitor, Settings,
+};
+use rtid::io::experiment_file::{self, Data, Experiment, Kind, Manifest};
+use rtid::model::{presets, Params};
+use rtid::objectives::peak_search::linear_peaks;
+
+fn fixture(path: &str) -> (String, Experiment) {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(path);
+    (path.to_string(), experiment_file::read(&p).unwrap())
+}
+
+fn preset_with(name: &str, set: &[(&str, f64)]) -> Params {
+    let mut p = presets::load(name).unwrap();
+    for (k, v) in set {
+        p.set(k, *v).unwrap();
+    }
+    p
+}
+
+fn config(experiments: Vec<(String, Experiment)>, base: Params, fit: &[&str]) -> Config {
+    Config {
+        experiments,
+        base,
+        fit: fit.iter().map(|s| s.to_string()).collect(),
+        bounds: Vec::new(),
+        objectives: None,
+        weights: Vec::new(),
+        fidelity: FidelityChoice::Auto,
+        settings: Settings::default(),
+        checkpoint: None,
+        resume: false,
+    }
+}
+
+fn run(c: &Config) -> Identified {
+    identify(c, &Monitor::default()).unwrap()
+}
+
+fn assert_within(r: &Identified, truth: &[(&str, f64)], tol: f64) {
+    for (name, want) in truth {
+        let got = r.result.parameters[*name];
+        assert!(
+            ((got - want) / want).abs() < tol,
+            "{name}: identified {got:.6e}, true {want:.6e} (tolerance {} %); result: {:#?}",
+            tol * 100.0,
+            r.result.parameters
+        );
+    }
+}
+
+#[test]
+fn kw_and_kg_from_the_worm_frequency_response_within_1_percent_from_50_percent_off() {
+    for (kw, kg) in [(1.5, 0.5), (0.5, 1.5), (1.5, 1.5)] {
+        let base = preset_with("worm-gear", &[("Kw", 3.1e5 * kw), ("Kg", 850.0 * kg)]);
+        let r = run(&config(
+            vec![fixture("worm-gear/frequency_response.json")],
+            base,
+            &["Kw", "Kg"],
+        ));
+        assert_within(&r, &[("Kw", 3.1e5), ("Kg", 850.0)], 0.01);
+        assert!(!r.result.interrupted);
+    }
+}
+
+#[test]
+fn kw_and_kb_of_the_roller_from_two_resonances() {
+    let base = preset_with(
+        "roller-gear-cam",
+        &[("Kw", 1.11e6 * 0.5), ("Kb", 9.0e6 * 1.5)],
+    );
+    let r = run(&config(
+        vec![fixture("roller-gear-cam/frequency_response.json")],
+        base,
+        &["Kw", "Kb"],
+    ));
+    assert_within(&r, &[("Kw", 1.11e6), ("Kb", 9.0e6)], 0.01);
+    assert!(
+        !r.result.warnings.iter().any(|w| w.contains("correlated")),
+        "Kw and Kb of the roller move its two modes differently: {:?}",
+        r.result.warnings
+    );
+}
+
+#[test]
+fn with_1_percent_noise_kw_and_kg_within_5_percent() {
+    let base = preset_with("worm-gear", &[("Kw", 3.1e5 * 1.5), ("Kg", 850.0 * 0.5)]);
+    let r = run(&config(
+        vec![fixture("worm-gear-noisy/frequency_response.json")],
+        base,
+        &["Kw", "Kg"],
+    ));
+    assert_within(&r, &[("Kw", 3.1e5), ("Kg", 850.0)], 0.05);
+}
+
+/// A resonance experiment made from the exact linear peaks of the preset (frequency
+/// and height), as a measurement in the linear limit would give them.
+fn linear_resonance_experiment(p: &Params) -> (String, Experiment) {
+    let peaks = linear_peaks(p, 10.0, 600.0, 2).unwrap();
+    let mut m = Manifest::new(Kind::Resonance);
+    m.peaks_hz = Some(peaks.iter().map(|k| k.frequency_hz).collect());
+    m.peak_gain_db = Some(peaks.iter().map(|k| k.gain_db).collect());
+    let data = Data::Resonance {
+        peaks_hz: m.peaks_hz.clone().unwrap(),
+        peak_gain_db: m.peak_gain_db.clone(),
+    };
+    (
+        "linear-peaks".into(),
+        Experiment {
+            manifest: m,
+            data,
+            path: "linear-peaks.json".into(),
+            data_path: None,
+        },
+    )
+}
+
+#[test]
+fn ciw_and_cig_from_the_peak_amplitudes_within_5_percent() {
+    let truth = presets::load("worm-gear").unwrap();
+    let exp = linear_resonance_experiment(&truth);
+    for (a, b) in [(1.5, 0.5), (0.5, 1.5)] {
+        let base = preset_with(
+            "worm-gear",
+            &[("Ciw", truth.ciw * a), ("Cig", truth.cig.unwrap() * b)],
+        );
+        let mut c = config(vec![exp.clone()], base, &["Ciw", "Cig"]);
+        c.objectives = Some(vec![ObjectiveKind::PeakAmplitude]);
+        let r = run(&c);
+        assert_within(&r, &[("Ciw", truth.ciw), ("Cig", truth.cig.unwrap())], 0.05);
+    }
+}
+
+#[test]
+fn motor_friction_and_viscous_damping_from_the_torque_curve_within_5_percent() {
+    // The motor's Coulomb friction and viscous damping (the table's are divided by
+    // Rg·Rw = 1/90 at the motor and hardly show; see docs/validation.md), started
+    // 50 % off, clean and with 1 % noise. Nelder–Mead: the quantised encoders make the
+    // torque residual rough on the scale of finite differences.
+    for (set, start) in [
+        ("worm-gear/torque_curve.json", (1.5, 0.5)),
+        ("worm-gear-noisy/torque_curve.json", (0.5, 1.5)),
+    ] {
+        let base = preset_with(
+            "worm-gear",
+            &[("fm", 0.14 * start.0), ("Cm", 8.0e-3 * start.1)],
+        );
+        let mut c = config(vec![fixture(set)], base, &["fm", "Cm"]);
+        c.settings.starts = 1;
+        c.settings.method = Method::NelderMead;
+        c.settings.max_iters = 60;
+        let r = run(&c);
+        assert_within(&r, &[("fm", 0.14), ("Cm", 8.0e-3)], 0.05);
+    }
+}
+
+#[test]
+fn the_table_friction_hardly_shows_in_the_motor_torque() {
+    // Why the torque curve identifies fm, not ft: ft reaches the motor divided by
+    // Rg·Rw = 1/90. Half as much again of it changes the motor torque by < 1 % of its
+    // RMS (measured 0.65 %: more than 1/90 of fm's effect, because in full-closed
+    // loop the table's stick also shapes the servo's response), an eighth of what the
+    // same change of fm does (5.3 %).
+    use rtid::experiments::torque_curve::{simulate_torque, TorqueTest};
+    let test = TorqueTest::default();
+    let times: Vec<f64> = (0..3000).map(|i| i as f64 * 2e-3).collect();
+    let p = presets::load("worm-gear").unwrap();
+    let base = simulate_torque(&p, &test, &times).unwrap();
+    let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
+    let change = |name: &str, factor: f64| {
+        let mut q = p.clone();
+        let v = q.get(name).unwrap().unwrap();
+        q.set(name, v * factor).unwrap();
+        let t = simulate_torque(&q, &test, &times).unwrap();
+        let d: Vec<f64> = t.iter().zip(&base).map(|(a, b)| a - b).collect();
+        rms(&d) / rms(&base)
+    };
+    let (ft, fm) = (change("ft", 1.5), change("fm", 1.5));
+    assert!(
+        ft < 0.01,
+        "ft ×1.5 changes the motor torque by {:.2} % of its RMS",
+        100.0 * ft
+    );
+    eprintln!("ft: {:.3} %, fm: {:.3} %", 100.0 * ft, 100.0 * fm);
+    assert!(
+        fm > 0.03 && ft < 0.25 * fm,
+        "fm ×1.5 changes the motor torque by {:.2} % of its RMS, ft ×1.5 by {:.2} %",
+        100.0 * fm,
+        100.0 * ft
+    );
+}
+
+#[test]
+fn the_kw_kb_pair_of_the_worm_is_flagged_and_kw_kg_is_not() {
+    let base = presets::load("worm-gear").unwrap();
+    let exp = fixture("worm-gear/frequency_response.json");
+    let r = run(&config(vec![exp.clone()], base.clone(), &["Kw", "Kb"]));
+    assert!(
+        r.result
+            .warnings
+            .iter()
+            .any(|w| w.contains("Kw and Kb") || w.contains("singular")),
+        "Kb·r² acts in series with Kw: {:?}",
+        r.result.warnings
+    );
+    let r = run(&config(vec![exp], base, &["Kw", "Kg"]));
+    assert!(
+        !r.result
+            .warnings
+            .iter()
+            .any(|w| w.contains("correlated") || w.contains("singular")),
+        "{:?}",
+        r.result.warnings
+    );
+}
+
+#[test]
+fn multistart_escapes_the_local_minimum_a_single_start_falls_into() {
+    // The whole linear gain curve against Kw alone over two decades: started 3.4×
+    // too soft (Kw = 9e4), the model's resonances sit below the measured ones and the
+    // gain-curve residual has a local minimum there.
+    let base = preset_with("worm-gear", &[("Kw", 9e4)]);
+    let mut c = config(
+        vec![fixture("worm-gear/frequency_response.json")],
+        base,
+        &["Kw"],
+    );
+    c.objectives = Some(vec![ObjectiveKind::GainCurve]);
+    c.fidelity = FidelityChoice::Linear;
+    c.bounds = vec![("Kw".into(), Bound { lo: 3e4, hi: 3e6 })];
+    c.settings.starts = 1;
+    let single = run(&c);
+    let kw = single.result.parameters["Kw"];
+    assert!(
+        ((kw - 3.1e5) / 3.1e5).abs() > 0.2,
+        "one start from 9e4 should stall in the local minimum, got Kw = {kw:.4e}"
+    );
+    c.settings.starts = 8;
+    let multi = run(&c);
+    assert_within(&multi, &[("Kw", 3.1e5)], 0.02);
+    assert!(multi.result.cost < single.result.cost);
+}
+
+#[test]
+fn an_interrupted_search_still_writes_a_valid_result() {
+    let base = preset_with("worm-gear", &[("fm", 0.2)]);
+    let mut c = config(
+        vec![fixture("worm-gear/torque_curve.json")],
+        base,
+        &["fm", "Cm"],
+    );
+    c.settings.max_evaluations = Some(5);
+    c.settings.starts = 2;
+    let r = run(&c);
+    assert!(r.result.interrupted);
+    assert!(r.result.warnings.iter().any(|w| w.contains("stopped")));
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("result.json");
+    r.result.write(&path).unwrap();
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    for name in ["fm", "Cm"] {
+        let x = v["parameters"][name].as_f64().unwrap();
+        let b = &v["bounds"][name];
+        assert!(x.is_finite() && x >= b[0].as_f64().unwrap() && x <= b[1].as_f64().unwrap());
+    }
+    assert!(v["cost"].as_f64().unwrap().is_finite());
+    assert_eq!(v["termination"], "interrupted");
+}
+
+#[test]
+fn the_paper_worm_resonances_are_out_of_reach_of_kw_and_kg() {
+    let r = run(&config(
+        vec![fixture("paper/worm-gear.json")],
+        presets::load("worm-gear").unwrap(),
+        &["Kw", "Kg"],
+    ));
+    assert!(
+        r.result
+            .warnings
+            .iter()
+            .any(|w| w.contains("misses the measured resonances")),
+        "{:?}",
+        r.result.warnings
+    );
+}
+
+#[test]
+fn methods_agree_on_an_easy_problem() {
+    for method in [Method::NelderMead, Method::Pso] {
+        let base = preset_with("worm-gear", &[("Kw", 3.1e5 * 1.3), ("Kg", 850.0 * 0.8)]);
+        let mut c = config(
+            vec![fixture("worm-gear/frequency_response.json")],
+            base,
+            &["Kw", "Kg"],
+        );
+        c.settings.method = method;
+        c.settings.starts = 4;
+        c.settings.max_iters = if method == Method::Pso { 60 } else { 300 };
+        let r = run(&c);
+        assert_within(&r, &[("Kw", 3.1e5), ("Kg", 850.0)], 0.02);
+    }
+}
