@@ -225,3 +225,99 @@ fn the_merge_of_n_shards_equals_the_unsharded_sweep() {
     // Morris on the first resonance: Kw and Kb matter (they are in series), all defined.
     assert_eq!(indices.rows.len(), s.output_columns().len() * 3);
 }
+
+/// Runs the real binary in `dir`.
+fn rtid(args: &[&str], dir: &Path) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_rtid"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the rtid binary runs")
+}
+
+#[test]
+fn bad_vary_specifications_give_one_clear_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = ["sweep", "--preset", "worm-gear", "--outputs", "modes", "--out", "x.csv"];
+    for (spec, needles) in [
+        ("Kx=1..2", &["unknown parameter `Kx`", "Kw", "theta_bw"][..]),
+        ("Kw=2e5..1e5", &["Kw=2e5..1e5", "empty"]),
+        ("Kw=1e5..1e5:log", &["empty"]),
+        ("Kw=-1e5..1e6:log", &["Kw=-1e5..1e6:log", "positive bounds"]),
+        ("theta_bw=0..2e-4:log", &["positive bounds"]),
+        ("Kw=1e5..1e6:1", &["1 levels"]),
+        ("Kw=abc", &["expected NAME=LOW..HIGH"]),
+    ] {
+        let mut args = base.to_vec();
+        args.extend(["--vary", spec]);
+        let out = rtid(&args, dir.path());
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(out.status.code(), Some(1), "{spec}: {err}");
+        assert_eq!(err.lines().count(), 1, "{spec}: {err}");
+        assert!(err.starts_with("error: ") && !err.contains("panicked"), "{err}");
+        for n in needles {
+            assert!(err.contains(n), "{spec}: `{n}` not in {err}");
+        }
+        assert!(!dir.path().join("x.csv").exists(), "no file for a bad spec");
+    }
+    // A grid needs a range; a local sweep of a parameter that is 0 has no log slope.
+    let out = rtid(&[&base[..], &["--vary", "Kw"]].concat(), dir.path());
+    assert!(String::from_utf8(out.stderr).unwrap().contains("needs a range"));
+    let out = rtid(
+        &[&base[..], &["--method", "local", "--vary", "W", "--set", "W=0"]].concat(),
+        dir.path(),
+    );
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("W is 0 at the base point"), "{err}");
+}
+
+#[test]
+fn the_command_line_shards_merges_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let common = [
+        "sweep",
+        "--preset",
+        "worm-gear",
+        "--method",
+        "sobol",
+        "--samples",
+        "64",
+        "--vary",
+        "Kw=1e5..1e6:log",
+        "--vary",
+        "Jt=0.08..0.14",
+        "--outputs",
+        "modes,peak_gain",
+        "--quiet",
+    ];
+    let ok = |args: &[&str]| {
+        let out = rtid(args, dir.path());
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    ok(&[&common[..], &["--out", "all.csv"]].concat());
+    for i in 0..2 {
+        let shard = format!("{i}/2");
+        let file = format!("part{i}.csv");
+        ok(&[&common[..], &["--shard", &shard, "--out", &file]].concat());
+    }
+    let json = ok(&["sweep", "merge", "part1.csv", "part0.csv", "--out", "merged.csv", "--json"]);
+    let read = |f: &str| std::fs::read(dir.path().join(f)).unwrap();
+    assert_eq!(read("merged.csv"), read("all.csv"));
+    assert_eq!(read("merged-indices.csv"), read("all-indices.csv"));
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["method"], "sobol");
+    // mode_1 (the table on Kw) depends on Kw and Jt only: the two ST add up to ≈ 1.
+    let st: f64 = v["indices"]["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| r["output"] == "mode_1_hz")
+        .map(|r| r["values"][3].as_f64().unwrap())
+        .sum();
+    assert!((0.9..1.2).contains(&st), "ΣST = {st}");
+    assert!(dir.path().join("all-mode_1_hz.svg").exists());
+    // An existing file is kept unless --resume or --overwrite.
+    let out = rtid(&[&common[..], &["--out", "all.csv"]].concat(), dir.path());
+    assert!(String::from_utf8(out.stderr).unwrap().contains("--resume"));
+}

@@ -37,8 +37,9 @@ Outputs (--outputs, comma-separated; columns carry units):
   fluctuation_pp  fluctuation_pp_arcsec: peak-to-peak of θt − θm·Rg·Rw at 180°/min
   torque_rms      torque_rms_nm: RMS motor torque under 30°·sin(2πt/3 s), full-closed loop
 The nonlinear tests run shortened with --tests short (default): positioning at 5 targets \
-0°–40° × 3 runs, 0.5 s dwell (≈ 23 s simulated, ~1 s of CPU); fluctuation over 12° of \
-travel each way (≈ 9.5 s); torque over one period after one of run-in (6 s). --tests full \
+0°–40° × 3 runs, 0.5 s dwell (≈ 23 s simulated); fluctuation over 18° of travel each \
+way, peak-to-peak over the middle 10° (two worm revolutions; ≈ 13.5 s); torque over one \
+period after one of run-in (6 s). Each costs about a second of CPU per point. --tests full \
 runs the paper's tests as `rtid experiment` does (minutes per point).
 
 Files: --out FILE.csv gets one row per point (index, the parameters, the outputs, error), \

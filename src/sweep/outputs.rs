@@ -131,8 +131,9 @@ impl FromStr for Output {
 /// - `Short`: positioning at 5 targets every 10° (0°–40°) × 3 runs × 2 directions
 ///   with 0.5 s dwell (≈ 23 s; every target at the same phase of the worm's
 ///   fluctuation, as the 30° targets of the full test are: 30° is six worm
-///   revolutions); fluctuation over 12° of table travel each way (two worm
-///   revolutions plus run-in, ≈ 9.5 s); torque curve over one recorded period after
+///   revolutions); fluctuation over 18° of table travel each way at 180°/min, the
+///   peak-to-peak taken over the middle 10° (two worm revolutions), skipping 4° after
+///   each start and reversal (≈ 13.5 s); torque curve over one recorded period after
 ///   one period of run-in (6 s).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
@@ -173,7 +174,7 @@ impl TestLength {
             TestLength::Full => FluctuationTest::default(),
             TestLength::Short => FluctuationTest {
                 revolutions: 0,
-                run_in: 6f64.to_radians(),
+                run_in: 9f64.to_radians(),
                 ..FluctuationTest::default()
             },
         }
@@ -265,7 +266,10 @@ impl Evaluator {
                 Output::FluctuationPp => {
                     let test = self.tests.fluctuation();
                     let record = fluctuation::run(p, &test, |_, _| {})?;
-                    out.push(Some(fluctuation::evaluate(&record, p.ratio())?.pp_arcsec));
+                    out.push(Some(match self.tests {
+                        TestLength::Full => fluctuation::evaluate(&record, p.ratio())?.pp_arcsec,
+                        TestLength::Short => short_fluctuation_pp(&record, &test, p.ratio()),
+                    }));
                 }
                 Output::TorqueRms => {
                     let test = self.tests.torque();
@@ -283,6 +287,39 @@ impl Evaluator {
         }
         Ok(out)
     }
+}
+
+/// Travel skipped at each end of a pass of the short fluctuation test, rad: the
+/// backlash take-up after the reversal and the servo's start-up.
+pub const SHORT_FLUCTUATION_SKIP_DEG: f64 = 4.0;
+
+/// Peak-to-peak of θt − θm·ratio, arc-seconds, over the steady middle of each pass
+/// of the short test (its travel less [`SHORT_FLUCTUATION_SKIP_DEG`] at both ends,
+/// located by the commanded schedule: dwell, ramp up, dwell, ramp down); the larger
+/// of the two directions. [`fluctuation::evaluate`] analyses whole revolutions centred
+/// in a pass and, with less than one revolution, the whole pass — reversal included.
+fn short_fluctuation_pp(record: &fluctuation::Record, test: &FluctuationTest, ratio: f64) -> f64 {
+    let travel = test.revolutions as f64 * std::f64::consts::TAU + 2.0 * test.run_in;
+    let ramp = travel / test.speed;
+    let skip = SHORT_FLUCTUATION_SKIP_DEG.to_radians() / test.speed;
+    let up = (test.dwell + skip, test.dwell + ramp - skip);
+    let down_start = 2.0 * test.dwell + ramp;
+    let down = (down_start + skip, down_start + ramp - skip);
+    let pp = |(a, b): (f64, f64)| {
+        let (lo, hi) = record
+            .time
+            .iter()
+            .zip(record.table_angle.iter().zip(&record.motor_angle))
+            .filter(|(&t, _)| t >= a && t <= b)
+            .map(|(_, (&th, &m))| (th - ratio * m) * iso230::ARCSEC_PER_RAD)
+            .fold((f64::MAX, f64::MIN), |(l, h), d| (l.min(d), h.max(d)));
+        if hi >= lo {
+            hi - lo
+        } else {
+            0.0
+        }
+    };
+    pp(up).max(pp(down))
 }
 
 /// Number of motor-held modes of a topology.
