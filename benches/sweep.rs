@@ -7,8 +7,8 @@
 //! Sobol design (N = 250 base rows, k = 2: Kw, Jt) on resonances + peak_gain — design,
 //! parallel evaluation, a flushed CSV row per point, the sorted atomic rewrite — into
 //! a temporary folder.
-//! `sweep/point/nonlinear_short`: one point of reversal + repeatability + accuracy
-//! + fluctuation_pp + torque_rms with the short tests.
+//! `sweep/point/nonlinear_short`: one point of reversal, repeatability, accuracy,
+//! fluctuation_pp and torque_rms with the short tests.
 //! `sweep/ishigami_indices`: Sobol S1/ST with 100 bootstrap resamples from
 //! 4096 × (3 + 2) outputs (the analysis alone).
 

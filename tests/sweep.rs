@@ -91,9 +91,15 @@ fn with_a_rigid_spur_stage_and_bearing_the_table_mode_moves_as_the_root_of_kw() 
         let mode: f64 = row[col("mode_1_hz")].parse().unwrap();
         let peak: f64 = row[col("resonance_1_hz")].parse().unwrap();
         let want = (kw / p.jt).sqrt() / (2.0 * PI);
-        assert!((mode / want - 1.0).abs() < 1e-3, "Kw {kw}: mode {mode} vs {want}");
+        assert!(
+            (mode / want - 1.0).abs() < 1e-3,
+            "Kw {kw}: mode {mode} vs {want}"
+        );
         // The damped peak: ζ = Ciw/(2√(Kw·Jt)) ≤ 3e-4 moves it far less than 0.1 %.
-        assert!((peak / want - 1.0).abs() < 1e-3, "Kw {kw}: peak {peak} vs {want}");
+        assert!(
+            (peak / want - 1.0).abs() < 1e-3,
+            "Kw {kw}: peak {peak} vs {want}"
+        );
         if let Some((k0, f0)) = last {
             let slope = (peak / f0).ln() / (kw / k0).ln();
             assert!((slope - 0.5).abs() < 2e-3, "d ln f / d ln Kw = {slope}");
@@ -115,7 +121,7 @@ fn with_a_rigid_spur_stage_and_bearing_the_table_mode_moves_as_the_root_of_kw() 
     .unwrap();
     let out = dir.path().join("local.csv");
     sweep::run(&s, &out, &RunOptions::default()).unwrap();
-    let (_, rows) = sweep::load_complete(&[out.clone()]).unwrap();
+    let (_, rows) = sweep::load_complete(std::slice::from_ref(&out)).unwrap();
     let (indices, files) = sweep::write_report(&s, &rows, &out).unwrap();
     let get = |output: &str, param: &str| {
         indices
@@ -127,7 +133,9 @@ fn with_a_rigid_spur_stage_and_bearing_the_table_mode_moves_as_the_root_of_kw() 
     };
     assert!((get("mode_1_hz", "Kw") - 0.5).abs() < 1e-3);
     assert!((get("mode_1_hz", "Jt") + 0.5).abs() < 1e-3);
-    assert!(files.iter().any(|f| f.extension().is_some_and(|e| e == "svg")));
+    assert!(files
+        .iter()
+        .any(|f| f.extension().is_some_and(|e| e == "svg")));
 }
 
 /// A small Morris sweep over linear outputs (fast), for the file tests.
@@ -182,7 +190,11 @@ fn a_sweep_interrupted_and_resumed_equals_one_run_straight_through() {
     assert_eq!((r.resumed, r.computed, r.complete), (10, 15, false));
     let r = sweep::run(&s, &out, &stop_after(usize::MAX, true)).unwrap();
     assert_eq!((r.resumed, r.computed, r.complete), (25, 23, true));
-    assert_eq!(std::fs::read(&out).unwrap(), straight, "resumed file differs");
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        straight,
+        "resumed file differs"
+    );
     // Resuming a finished sweep computes nothing and changes nothing.
     let r = sweep::run(&s, &out, &stop_after(usize::MAX, true)).unwrap();
     assert_eq!((r.computed, r.complete), (0, true));
@@ -220,7 +232,11 @@ fn the_merge_of_n_shards_equals_the_unsharded_sweep() {
     assert_eq!(merged_sweep, s);
     let out = dir.path().join("merged.csv");
     sweep::write_final(&merged_sweep, &rows, &out).unwrap();
-    assert_eq!(std::fs::read(&out).unwrap(), straight, "merged file differs");
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        straight,
+        "merged file differs"
+    );
     let (indices, _) = sweep::write_report(&s, &rows, &out).unwrap();
     // Morris on the first resonance: Kw and Kb matter (they are in series), all defined.
     assert_eq!(indices.rows.len(), s.output_columns().len() * 3);
@@ -238,7 +254,15 @@ fn rtid(args: &[&str], dir: &Path) -> std::process::Output {
 #[test]
 fn bad_vary_specifications_give_one_clear_line() {
     let dir = tempfile::tempdir().unwrap();
-    let base = ["sweep", "--preset", "worm-gear", "--outputs", "modes", "--out", "x.csv"];
+    let base = [
+        "sweep",
+        "--preset",
+        "worm-gear",
+        "--outputs",
+        "modes",
+        "--out",
+        "x.csv",
+    ];
     for (spec, needles) in [
         ("Kx=1..2", &["unknown parameter `Kx`", "Kw", "theta_bw"][..]),
         ("Kw=2e5..1e5", &["Kw=2e5..1e5", "empty"]),
@@ -254,7 +278,10 @@ fn bad_vary_specifications_give_one_clear_line() {
         let err = String::from_utf8(out.stderr).unwrap();
         assert_eq!(out.status.code(), Some(1), "{spec}: {err}");
         assert_eq!(err.lines().count(), 1, "{spec}: {err}");
-        assert!(err.starts_with("error: ") && !err.contains("panicked"), "{err}");
+        assert!(
+            err.starts_with("error: ") && !err.contains("panicked"),
+            "{err}"
+        );
         for n in needles {
             assert!(err.contains(n), "{spec}: `{n}` not in {err}");
         }
@@ -262,9 +289,15 @@ fn bad_vary_specifications_give_one_clear_line() {
     }
     // A grid needs a range; a local sweep of a parameter that is 0 has no log slope.
     let out = rtid(&[&base[..], &["--vary", "Kw"]].concat(), dir.path());
-    assert!(String::from_utf8(out.stderr).unwrap().contains("needs a range"));
+    assert!(String::from_utf8(out.stderr)
+        .unwrap()
+        .contains("needs a range"));
     let out = rtid(
-        &[&base[..], &["--method", "local", "--vary", "W", "--set", "W=0"]].concat(),
+        &[
+            &base[..],
+            &["--method", "local", "--vary", "W", "--set", "W=0"],
+        ]
+        .concat(),
         dir.path(),
     );
     let err = String::from_utf8(out.stderr).unwrap();
@@ -292,7 +325,11 @@ fn the_command_line_shards_merges_and_plots() {
     ];
     let ok = |args: &[&str]| {
         let out = rtid(args, dir.path());
-        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         String::from_utf8(out.stdout).unwrap()
     };
     ok(&[&common[..], &["--out", "all.csv"]].concat());
@@ -301,7 +338,15 @@ fn the_command_line_shards_merges_and_plots() {
         let file = format!("part{i}.csv");
         ok(&[&common[..], &["--shard", &shard, "--out", &file]].concat());
     }
-    let json = ok(&["sweep", "merge", "part1.csv", "part0.csv", "--out", "merged.csv", "--json"]);
+    let json = ok(&[
+        "sweep",
+        "merge",
+        "part1.csv",
+        "part0.csv",
+        "--out",
+        "merged.csv",
+        "--json",
+    ]);
     let read = |f: &str| std::fs::read(dir.path().join(f)).unwrap();
     assert_eq!(read("merged.csv"), read("all.csv"));
     assert_eq!(read("merged-indices.csv"), read("all-indices.csv"));

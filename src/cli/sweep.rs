@@ -166,7 +166,9 @@ impl RunArgs {
     pub fn sweep(&self) -> anyhow::Result<Sweep> {
         let params = self.model.load()?;
         if self.vary.is_empty() {
-            bail!("no parameter to vary: give --vary NAME=LOW..HIGH, e.g. --vary Kw=1e5..1e6:log:20");
+            bail!(
+                "no parameter to vary: give --vary NAME=LOW..HIGH, e.g. --vary Kw=1e5..1e6:log:20"
+            );
         }
         let factors = sweep::spec::parse_all(&self.vary, &params)?;
         if self.outputs.is_empty() {
@@ -194,7 +196,9 @@ impl RunArgs {
                 bootstrap: self.bootstrap,
             },
         };
-        Ok(Sweep::new(params, factors, method, outputs, self.tests, self.seed)?)
+        Ok(Sweep::new(
+            params, factors, method, outputs, self.tests, self.seed,
+        )?)
     }
 }
 

@@ -48,7 +48,11 @@ impl Indices {
 
 /// The values of output column `c` (position in the row) in design order; `Err` names
 /// why some are missing.
-fn column(rows: &BTreeMap<usize, Vec<String>>, c: usize, error_col: usize) -> Result<Vec<f64>, String> {
+fn column(
+    rows: &BTreeMap<usize, Vec<String>>,
+    c: usize,
+    error_col: usize,
+) -> Result<Vec<f64>, String> {
     let mut out = Vec::with_capacity(rows.len());
     let mut missing = Vec::new();
     for (&i, r) in rows {
@@ -115,7 +119,8 @@ pub fn analyse(sweep: &Sweep, rows: &BTreeMap<usize, Vec<String>>) -> Result<Ind
                     .map(|m| vec![Some(m.mu_star), Some(m.mu), Some(m.sigma)])
                     .collect(),
                 None => {
-                    out.notes.push(format!("{name}: the rows are not Morris trajectories"));
+                    out.notes
+                        .push(format!("{name}: the rows are not Morris trajectories"));
                     continue;
                 }
             },
@@ -158,7 +163,11 @@ pub fn write(path: &Path, indices: &Indices) -> std::io::Result<()> {
         csv.write_record(&header)?;
         for r in &indices.rows {
             let mut fields = vec![r.output.clone(), r.parameter.clone()];
-            fields.extend(r.values.iter().map(|v| v.map_or(String::new(), |v| v.to_string())));
+            fields.extend(
+                r.values
+                    .iter()
+                    .map(|v| v.map_or(String::new(), |v| v.to_string())),
+            );
             csv.write_record(&fields)?;
         }
         csv.flush()?;

@@ -92,7 +92,12 @@ pub struct Design {
 
 impl Design {
     /// Builds the design. `base` holds the base value of each factor (local method).
-    pub fn new(method: &Method, factors: &[Factor], base: &[f64], seed: u64) -> Result<Self, DesignError> {
+    pub fn new(
+        method: &Method,
+        factors: &[Factor],
+        base: &[f64],
+        seed: u64,
+    ) -> Result<Self, DesignError> {
         let k = factors.len();
         if k == 0 {
             return Err(DesignError::NoFactors);
@@ -158,6 +163,9 @@ fn setting(what: &'static str, value: f64, reason: &'static str) -> DesignError 
     }
 }
 
+/// Points of a design, one `Vec` per point.
+type Points = Vec<Vec<f64>>;
+
 /// Full factorial, first factor slowest; levels at u = l/(levels − 1).
 fn grid(factors: &[Factor]) -> Result<Vec<Vec<f64>>, DesignError> {
     let points: f64 = factors.iter().map(|f| f.levels as f64).product();
@@ -181,9 +189,13 @@ fn grid(factors: &[Factor]) -> Result<Vec<Vec<f64>>, DesignError> {
 }
 
 /// Base point, then p·e^{±step} for each factor in turn.
-fn local(factors: &[Factor], base: &[f64], step: f64) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>), DesignError> {
+fn local(factors: &[Factor], base: &[f64], step: f64) -> Result<(Points, Points), DesignError> {
     if !(step > 0.0 && step <= 0.5) {
-        return Err(setting("--step", step, "the relative step must lie in (0, 0.5]"));
+        return Err(setting(
+            "--step",
+            step,
+            "the relative step must lie in (0, 0.5]",
+        ));
     }
     if let Some((f, &v)) = factors.iter().zip(base).find(|(_, &v)| v == 0.0) {
         return Err(DesignError::ZeroBase {
@@ -208,12 +220,25 @@ fn local(factors: &[Factor], base: &[f64], step: f64) -> Result<(Vec<Vec<f64>>, 
 }
 
 /// Morris trajectories on the `levels`-grid of [0, 1]^k with Δ = levels/(2(levels − 1)).
-fn morris(k: usize, trajectories: usize, levels: usize, seed: u64) -> Result<Vec<Vec<f64>>, DesignError> {
+fn morris(
+    k: usize,
+    trajectories: usize,
+    levels: usize,
+    seed: u64,
+) -> Result<Vec<Vec<f64>>, DesignError> {
     if trajectories < 2 {
-        return Err(setting("--trajectories", trajectories as f64, "at least 2 are needed for σ"));
+        return Err(setting(
+            "--trajectories",
+            trajectories as f64,
+            "at least 2 are needed for σ",
+        ));
     }
     if levels < 2 || levels % 2 != 0 {
-        return Err(setting("--levels", levels as f64, "the Morris grid needs an even number of levels ≥ 2"));
+        return Err(setting(
+            "--levels",
+            levels as f64,
+            "the Morris grid needs an even number of levels ≥ 2",
+        ));
     }
     let delta = levels as f64 / (2.0 * (levels - 1) as f64);
     // Base coordinates l/(levels − 1) with l < levels/2, so that x + Δ ≤ 1.
@@ -244,10 +269,18 @@ fn morris(k: usize, trajectories: usize, levels: usize, seed: u64) -> Result<Vec
 /// Saltelli's A, B, A_B^(i) points (module docs), base row by base row.
 fn saltelli(k: usize, samples: usize, seed: u64) -> Result<Vec<Vec<f64>>, DesignError> {
     if !(2..=MAX_SOBOL_SAMPLES).contains(&samples) {
-        return Err(setting("--samples", samples as f64, "the base sample must lie in 2..=65536"));
+        return Err(setting(
+            "--samples",
+            samples as f64,
+            "the base sample must lie in 2..=65536",
+        ));
     }
     if k > MAX_SOBOL_FACTORS {
-        return Err(setting("factors", k as f64, "the Sobol design takes at most 128 factors"));
+        return Err(setting(
+            "factors",
+            k as f64,
+            "the Sobol design takes at most 128 factors",
+        ));
     }
     let seed32 = (seed ^ (seed >> 32)) as u32;
     let mut out = Vec::with_capacity(samples * (k + 2));
@@ -313,7 +346,10 @@ mod tests {
                 assert!(!changed[i]);
                 changed[i] = true;
             }
-            assert!(t.iter().flatten().all(|&u| (-1e-12..=1.0 + 1e-12).contains(&u)));
+            assert!(t
+                .iter()
+                .flatten()
+                .all(|&u| (-1e-12..=1.0 + 1e-12).contains(&u)));
         }
     }
 

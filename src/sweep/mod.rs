@@ -148,10 +148,9 @@ impl Sweep {
             .iter()
             .map(|f| {
                 let spec = params::spec(&f.name)?;
-                spec.get(&self.params)
-                    .ok_or(SweepError::Params(params::ParamError::NotApplicable {
-                        name: spec.name,
-                    }))
+                spec.get(&self.params).ok_or(SweepError::Params(
+                    params::ParamError::NotApplicable { name: spec.name },
+                ))
             })
             .collect()
     }
@@ -211,7 +210,10 @@ impl Sweep {
         row.extend(values.iter().map(|v| v.to_string()));
         match result {
             Ok(out) => {
-                row.extend(out.iter().map(|v| v.map_or(String::new(), |v| v.to_string())));
+                row.extend(
+                    out.iter()
+                        .map(|v| v.map_or(String::new(), |v| v.to_string())),
+                );
                 row.push(String::new());
             }
             Err(e) => {
@@ -281,19 +283,27 @@ pub fn run(sweep: &Sweep, out: &Path, opts: &RunOptions) -> Result<RunReport, Sw
         }));
     }
     let resumed = done.len();
-    let mut todo: Vec<usize> = mine.iter().copied().filter(|i| !done.contains_key(i)).collect();
+    let mut todo: Vec<usize> = mine
+        .iter()
+        .copied()
+        .filter(|i| !done.contains_key(i))
+        .collect();
     if let Some(limit) = opts.limit {
         todo.truncate(limit);
     }
     let journal = Mutex::new(journal);
     let rows = Mutex::new(done);
-    todo.par_iter().try_for_each(|&i| -> Result<(), StreamError> {
-        let row = sweep.row(&design, &evaluator, i);
-        journal.lock().expect("no panic holds the lock").append(&row)?;
-        rows.lock().expect("no panic holds the lock").insert(i, row);
-        (opts.on_row)();
-        Ok(())
-    })?;
+    todo.par_iter()
+        .try_for_each(|&i| -> Result<(), StreamError> {
+            let row = sweep.row(&design, &evaluator, i);
+            journal
+                .lock()
+                .expect("no panic holds the lock")
+                .append(&row)?;
+            rows.lock().expect("no panic holds the lock").insert(i, row);
+            (opts.on_row)();
+            Ok(())
+        })?;
     drop(journal);
     let rows = rows.into_inner().expect("no panic holds the lock");
     let error_col = sweep.columns().len() - 1;
@@ -342,7 +352,9 @@ pub fn write_final(
 
 /// The name of the indices file of the sweep file `out` (`stem-indices.csv`).
 pub fn indices_path(out: &Path) -> std::path::PathBuf {
-    let stem = out.file_stem().map_or("sweep".into(), |s| s.to_string_lossy());
+    let stem = out
+        .file_stem()
+        .map_or("sweep".into(), |s| s.to_string_lossy());
     out.with_file_name(format!("{stem}-indices.csv"))
 }
 

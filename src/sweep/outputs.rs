@@ -114,12 +114,14 @@ impl Output {
 impl FromStr for Output {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        ALL.into_iter().find(|o| o.name() == s.trim()).ok_or_else(|| {
-            format!(
-                "unknown output `{s}`: the outputs are {}",
-                ALL.map(Output::name).join(", ")
-            )
-        })
+        ALL.into_iter()
+            .find(|o| o.name() == s.trim())
+            .ok_or_else(|| {
+                format!(
+                    "unknown output `{s}`: the outputs are {}",
+                    ALL.map(Output::name).join(", ")
+                )
+            })
     }
 }
 
@@ -347,7 +349,10 @@ pub fn gain_peaks(p: &Params, max: usize) -> Result<Vec<Peak>, ParamError> {
     let mut out = Vec::new();
     for guess in frequency_response::peaks(&coarse, usize::MAX) {
         // A grid 50× finer over two coarse spacings either side.
-        let (a, b) = (guess.frequency_hz / ratio.powi(2), guess.frequency_hz * ratio.powi(2));
+        let (a, b) = (
+            guess.frequency_hz / ratio.powi(2),
+            guess.frequency_hz * ratio.powi(2),
+        );
         let fine: Vec<f64> = (0..=200).map(|i| a + (b - a) * i as f64 / 200.0).collect();
         let refined = frequency_response::peaks(&curve(p, &fine)?, 1);
         out.extend(refined.into_iter().next().or(Some(guess)));
@@ -390,8 +395,14 @@ mod tests {
         // more damped one, Ciw acting on the shaft-table twist).
         let (r1, r2) = (v[0].unwrap(), v[1].unwrap());
         let (m1, m2) = (v[4].unwrap(), v[5].unwrap());
-        assert!((m1 - 186.5).abs() < 0.1 && (m2 - 236.9).abs() < 0.1, "{v:?}");
-        assert!((r1 - m1).abs() < 0.02 * m1 && (r2 - m2).abs() < 0.02 * m2, "{v:?}");
+        assert!(
+            (m1 - 186.5).abs() < 0.1 && (m2 - 236.9).abs() < 0.1,
+            "{v:?}"
+        );
+        assert!(
+            (r1 - m1).abs() < 0.02 * m1 && (r2 - m2).abs() < 0.02 * m2,
+            "{v:?}"
+        );
         assert!(r1 != m1 && r2 != m2, "the peaks are the damped ones: {v:?}");
         assert!(v[3].unwrap() > 20.0, "a lightly damped peak is tall: {v:?}");
     }

@@ -29,16 +29,30 @@ pub struct Bar {
 }
 
 /// Renders a tornado chart: horizontal bars, the largest |value| on top.
-pub fn tornado_svg(title: &str, x_label: &str, legend: (&str, Option<&str>), bars: &[Bar]) -> std::io::Result<String> {
+pub fn tornado_svg(
+    title: &str,
+    x_label: &str,
+    legend: (&str, Option<&str>),
+    bars: &[Bar],
+) -> std::io::Result<String> {
     let mut bars: Vec<&Bar> = bars.iter().filter(|b| b.value.is_finite()).collect();
     if bars.is_empty() {
-        return Err(std::io::Error::other("nothing to plot: no finite sensitivity"));
+        return Err(std::io::Error::other(
+            "nothing to plot: no finite sensitivity",
+        ));
     }
     bars.sort_by(|a, b| a.value.abs().total_cmp(&b.value.abs()));
     let n = bars.len();
     let extent = bars
         .iter()
-        .flat_map(|b| [Some(b.value), b.second, b.interval.map(|i| i.0), b.interval.map(|i| i.1)])
+        .flat_map(|b| {
+            [
+                Some(b.value),
+                b.second,
+                b.interval.map(|i| i.0),
+                b.interval.map(|i| i.1),
+            ]
+        })
         .flatten()
         .filter(|v| v.is_finite());
     let (lo, hi) = extent.fold((0.0f64, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
@@ -75,7 +89,10 @@ pub fn tornado_svg(title: &str, x_label: &str, legend: (&str, Option<&str>), bar
         let (h_main, h_second) = if has_second { (0.38, 0.2) } else { (0.35, 0.0) };
         c.draw_series(bars.iter().enumerate().map(|(i, b)| {
             let y = i as f64;
-            Rectangle::new([(0.0, y - h_main), (b.value, y + h_main)], BAR.mix(0.8).filled())
+            Rectangle::new(
+                [(0.0, y - h_main), (b.value, y + h_main)],
+                BAR.mix(0.8).filled(),
+            )
         }))
         .map_err(text)?
         .label(legend.0)
@@ -83,8 +100,9 @@ pub fn tornado_svg(title: &str, x_label: &str, legend: (&str, Option<&str>), bar
         if has_second {
             c.draw_series(bars.iter().enumerate().filter_map(|(i, b)| {
                 let y = i as f64;
-                b.second
-                    .map(|s| Rectangle::new([(0.0, y - h_second), (s, y + h_second)], SECOND.filled()))
+                b.second.map(|s| {
+                    Rectangle::new([(0.0, y - h_second), (s, y + h_second)], SECOND.filled())
+                })
             }))
             .map_err(text)?
             .label(legend.1.unwrap_or(""))
@@ -141,9 +159,15 @@ pub fn tornadoes(indices: &Indices, out: &Path) -> std::io::Result<Vec<std::path
         by_output.entry(r.output.as_str()).or_default().push(bar);
     }
     let (x_label, legend) = match indices.method {
-        "local" => ("normalised sensitivity ∂ln y / ∂ln p", ("∂ln y/∂ln p", None)),
+        "local" => (
+            "normalised sensitivity ∂ln y / ∂ln p",
+            ("∂ln y/∂ln p", None),
+        ),
         "morris" => ("Morris μ* (output units per full range)", ("μ*", None)),
-        _ => ("Sobol index (bars: ST with 95 % interval, S1)", ("ST", Some("S1"))),
+        _ => (
+            "Sobol index (bars: ST with 95 % interval, S1)",
+            ("ST", Some("S1")),
+        ),
     };
     let mut written = Vec::new();
     for output in order {
@@ -162,7 +186,9 @@ pub fn tornadoes(indices: &Indices, out: &Path) -> std::io::Result<Vec<std::path
 
 /// `dir/stem.csv` → `dir/stem-NAME.svg`.
 pub fn beside(out: &Path, name: &str) -> std::path::PathBuf {
-    let stem = out.file_stem().map_or("sweep".into(), |s| s.to_string_lossy());
+    let stem = out
+        .file_stem()
+        .map_or("sweep".into(), |s| s.to_string_lossy());
     out.with_file_name(format!("{stem}-{name}.svg"))
 }
 
@@ -211,7 +237,11 @@ pub fn grid_plots(
                     x_label: &xl,
                     y_label: name,
                 };
-                lines::write(&path, &chart, &[Series::new(name.clone(), pts, Style::Line)])?;
+                lines::write(
+                    &path,
+                    &chart,
+                    &[Series::new(name.clone(), pts, Style::Line)],
+                )?;
             }
             2 => {
                 let svg = heat_map(name, factors, values, col)?;
@@ -242,7 +272,12 @@ fn colour(t: f64) -> RGBColor {
 }
 
 /// A heat map of `col` over a two-factor grid, with a colour bar.
-fn heat_map(name: &str, factors: &[Factor], values: &[Vec<f64>], col: &[f64]) -> std::io::Result<String> {
+fn heat_map(
+    name: &str,
+    factors: &[Factor],
+    values: &[Vec<f64>],
+    col: &[f64],
+) -> std::io::Result<String> {
     let (fx, fy) = (&factors[0], &factors[1]);
     let cell = |f: &Factor| {
         let (a, b) = (axis(f, f.low), axis(f, f.high));
@@ -279,7 +314,10 @@ fn heat_map(name: &str, factors: &[Factor], values: &[Vec<f64>], col: &[f64]) ->
             } else {
                 RGBColor(200, 200, 200).filled()
             };
-            Rectangle::new([(x - dx / 2.0, y - dy / 2.0), (x + dx / 2.0, y + dy / 2.0)], fill)
+            Rectangle::new(
+                [(x - dx / 2.0, y - dy / 2.0), (x + dx / 2.0, y + dy / 2.0)],
+                fill,
+            )
         }))
         .map_err(text)?;
         let mut b = ChartBuilder::on(&bar)

@@ -35,7 +35,11 @@ pub struct SobolIndex {
 #[non_exhaustive]
 pub enum SobolError {
     #[error("{got} outputs do not fill a Saltelli design of {samples} base rows × ({k} + 2)")]
-    Length { got: usize, samples: usize, k: usize },
+    Length {
+        got: usize,
+        samples: usize,
+        k: usize,
+    },
     #[error("the output does not vary over the design (variance 0): its indices are undefined")]
     NoVariance,
 }
@@ -53,7 +57,7 @@ fn estimate(y: &[f64], k: usize, rows: &[usize], s1: &mut [f64], st: &mut [f64])
     }
     let mean = sum / (2.0 * n);
     let var = sum2 / (2.0 * n) - mean * mean;
-    if !(var > 0.0) {
+    if var.is_nan() || var <= 0.0 {
         return false;
     }
     for i in 0..k {
@@ -169,6 +173,9 @@ mod tests {
 
     #[test]
     fn a_constant_output_is_an_error_not_a_nan() {
-        assert_eq!(indices(&[1.0; 12], 2, 3, 10, 0.95, 0), Err(SobolError::NoVariance));
+        assert_eq!(
+            indices(&[1.0; 12], 2, 3, 10, 0.95, 0),
+            Err(SobolError::NoVariance)
+        );
     }
 }

@@ -72,7 +72,13 @@ pub enum SpecError {
 
 impl Factor {
     /// A factor over `low..high`, checked (finite, non-empty, log bounds positive).
-    pub fn new(name: &str, low: f64, high: f64, scale: Scale, levels: usize) -> Result<Self, SpecError> {
+    pub fn new(
+        name: &str,
+        low: f64,
+        high: f64,
+        scale: Scale,
+        levels: usize,
+    ) -> Result<Self, SpecError> {
         let spec = format!("{name}={low}..{high}");
         if !(low.is_finite() && high.is_finite()) {
             return Err(SpecError::Syntax {
@@ -229,7 +235,10 @@ mod tests {
     #[test]
     fn the_issue_examples_parse() {
         let f = parse("Kw=1e5..1e6:log:20", &worm()).unwrap();
-        assert_eq!((f.low, f.high, f.scale, f.levels), (1e5, 1e6, Scale::Log, 20));
+        assert_eq!(
+            (f.low, f.high, f.scale, f.levels),
+            (1e5, 1e6, Scale::Log, 20)
+        );
         assert!((f.value(0.5) - 1e5 * 10f64.sqrt()).abs() < 1e-6);
         let f = parse("theta_bw=0..2e-4:10", &worm()).unwrap();
         assert_eq!((f.scale, f.levels, f.value(0.5)), (Scale::Lin, 10, 1e-4));
@@ -240,7 +249,10 @@ mod tests {
     #[test]
     fn bad_specifications_name_what_is_wrong() {
         let cases = [
-            ("Kx=1..2", "unknown parameter `Kx`; the parameters are Jm, Jw"),
+            (
+                "Kx=1..2",
+                "unknown parameter `Kx`; the parameters are Jm, Jw",
+            ),
             ("Kw=2e5..1e5", "range 200000..100000 is empty"),
             ("Kw=1e5..1e5", "is empty"),
             ("theta_bw=0..2e-4:log", "log range needs positive bounds"),

@@ -172,7 +172,10 @@ pub fn read(path: &Path) -> Result<(SweepFile, bool), StreamError> {
             .map_err(|_| bad(line, format!("index `{}` is not a whole number", fields[0])))?;
         if let Some(old) = rows.insert(index, fields) {
             if old != rows[&index] {
-                return Err(bad(line, format!("index {index} appears twice with different values")));
+                return Err(bad(
+                    line,
+                    format!("index {index} appears twice with different values"),
+                ));
             }
         }
     }
@@ -222,7 +225,10 @@ impl Journal {
                     what,
                 });
             }
-            let file = OpenOptions::new().append(true).open(path).map_err(io(path))?;
+            let file = OpenOptions::new()
+                .append(true)
+                .open(path)
+                .map_err(io(path))?;
             if partial {
                 let bytes = std::fs::read(path).map_err(io(path))?;
                 let keep = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
@@ -262,7 +268,11 @@ impl Journal {
 }
 
 /// Writes the final file atomically: `header`, then `rows` in index order.
-pub fn finish(path: &Path, header: &str, rows: &BTreeMap<usize, Vec<String>>) -> Result<(), StreamError> {
+pub fn finish(
+    path: &Path,
+    header: &str,
+    rows: &BTreeMap<usize, Vec<String>>,
+) -> Result<(), StreamError> {
     crate::io::atomic::write_with(path, |w| {
         w.write_all(header.as_bytes())?;
         let mut csv = csv::WriterBuilder::new().has_headers(false).from_writer(w);
@@ -289,7 +299,10 @@ pub fn merge(paths: &[PathBuf]) -> Result<SweepFile, StreamError> {
             reason,
         };
         if partial {
-            return Err(bad("the last line is incomplete: the shard did not finish; rerun it with --resume".into()));
+            return Err(bad(
+                "the last line is incomplete: the shard did not finish; rerun it with --resume"
+                    .into(),
+            ));
         }
         let shard = file.shard.unwrap_or(Shard { index: 0, count: 1 });
         if seen.is_empty() {
