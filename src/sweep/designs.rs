@@ -77,7 +77,7 @@ pub enum DesignError {
 }
 
 /// Most points a grid may have (beyond this a global method is the better tool).
-pub const MAX_GRID_POINTS: usize = 10_000_000;
+pub const MAX_GRID_POINTS: usize = 1_000_000;
 
 /// The points of a design, as unit coordinates and as parameter values.
 #[derive(Clone, Debug, PartialEq)]

@@ -327,9 +327,14 @@ fn heat_map(
             .y_label_area_size(70)
             .build_cartesian_2d(0.0..1.0, lo..(lo + span))
             .map_err(text)?;
+        // Enough decimals to tell the colour bar's ticks apart.
+        let decimals = (2.0 - span.log10().floor()).clamp(0.0, 12.0) as usize;
         b.configure_mesh()
             .disable_x_axis()
             .disable_mesh()
+            .y_labels(8)
+            .y_label_style(("sans-serif", 14))
+            .y_label_formatter(&|v: &f64| format!("{v:.decimals$}"))
             .draw()
             .map_err(text)?;
         b.draw_series((0..100).map(|i| {
