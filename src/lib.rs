@@ -16,3 +16,4 @@ pub mod objectives;
 pub mod recorder;
 pub mod report;
 pub mod sim;
+pub mod sweep;

@@ -10,6 +10,7 @@ mod modes;
 mod params_cmd;
 mod progress;
 mod simulate;
+mod sweep;
 
 use clap::{Parser, Subcommand};
 
@@ -35,7 +36,8 @@ Examples:
   rtid params --preset worm-gear --set Kw=3.5e5 --out my-table.json
   rtid experiment positioning --preset worm-gear --out runs/worm
   rtid evaluate runs/worm/positioning.json
-  rtid compare runs/worm runs/roller";
+  rtid compare runs/worm runs/roller
+  rtid sweep --preset worm-gear --method sobol --vary Kw=1e5..1e6:log --vary Jt=0.08..0.14 --outputs resonances --out s.csv";
 
 /// Top-level arguments.
 #[derive(Debug, Parser)]
@@ -72,6 +74,9 @@ pub enum Command {
     /// The paper's Table 3: two folders of experiment files side by side.
     #[command(long_about = compare::LONG_ABOUT)]
     Compare(compare::Args),
+    /// Sensitivity sweeps: grid, local, Morris, Sobol; streamed, resumable, shardable.
+    #[command(long_about = sweep::LONG_ABOUT)]
+    Sweep(sweep::Args),
 }
 
 /// Runs one parsed command line.
@@ -84,5 +89,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Identify(a) => identify::run(a),
         Command::Evaluate(a) => evaluate::run(a),
         Command::Compare(a) => compare::run(a),
+        Command::Sweep(a) => sweep::run(a),
     }
 }

@@ -1,0 +1,397 @@
+//! Sensitivity sweeps: how the resonances, the ISO 230-2 values, the fluctuation or
+//! the torque change when parameters change, and which parameter matters most.
+//!
+//! A [`Sweep`] is a design ([`designs`]: full grid, local derivatives, Morris
+//! trajectories or Saltelli's Sobol sampling) over factors ([`spec`]: registry
+//! parameters with ranges) around a base parameter set, and the outputs to compute
+//! at each point ([`outputs`]: the virtual experiments, exact linear ones where the
+//! output allows). [`run`] evaluates the points in parallel (rayon, one point per
+//! task) and streams each finished row to the CSV file ([`stream`]), so an
+//! interrupted sweep resumes where it stopped and a large one splits into shards for
+//! a job array. [`analysis`] turns the finished rows into local sensitivities,
+//! Morris μ*/σ or Sobol S1/ST with bootstrap intervals, and [`plot`] draws them.
+//!
+//! Rows are deterministic functions of (design, seed, index): the final file of a
+//! straight run, of a resumed one and of merged shards are the same bytes.
+
+pub mod analysis;
+pub mod designs;
+pub mod local;
+pub mod morris;
+pub mod outputs;
+pub mod plot;
+pub mod sobol;
+pub mod spec;
+pub mod stream;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::model::params::{self, Params};
+pub use designs::{Design, DesignError, Method};
+pub use outputs::{Evaluator, Output, TestLength};
+pub use spec::{Factor, Scale, SpecError};
+pub use stream::{Shard, StreamError};
+
+/// What a sweep computes: written as the `# config` line of its file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sweep {
+    pub method: Method,
+    pub seed: u64,
+    pub factors: Vec<Factor>,
+    pub outputs: Vec<Output>,
+    pub tests: TestLength,
+    /// The base parameter set (every factor replaces one of its values).
+    pub params: Params,
+}
+
+/// Why a sweep cannot run or be analysed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SweepError {
+    #[error(transparent)]
+    Spec(#[from] SpecError),
+    #[error(transparent)]
+    Design(#[from] DesignError),
+    #[error(transparent)]
+    Stream(#[from] StreamError),
+    #[error(transparent)]
+    Params(#[from] params::ParamError),
+    #[error("{path}: the `# config` line does not describe a sweep: {reason}")]
+    Config { path: String, reason: String },
+    #[error("no output requested: give --outputs, e.g. resonances,peak_gain")]
+    NoOutputs,
+    #[error("{missing} of the {total} design points have no row (first: index {first}): finish the sweep (--resume) or merge every shard")]
+    Incomplete {
+        missing: usize,
+        total: usize,
+        first: usize,
+    },
+}
+
+/// The column suffix of a registry unit (`N·m/rad` → `nm_per_rad`).
+pub fn unit_suffix(unit: &str) -> String {
+    match unit {
+        "-" => String::new(),
+        "kg·m²" => "kg_m2".into(),
+        "N·m·s/rad" => "nms_per_rad".into(),
+        "N·s/m" => "ns_per_m".into(),
+        "N·m" => "nm".into(),
+        "N·m/rad" => "nm_per_rad".into(),
+        "N/m" => "n_per_m".into(),
+        "1/s" => "per_s".into(),
+        "rad/s" => "rad_per_s".into(),
+        "1/rev" => "per_rev".into(),
+        other => other
+            .replace(['·', ' '], "")
+            .replace('/', "_per_")
+            .replace('²', "2")
+            .to_lowercase(),
+    }
+}
+
+/// A factor's CSV column: its name and unit (`Kw_nm_per_rad`, `theta_bw_rad`, `Rw`).
+pub fn factor_column(name: &str) -> String {
+    match params::spec(name).map(|s| unit_suffix(s.unit)) {
+        Ok(suffix) if !suffix.is_empty() => format!("{name}_{suffix}"),
+        _ => name.to_string(),
+    }
+}
+
+impl Sweep {
+    /// A sweep, checked: the factors are registry parameters of `params`' topology and
+    /// the design can be built.
+    pub fn new(
+        params: Params,
+        factors: Vec<Factor>,
+        method: Method,
+        outputs: Vec<Output>,
+        tests: TestLength,
+        seed: u64,
+    ) -> Result<Sweep, SweepError> {
+        params.validate()?;
+        if outputs.is_empty() {
+            return Err(SweepError::NoOutputs);
+        }
+        let sweep = Sweep {
+            method,
+            seed,
+            factors,
+            outputs,
+            tests,
+            params,
+        };
+        sweep.design()?;
+        Ok(sweep)
+    }
+
+    /// The sweep described by a file's `# config` line.
+    pub fn from_config(config: &str, path: &Path) -> Result<Sweep, SweepError> {
+        serde_json::from_str(config).map_err(|e| SweepError::Config {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        })
+    }
+
+    /// The `# config` line's JSON.
+    pub fn config(&self) -> String {
+        serde_json::to_string(self).expect("a sweep serialises")
+    }
+
+    /// Base value of each factor.
+    pub fn base_values(&self) -> Result<Vec<f64>, SweepError> {
+        self.factors
+            .iter()
+            .map(|f| {
+                let spec = params::spec(&f.name)?;
+                spec.get(&self.params).ok_or(SweepError::Params(
+                    params::ParamError::NotApplicable { name: spec.name },
+                ))
+            })
+            .collect()
+    }
+
+    /// The design points.
+    pub fn design(&self) -> Result<Design, SweepError> {
+        Ok(Design::new(
+            &self.method,
+            &self.factors,
+            &self.base_values()?,
+            self.seed,
+        )?)
+    }
+
+    /// What computes the outputs.
+    pub fn evaluator(&self) -> Evaluator {
+        Evaluator {
+            outputs: self.outputs.clone(),
+            tests: self.tests,
+            topology: self.params.topology,
+        }
+    }
+
+    /// Output columns (units in the names).
+    pub fn output_columns(&self) -> Vec<String> {
+        self.evaluator().columns()
+    }
+
+    /// Every column of the file: index, factors, outputs, error.
+    pub fn columns(&self) -> Vec<String> {
+        std::iter::once("index".to_string())
+            .chain(self.factors.iter().map(|f| factor_column(&f.name)))
+            .chain(self.output_columns())
+            .chain(std::iter::once("error".to_string()))
+            .collect()
+    }
+
+    /// The parameter set at design point `values`.
+    pub fn params_at(&self, values: &[f64]) -> Result<Params, params::ParamError> {
+        let mut p = self.params.clone();
+        for (f, &v) in self.factors.iter().zip(values) {
+            p.set(&f.name, v)?;
+        }
+        Ok(p)
+    }
+
+    /// The row of design point `index` (fields as written to the file).
+    pub fn row(&self, design: &Design, evaluator: &Evaluator, index: usize) -> Vec<String> {
+        let values = &design.values[index];
+        let n_out = evaluator.columns().len();
+        let result = self
+            .params_at(values)
+            .map_err(outputs::OutputError::from)
+            .and_then(|p| evaluator.evaluate(&p));
+        let mut row = Vec::with_capacity(2 + values.len() + n_out);
+        row.push(index.to_string());
+        row.extend(values.iter().map(|v| v.to_string()));
+        match result {
+            Ok(out) => {
+                row.extend(
+                    out.iter()
+                        .map(|v| v.map_or(String::new(), |v| v.to_string())),
+                );
+                row.push(String::new());
+            }
+            Err(e) => {
+                row.extend(std::iter::repeat(String::new()).take(n_out));
+                row.push(e.to_string());
+            }
+        }
+        row
+    }
+}
+
+/// How [`run`] proceeds.
+pub struct RunOptions<'a> {
+    /// Continue an existing file, computing only its missing rows.
+    pub resume: bool,
+    /// Replace an existing file.
+    pub overwrite: bool,
+    /// Compute only this slice of the design.
+    pub shard: Option<Shard>,
+    /// Stop after computing this many rows (a test's interruption; `None`: all).
+    pub limit: Option<usize>,
+    /// Called after each row is written (progress).
+    pub on_row: &'a (dyn Fn() + Sync),
+}
+
+impl Default for RunOptions<'_> {
+    fn default() -> Self {
+        RunOptions {
+            resume: false,
+            overwrite: false,
+            shard: None,
+            limit: None,
+            on_row: &|| {},
+        }
+    }
+}
+
+/// What [`run`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct RunReport {
+    /// Design points in this file (the shard's, or all).
+    pub total: usize,
+    /// Rows found in the file when resuming.
+    pub resumed: usize,
+    /// Rows computed now.
+    pub computed: usize,
+    /// Rows whose outputs could not be computed (their `error` column says why).
+    pub failed: usize,
+    /// Whether every row is there (the file is then sorted and final).
+    pub complete: bool,
+}
+
+/// Runs (or resumes) `sweep` into `out` (module docs).
+pub fn run(sweep: &Sweep, out: &Path, opts: &RunOptions) -> Result<RunReport, SweepError> {
+    let design = sweep.design()?;
+    let evaluator = sweep.evaluator();
+    let header = stream::header(&sweep.config(), opts.shard, &sweep.columns());
+    let (journal, done) = stream::Journal::open(out, &header, opts.resume, opts.overwrite)?;
+    let mine: Vec<usize> = (0..design.len())
+        .filter(|&i| opts.shard.map_or(true, |s| s.contains(i)))
+        .collect();
+    if let Some(&stray) = done.keys().find(|i| mine.binary_search(i).is_err()) {
+        return Err(SweepError::Stream(StreamError::BadRow {
+            path: out.into(),
+            line: 0,
+            reason: format!("row {stray} is not a point of this sweep or shard"),
+        }));
+    }
+    let resumed = done.len();
+    let mut todo: Vec<usize> = mine
+        .iter()
+        .copied()
+        .filter(|i| !done.contains_key(i))
+        .collect();
+    if let Some(limit) = opts.limit {
+        todo.truncate(limit);
+    }
+    let journal = Mutex::new(journal);
+    let rows = Mutex::new(done);
+    todo.par_iter()
+        .try_for_each(|&i| -> Result<(), StreamError> {
+            let row = sweep.row(&design, &evaluator, i);
+            journal
+                .lock()
+                .expect("no panic holds the lock")
+                .append(&row)?;
+            rows.lock().expect("no panic holds the lock").insert(i, row);
+            (opts.on_row)();
+            Ok(())
+        })?;
+    drop(journal);
+    let rows = rows.into_inner().expect("no panic holds the lock");
+    let error_col = sweep.columns().len() - 1;
+    let failed = rows.values().filter(|r| !r[error_col].is_empty()).count();
+    let complete = rows.len() == mine.len();
+    if complete {
+        stream::finish(out, &header, &rows)?;
+    }
+    Ok(RunReport {
+        total: mine.len(),
+        resumed,
+        computed: todo.len(),
+        failed,
+        complete,
+    })
+}
+
+/// Reads a finished sweep file (or merges shard files) and checks that every design
+/// point has its row. Returns the sweep and the rows.
+pub fn load_complete(
+    paths: &[std::path::PathBuf],
+) -> Result<(Sweep, BTreeMap<usize, Vec<String>>), SweepError> {
+    let file = stream::merge(paths)?;
+    let sweep = Sweep::from_config(&file.config, &paths[0])?;
+    let n = sweep.design()?.len();
+    let missing: Vec<usize> = (0..n).filter(|i| !file.rows.contains_key(i)).collect();
+    if let Some(&first) = missing.first() {
+        return Err(SweepError::Incomplete {
+            missing: missing.len(),
+            total: n,
+            first,
+        });
+    }
+    Ok((sweep, file.rows))
+}
+
+/// Writes the merged (or finished) rows as the final file of `sweep`, atomically.
+pub fn write_final(
+    sweep: &Sweep,
+    rows: &BTreeMap<usize, Vec<String>>,
+    out: &Path,
+) -> Result<(), SweepError> {
+    let header = stream::header(&sweep.config(), None, &sweep.columns());
+    Ok(stream::finish(out, &header, rows)?)
+}
+
+/// The name of the indices file of the sweep file `out` (`stem-indices.csv`).
+pub fn indices_path(out: &Path) -> std::path::PathBuf {
+    let stem = out
+        .file_stem()
+        .map_or("sweep".into(), |s| s.to_string_lossy());
+    out.with_file_name(format!("{stem}-indices.csv"))
+}
+
+/// Analyses complete rows and writes the indices file (not for a grid) and the plots
+/// beside `out`: tornado charts, or for a grid of one or two factors line plots or
+/// heat maps. Returns the indices and the files written.
+pub fn write_report(
+    sweep: &Sweep,
+    rows: &BTreeMap<usize, Vec<String>>,
+    out: &Path,
+) -> Result<(analysis::Indices, Vec<std::path::PathBuf>), SweepError> {
+    let indices = analysis::analyse(sweep, rows)?;
+    let io = |e: std::io::Error, p: &Path| {
+        SweepError::Stream(StreamError::Io {
+            path: p.to_path_buf(),
+            source: e,
+        })
+    };
+    let mut written = Vec::new();
+    if sweep.method == Method::Grid {
+        let design = sweep.design()?;
+        let k = sweep.factors.len();
+        let names = sweep.output_columns();
+        let y: Vec<Vec<f64>> = (0..names.len())
+            .map(|j| {
+                rows.values()
+                    .map(|r| r[1 + k + j].parse().unwrap_or(f64::NAN))
+                    .collect()
+            })
+            .collect();
+        written = plot::grid_plots(&sweep.factors, &design.values, &names, &y, out)
+            .map_err(|e| io(e, out))?;
+    } else {
+        let path = indices_path(out);
+        analysis::write(&path, &indices).map_err(|e| io(e, &path))?;
+        written.push(path);
+        written.extend(plot::tornadoes(&indices, out).map_err(|e| io(e, out))?);
+    }
+    Ok((indices, written))
+}
