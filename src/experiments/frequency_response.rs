@@ -32,14 +32,15 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use nalgebra::{Complex, DVector};
 use rayon::prelude::*;
 
-use crate::input::{Sine, TorqueInput};
+use crate::input::Sine;
 use crate::model::drive::{idx::*, Drive, NSTATE};
+use crate::model::lanes::Lanes;
 use crate::model::modes::LinearModel;
 use crate::model::Params;
 use crate::sim::{default_step, LaneSimulation, SimError};
 
 /// Frequencies advanced together by one worker (two AVX2 registers per state).
-pub const LANES: usize = 8;
+pub const LANES: usize = 4;
 
 /// Conditions of the test (defaults: MODEL.md §5.1).
 #[derive(Clone, Debug, PartialEq)]
@@ -112,7 +113,8 @@ pub struct Peak {
 /// Samples of one window: time, motor angle, table angle, and contact counts.
 struct Window {
     every: usize,
-    count: usize,
+    /// Records left until the next sample.
+    until: usize,
     t: Vec<f64>,
     motor: Vec<f64>,
     table: Vec<f64>,
@@ -124,8 +126,11 @@ impl Window {
     /// Counts one recorded state; true if it is to be sampled.
     #[inline]
     fn tick(&mut self) -> bool {
-        self.count += 1;
-        self.count % self.every == 0
+        self.until -= 1;
+        if self.until == 0 {
+            self.until = self.every;
+        }
+        self.until == self.every
     }
 
     fn sample(&mut self, t: f64, y: &[f64; NSTATE]) {
@@ -140,7 +145,7 @@ impl Window {
     }
 
     fn clear(&mut self) {
-        self.count = 0;
+        self.until = self.every;
         self.t.clear();
         self.motor.clear();
         self.table.clear();
@@ -264,6 +269,111 @@ fn take(next: &AtomicUsize, n: usize, failed: Option<&AtomicBool>) -> Option<usi
     (i < n).then_some(i)
 }
 
+/// The motor torques `offset + amplitude·sin(ωt)` of `L` lanes, each exactly as
+/// [`Sine::step_torques`] computes them for its own clock `t` = steps·dt (the same
+/// rotations of (sin, cos) by half steps, the same resynchronisation every
+/// [`Sine::RESYNC`] steps or on a clock jump), but advanced lane-wise.
+struct Sines<const L: usize> {
+    dt: f64,
+    amplitude: [f64; L],
+    offset: [f64; L],
+    omega: [f64; L],
+    /// sin, cos of ω·t at the next step start, and of ω·dt/2.
+    sin: [f64; L],
+    cos: [f64; L],
+    half_sin: [f64; L],
+    half_cos: [f64; L],
+    /// Steps taken (the lane's clock is steps·dt), and steps left before the next
+    /// resynchronisation (0: now).
+    steps: [f64; L],
+    count: [u32; L],
+    next_t: [f64; L],
+}
+
+impl<const L: usize> Sines<L> {
+    /// Zero torque in every lane.
+    fn new(dt: f64) -> Self {
+        Sines {
+            dt,
+            amplitude: [0.0; L],
+            offset: [0.0; L],
+            omega: [0.0; L],
+            sin: [0.0; L],
+            cos: [1.0; L],
+            half_sin: [0.0; L],
+            half_cos: [1.0; L],
+            steps: [0.0; L],
+            count: [u32::MAX; L],
+            next_t: [0.0; L],
+        }
+    }
+
+    /// Lane `l` starts `input`'s sine at t = 0 (a fresh [`Sine`]).
+    fn start(&mut self, l: usize, frequency_hz: f64, amplitude_nm: f64, offset_nm: f64) {
+        self.amplitude[l] = amplitude_nm;
+        self.offset[l] = offset_nm;
+        self.omega[l] = std::f64::consts::TAU * frequency_hz;
+        (self.half_sin[l], self.half_cos[l]) = (0.5 * self.omega[l] * self.dt).sin_cos();
+        self.steps[l] = 0.0;
+        self.count[l] = 0;
+        self.next_t[l] = f64::NAN;
+    }
+
+    /// Lane `l` applies no torque.
+    fn stop(&mut self, l: usize) {
+        (self.amplitude[l], self.offset[l]) = (0.0, 0.0);
+        self.count[l] = u32::MAX;
+    }
+
+    /// The torques of every lane at the start, middle and end of the next step.
+    #[inline]
+    fn step_torques(&mut self) -> [[f64; L]; 3] {
+        let h = self.dt;
+        let t = Lanes(self.steps) * h;
+        let jump = t.zip(Lanes(self.next_t), |t, n| {
+            if (t - n).abs() > 1e-6 * h {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let mut resync = jump.any(|j| j != 0.0);
+        for c in &mut self.count {
+            resync |= *c == 0;
+        }
+        if resync {
+            self.resync(t, jump);
+        }
+        for c in &mut self.count {
+            *c = c.wrapping_sub(1);
+        }
+        let rotate = |s: Lanes<L>, c: Lanes<L>| {
+            let (sh, ch) = (Lanes(self.half_sin), Lanes(self.half_cos));
+            (s * ch + c * sh, c * ch - s * sh)
+        };
+        let (s0, c0) = (Lanes(self.sin), Lanes(self.cos));
+        let (s1, c1) = rotate(s0, c0);
+        let (s2, c2) = rotate(s1, c1);
+        let (a, o) = (Lanes(self.amplitude), Lanes(self.offset));
+        self.sin = s2.0;
+        self.cos = c2.0;
+        self.next_t = (t + h).0;
+        self.steps = (Lanes(self.steps) + 1.0).0;
+        [s0, s1, s2].map(|s| (o + a * s).0)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn resync(&mut self, t: Lanes<L>, jump: Lanes<L>) {
+        for l in 0..L {
+            if self.count[l] == 0 || jump.0[l] != 0.0 {
+                (self.sin[l], self.cos[l]) = (self.omega[l] * t.0[l]).sin_cos();
+                self.count[l] = Sine::RESYNC;
+            }
+        }
+    }
+}
+
 /// One frequency in progress in a lane: its input, its current window and the
 /// amplitudes of the previous one.
 struct Run {
@@ -272,7 +382,6 @@ struct Run {
     omega: f64,
     period: f64,
     window: f64,
-    input: Sine,
     rec: Window,
     /// Steps left in the current window.
     remaining: u64,
@@ -283,6 +392,7 @@ impl Run {
     /// Starts frequency `index` in lane `l` of `sim`, from the linear steady state.
     fn start<const L: usize>(
         sim: &mut LaneSimulation<L>,
+        sines: &mut Sines<L>,
         l: usize,
         p: &Params,
         index: usize,
@@ -303,10 +413,9 @@ impl Run {
             omega,
             period,
             window,
-            input: Sine::new(frequency_hz, test.amplitude_nm, test.preload_nm * p.ratio()),
             rec: Window {
                 every,
-                count: 0,
+                until: every,
                 t: Vec::with_capacity(capacity),
                 motor: Vec::with_capacity(capacity),
                 table: Vec::with_capacity(capacity),
@@ -316,10 +425,14 @@ impl Run {
             remaining: 0,
             previous: None,
         };
+        sines.start(
+            l,
+            frequency_hz,
+            test.amplitude_nm,
+            test.preload_nm * p.ratio(),
+        );
         run.begin_window(sim, l);
-        // The initial state is the first record of the first window (its torque
-        // query, as in `Simulation::run_open_loop`, leaves the sine unchanged).
-        run.input.step_torques(0.0, dt);
+        // The initial state is the first record of the first window.
         if run.rec.tick() {
             run.rec.sample(0.0, &sim.state(l));
         }
@@ -412,6 +525,7 @@ fn run_lanes<const L: usize>(
     out: &mut Vec<(usize, Point)>,
 ) -> Result<(), SimError> {
     let mut sim = LaneSimulation::<L>::new(p, dt)?;
+    let mut sines = Sines::<L>::new(dt);
     let mut runs: [Option<Run>; L] = std::array::from_fn(|_| None);
     let mut queue_open = true;
     loop {
@@ -419,7 +533,9 @@ fn run_lanes<const L: usize>(
             for (l, run) in runs.iter_mut().enumerate() {
                 if run.is_none() {
                     match next() {
-                        Some(i) => *run = Some(Run::start(&mut sim, l, p, i, freqs[i], test)),
+                        Some(i) => {
+                            *run = Some(Run::start(&mut sim, &mut sines, l, p, i, freqs[i], test))
+                        }
                         None => {
                             queue_open = false;
                             break;
@@ -431,16 +547,7 @@ fn run_lanes<const L: usize>(
         if runs.iter().all(Option::is_none) {
             return Ok(());
         }
-        let mut motor = [[0.0; L]; 3];
-        for (l, run) in runs.iter_mut().enumerate() {
-            if let Some(run) = run {
-                let m = run.input.step_torques(sim.time(l), dt);
-                for (s, m) in m.into_iter().enumerate() {
-                    motor[s][l] = m;
-                }
-            }
-        }
-        sim.step(&motor)?;
+        sim.step(&sines.step_torques())?;
         for (l, slot) in runs.iter_mut().enumerate() {
             if let Some(run) = slot {
                 if let Some(point) = run.after_step(&sim, l, p, test) {
@@ -449,6 +556,7 @@ fn run_lanes<const L: usize>(
                     *slot = None;
                     // Idle until refilled: at rest, without load or torque.
                     sim.start(l, [0.0; NSTATE], 0.0);
+                    sines.stop(l);
                 }
             }
         }
@@ -595,6 +703,31 @@ mod tests {
             (a - 0.7).abs() < 1e-9 && (phi - 0.4).abs() < 1e-9,
             "{a} {phi}"
         );
+    }
+
+    #[test]
+    fn lanes_of_sines_equal_lone_sines() {
+        use crate::input::TorqueInput;
+        let dt = 1e-5;
+        let mut lanes = Sines::<4>::new(dt);
+        let mut lone: Vec<(Sine, u64)> = Vec::new();
+        for (l, f) in [10.0, 230.0, 599.0, 47.5].into_iter().enumerate() {
+            lanes.start(l, f, 5.0, 0.1 * l as f64);
+            lone.push((Sine::new(f, 5.0, 0.1 * l as f64), 0));
+        }
+        for k in 0..20_000 {
+            if k == 7_000 {
+                // Lane 2 restarts with another frequency, out of step with the rest.
+                lanes.start(2, 321.0, 3.0, -1.0);
+                lone[2] = (Sine::new(321.0, 3.0, -1.0), 0);
+            }
+            let m = lanes.step_torques();
+            for (l, (sine, steps)) in lone.iter_mut().enumerate() {
+                let expected = sine.step_torques(*steps as f64 * dt, dt);
+                *steps += 1;
+                assert_eq!([m[0][l], m[1][l], m[2][l]], expected, "lane {l}, step {k}");
+            }
+        }
     }
 
     #[test]

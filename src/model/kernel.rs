@@ -64,14 +64,17 @@ pub type States<const L: usize> = [[f64; L]; NSTATE];
 struct LaneState<const L: usize> {
     /// Friction torque of motor, shaft, table opposing the motion (0 when stuck).
     friction: [[f64; L]; 3],
-    /// 1 while the body moves, 0 while it sticks (multiplies its acceleration).
+    /// 1 while the body moves, 0 while it sticks.
     free: [[f64; L]; 3],
+    /// free / inertia: net torque → acceleration (0 while stuck).
+    gain: [[f64; L]; 3],
     /// Shaft angle, and sin, cos of the fluctuation phase there.
     shaft: [f64; L],
     sin: [f64; L],
     cos: [f64; L],
-    /// Steps left before the phase is computed afresh (0: compute now).
-    fresh: [u32; L],
+    /// Steps left before the phase is computed afresh (0: compute now); a whole
+    /// number, kept as `f64` so that its update vectorises with the rest.
+    fresh: [f64; L],
     /// Taylor coefficients of e(θ0 + Δ) = e0 + e1·Δ + e2·Δ²/2 + e3·Δ³/6 at the
     /// step start: [e0, e1, e2/2, e3/6, e2, e3/2].
     taylor: [[f64; L]; 6],
@@ -85,10 +88,11 @@ impl<const L: usize> Default for LaneState<L> {
         LaneState {
             friction: [[0.0; L]; 3],
             free: [[1.0; L]; 3],
+            gain: [[0.0; L]; 3],
             shaft: [0.0; L],
             sin: [0.0; L],
             cos: [1.0; L],
-            fresh: [0; L],
+            fresh: [0.0; L],
             taylor: [[0.0; L]; 6],
             twist: [[0.0; L]; 2],
             rate: [[0.0; L]; 2],
@@ -102,6 +106,7 @@ impl<const L: usize> LaneState<L> {
         LaneState {
             friction: self.friction.map(|b| [b[l]]),
             free: self.free.map(|b| [b[l]]),
+            gain: self.gain.map(|b| [b[l]]),
             shaft: [self.shaft[l]],
             sin: [self.sin[l]],
             cos: [self.cos[l]],
@@ -117,6 +122,7 @@ impl<const L: usize> LaneState<L> {
         for b in 0..3 {
             self.friction[b][l] = one.friction[b][0];
             self.free[b][l] = one.free[b][0];
+            self.gain[b][l] = one.gain[b][0];
         }
         self.shaft[l] = one.shaft[0];
         self.sin[l] = one.sin[0];
@@ -131,18 +137,21 @@ impl<const L: usize> LaneState<L> {
         }
     }
 
-    /// Decides the friction of body `b` from the sum `t` of its other torques.
+    /// Decides the friction of body `b` (inverse inertia `inv_j`) from the sum `t`
+    /// of its other torques.
     #[inline(always)]
-    fn decide(&mut self, b: usize, t: Lanes<L>, w: Lanes<L>, fc: f64) {
+    fn decide(&mut self, b: usize, t: Lanes<L>, w: Lanes<L>, fc: f64, inv_j: f64) {
         let (torque, free) = decide_lanes(t, w, fc);
         self.friction[b] = torque.0;
         self.free[b] = free.0;
+        self.gain[b] = (free * inv_j).0;
     }
 
-    /// The net torque on body `b` (0 while stuck).
+    /// The acceleration of body `b` under the other torques `t`: (t − friction)/J,
+    /// 0 while stuck. (free ∈ {0, 1}, so this equals ((t − friction)·free)/J exactly.)
     #[inline(always)]
-    fn net(&self, b: usize, t: Lanes<L>) -> Lanes<L> {
-        (t - Lanes(self.friction[b])) * Lanes(self.free[b])
+    fn accel(&self, b: usize, t: Lanes<L>) -> Lanes<L> {
+        (t - Lanes(self.friction[b])) * Lanes(self.gain[b])
     }
 
     /// e and e' at a step's start: sin/cos of the phase carried from the previous
@@ -157,17 +166,16 @@ impl<const L: usize> LaneState<L> {
         let (s0, c0) = (Lanes(self.sin), Lanes(self.cos));
         let mut s = s0 * cx + c0 * sx;
         let mut c = c0 * cx - s0 * sx;
-        let mut resync = false;
-        for l in 0..L {
-            let carry = self.fresh[l] > 0 && x.0[l].abs() < SMALL_ANGLE;
-            resync |= !carry;
-            self.fresh[l] = if carry {
-                self.fresh[l].wrapping_sub(1)
+        let resync_at = PHASE_RESYNC as f64;
+        let fresh = Lanes(self.fresh).zip(x, |fresh, x| {
+            if (fresh > 0.0) & (x.abs() < SMALL_ANGLE) {
+                fresh - 1.0
             } else {
-                PHASE_RESYNC
-            };
-        }
-        if resync {
+                resync_at
+            }
+        });
+        self.fresh = fresh.0;
+        if fresh.any(|f| f == resync_at) {
             self.resync_phase(d, shaft, &mut s, &mut c);
         }
         self.shaft = shaft.0;
@@ -192,7 +200,7 @@ impl<const L: usize> LaneState<L> {
     #[inline(never)]
     fn resync_phase(&self, d: &Drive, shaft: Lanes<L>, s: &mut Lanes<L>, c: &mut Lanes<L>) {
         for l in 0..L {
-            if self.fresh[l] == PHASE_RESYNC {
+            if self.fresh[l] == PHASE_RESYNC as f64 {
                 (s.0[l], c.0[l]) = d.exact_phase(shaft.0[l]);
             }
         }
@@ -318,7 +326,7 @@ impl<const L: usize> Kernel<L> {
         h: f64,
     ) {
         let y0 = *y;
-        rk4::<L, SPUR>(d, &mut self.lanes, y, motor, load, Lanes::splat(h));
+        rk4::<L, SPUR>(d, &mut self.lanes, &y0, y, motor, load, Lanes::splat(h));
         let gaps = [SPUR && d.bg > 0.0, d.bw > 0.0];
         if !(gaps[0] || gaps[1]) {
             return;
@@ -406,13 +414,25 @@ impl<const L: usize> Kernel<L> {
     ) {
         self.events += 1;
         let mut one = self.lanes.lane(l);
-        let mut part: States<1> = y0.map(|v| [v[l]]);
+        let mut part: States<1> = [[0.0]; NSTATE];
+        for i in 0..NSTATE {
+            part[i] = [y0[i][l]];
+        }
         let m = [motor[0][l], motor[1][l], motor[2][l]];
         let m1 = [0.0, 0.5 * s, s].map(|at| [quadratic(&m, at)]);
         let m2 = [s, 0.5 * (1.0 + s), 1.0].map(|at| [quadratic(&m, at)]);
         let load = [load[l]];
-        rk4::<1, SPUR>(d, &mut one, &mut part, &m1, &load, Lanes([s * h]));
-        rk4::<1, SPUR>(d, &mut one, &mut part, &m2, &load, Lanes([(1.0 - s) * h]));
+        let mut mid = part;
+        rk4::<1, SPUR>(d, &mut one, &part, &mut mid, &m1, &load, Lanes([s * h]));
+        rk4::<1, SPUR>(
+            d,
+            &mut one,
+            &mid,
+            &mut part,
+            &m2,
+            &load,
+            Lanes([(1.0 - s) * h]),
+        );
         for i in 0..NSTATE {
             y[i][l] = part[i][0];
         }
@@ -495,32 +515,32 @@ fn unbalance_torque(d: &Drive, table_angle: f64) -> f64 {
 /// `y + a·k`, lane-wise.
 #[inline(always)]
 fn axpy<const L: usize>(y: &States<L>, a: Lanes<L>, k: &States<L>) -> States<L> {
-    let mut out = *y;
+    let mut out = [[0.0; L]; NSTATE];
     for i in 0..NSTATE {
         out[i] = (Lanes(y[i]) + a * Lanes(k[i])).0;
     }
     out
 }
 
-/// One classical RK4 step of length `h[l]` for each lane (0 leaves a lane as is),
-/// then the stop of sliding bodies whose velocity reversed (friction.rs). Stage
-/// values are locals, not fields, so the compiler can keep them in registers.
+/// One classical RK4 step of length `h[l]` for each lane from `y0` into `y`, then
+/// the stop of sliding bodies whose velocity reversed (friction.rs). Stage values
+/// are locals, not fields, so the compiler can keep them in registers.
 #[inline(always)]
 fn rk4<const L: usize, const SPUR: bool>(
     d: &Drive,
     st: &mut LaneState<L>,
+    y0: &States<L>,
     y: &mut States<L>,
     motor: &[[f64; L]; 3],
     load: &[f64; L],
     h: Lanes<L>,
 ) {
-    let y0 = *y;
     let half = h.map(|h| 0.5 * h);
     let load = Lanes(*load);
-    let k1 = derivative::<L, SPUR, true>(d, &y0, Lanes(motor[0]), load, st);
-    let k2 = derivative::<L, SPUR, false>(d, &axpy(&y0, half, &k1), Lanes(motor[1]), load, st);
-    let k3 = derivative::<L, SPUR, false>(d, &axpy(&y0, half, &k2), Lanes(motor[1]), load, st);
-    let k4 = derivative::<L, SPUR, false>(d, &axpy(&y0, h, &k3), Lanes(motor[2]), load, st);
+    let k1 = derivative::<L, SPUR, true>(d, y0, Lanes(motor[0]), load, st);
+    let k2 = derivative::<L, SPUR, false>(d, &axpy(y0, half, &k1), Lanes(motor[1]), load, st);
+    let k3 = derivative::<L, SPUR, false>(d, &axpy(y0, half, &k2), Lanes(motor[1]), load, st);
+    let k4 = derivative::<L, SPUR, false>(d, &axpy(y0, h, &k3), Lanes(motor[2]), load, st);
     let sixth = h.map(|h| h * (1.0 / 6.0));
     for i in 0..NSTATE {
         let (a, b, c, e) = (Lanes(k1[i]), Lanes(k2[i]), Lanes(k3[i]), Lanes(k4[i]));
@@ -576,9 +596,9 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
     };
     let table = tw - d.ct * wt + unbalance + load;
     if FIRST {
-        st.decide(2, table, wt, d.fc[2]);
+        st.decide(2, table, wt, d.fc[2], d.inv_jt);
     }
-    let at = st.net(2, table) * d.inv_jt;
+    let at = st.accel(2, table);
     let ax = (-d.cb * vw - d.kb * xw - tw * d.inv_r) * d.inv_mw;
 
     let mut out = [[0.0; L]; NSTATE];
@@ -593,18 +613,18 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
         let m = motor - d.cm * wm - d.rg * tg;
         let s = tg - d.cw * ws - lever * tw;
         if FIRST {
-            st.decide(0, m, wm, d.fc[0]);
-            st.decide(1, s, ws, d.fc[1]);
+            st.decide(0, m, wm, d.fc[0], d.inv_jm);
+            st.decide(1, s, ws, d.fc[1], d.inv_jw);
         }
-        out[OMEGA_W] = (st.net(1, s) * d.inv_jw).0;
+        out[OMEGA_W] = st.accel(1, s).0;
         out[THETA_W] = ws.0;
-        st.net(0, m) * d.inv_jm
+        st.accel(0, m)
     } else {
         let m = motor - d.cm * wm - lever * tw;
         if FIRST {
-            st.decide(0, m, wm, d.fc[0]);
+            st.decide(0, m, wm, d.fc[0], d.inv_jm);
         }
-        let a = st.net(0, m) * d.inv_jm;
+        let a = st.accel(0, m);
         out[OMEGA_W] = a.0;
         out[THETA_W] = wm.0;
         a
