@@ -216,7 +216,7 @@ impl<const L: usize> LaneState<L> {
         let t = self.taylor.map(Lanes);
         let mut e = t[0] + dx * (t[1] + dx * (t[2] + dx * t[3]));
         let mut ep = t[1] + dx * (t[4] + dx * t[5]);
-        if (d.n * dx).any(|x| !(x.abs() < SMALL_ANGLE)) {
+        if (d.n * dx).any(far) {
             self.far_fluctuation(d, shaft, &mut e, &mut ep);
         }
         (e, ep)
@@ -226,7 +226,7 @@ impl<const L: usize> LaneState<L> {
     #[inline(never)]
     fn far_fluctuation(&self, d: &Drive, shaft: Lanes<L>, e: &mut Lanes<L>, ep: &mut Lanes<L>) {
         for l in 0..L {
-            if !((d.n * (shaft.0[l] - self.shaft[l])).abs() < SMALL_ANGLE) {
+            if far(d.n * (shaft.0[l] - self.shaft[l])) {
                 (e.0[l], ep.0[l]) =
                     d.fluctuation_near(shaft.0[l], self.shaft[l], (self.sin[l], self.cos[l]));
             }
@@ -241,7 +241,7 @@ impl<const L: usize> LaneState<L> {
         let x = d.n * (shaft - Lanes(self.shaft));
         let mut sx = x.map(|x| taylor_sin_cos(x).0);
         let mut cx = x.map(|x| taylor_sin_cos(x).1);
-        if x.any(|x| !(x.abs() < SMALL_ANGLE)) {
+        if x.any(far) {
             library_sin_cos(x, &mut sx, &mut cx);
         }
         let (s0, c0) = (Lanes(self.sin), Lanes(self.cos));
@@ -250,12 +250,19 @@ impl<const L: usize> LaneState<L> {
     }
 }
 
+/// Whether the angle `x` is beyond the Taylor polynomials' range (or NaN).
+#[inline(always)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+fn far(x: f64) -> bool {
+    !(x.abs() < SMALL_ANGLE)
+}
+
 /// sin, cos of `x` by the library in the lanes where |x| ≥ 0.01.
 #[cold]
 #[inline(never)]
 fn library_sin_cos<const L: usize>(x: Lanes<L>, s: &mut Lanes<L>, c: &mut Lanes<L>) {
     for l in 0..L {
-        if !(x.0[l].abs() < SMALL_ANGLE) {
+        if far(x.0[l]) {
             (s.0[l], c.0[l]) = x.0[l].sin_cos();
         }
     }
