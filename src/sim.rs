@@ -1,12 +1,15 @@
 //! Running one simulation: the kernel at a fixed step, driven open loop by a
 //! [`TorqueInput`] or closed loop by the [`Controller`] following a [`Trajectory`],
 //! with every step checked for divergence and reported to a [`Recorder`].
+//! [`LaneSimulation`] advances several independent simulations of one model in
+//! lockstep lanes, for batches such as the frequencies of a sweep.
 
 use std::fmt::Write as _;
 
 use crate::controller::{Controller, ControllerError, Gains};
 use crate::input::{TorqueInput, Trajectory};
 use crate::model::drive::idx::*;
+use crate::model::lanes::Lanes;
 use crate::model::{Drive, Kernel, ParamError, Params, States, NSTATE};
 use crate::recorder::Recorder;
 
@@ -91,20 +94,8 @@ impl Simulation {
     /// A table at rest at zero angles, integrated with step `dt` (checked against the
     /// model's stiffest mode).
     pub fn new(params: &Params, dt: f64) -> Result<Self, SimError> {
-        let drive = Drive::new(params)?;
-        if !(dt > 0.0 && dt.is_finite()) {
-            return Err(SimError::BadStep { dt });
-        }
-        let rate = crate::model::modes::max_rate(params)?;
-        if rate * dt > STEP_LIMIT {
-            return Err(SimError::StepTooLarge {
-                dt,
-                rate,
-                max: STEP_ACCURACY / rate,
-            });
-        }
         Ok(Simulation {
-            drive,
+            drive: checked_drive(params, dt)?,
             dt,
             steps: 0,
             y: [[0.0]; NSTATE],
@@ -225,23 +216,147 @@ impl Simulation {
         self.kernel
             .step(&self.drive, &mut self.y, motor, &[self.load], self.dt);
         self.steps += 1;
-        // A NaN or infinity anywhere reaches the velocities within a step; checking
-        // them (and the angles' sum) catches every divergence at little cost.
-        let y = &self.y;
-        let speed = y[OMEGA_M][0]
-            .abs()
-            .max(y[OMEGA_W][0].abs())
-            .max(y[V_W][0].abs())
-            .max(y[OMEGA_T][0].abs());
-        let ok = speed < VELOCITY_LIMIT
-            && (y[THETA_M][0] + y[THETA_W][0] + y[X_W][0] + y[THETA_T][0]).is_finite();
-        if ok {
+        if diverged(&self.y).is_none() {
             Ok(())
         } else {
             Err(SimError::Diverged {
                 time: self.time(),
                 state: describe(&self.state()),
             })
+        }
+    }
+}
+
+/// The compiled model, after checking the step `dt` against its stiffest mode.
+fn checked_drive(params: &Params, dt: f64) -> Result<Drive, SimError> {
+    let drive = Drive::new(params)?;
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(SimError::BadStep { dt });
+    }
+    let rate = crate::model::modes::max_rate(params)?;
+    if rate * dt > STEP_LIMIT {
+        return Err(SimError::StepTooLarge {
+            dt,
+            rate,
+            max: STEP_ACCURACY / rate,
+        });
+    }
+    Ok(drive)
+}
+
+/// The first lane whose state diverged, if any. A NaN or infinity anywhere reaches
+/// the velocities within a step; checking them (and the angles' sum) catches every
+/// divergence at little cost.
+#[inline(always)]
+fn diverged<const L: usize>(y: &States<L>) -> Option<usize> {
+    let speed = |i: usize| Lanes(y[i]).map(f64::abs);
+    let fastest = speed(OMEGA_M)
+        .zip(speed(OMEGA_W), f64::max)
+        .zip(speed(V_W), f64::max)
+        .zip(speed(OMEGA_T), f64::max);
+    let angles = Lanes(y[THETA_M]) + Lanes(y[THETA_W]) + Lanes(y[X_W]) + Lanes(y[THETA_T]);
+    let bad = fastest.zip(angles, |v, a| {
+        if v < VELOCITY_LIMIT && a.is_finite() {
+            0.0
+        } else {
+            1.0
+        }
+    });
+    if bad.any(|b| b != 0.0) {
+        bad.0.iter().position(|&b| b != 0.0)
+    } else {
+        None
+    }
+}
+
+/// `L` independent simulations of one model, advanced together one step at a time
+/// (`Kernel<L>` lanes, so that the compiler vectorises them). Each lane has its own
+/// state, clock, table load and motor torque, and can be restarted on its own; lane
+/// `l` computes bit for bit what a [`Simulation`] computes for the same run alone.
+/// Every step checks every lane for divergence; an idle lane (at rest, no torque)
+/// stays at rest.
+#[derive(Clone, Debug)]
+pub struct LaneSimulation<const L: usize> {
+    drive: Drive,
+    dt: f64,
+    steps: [u64; L],
+    y: States<L>,
+    kernel: Kernel<L>,
+    load: [f64; L],
+}
+
+impl<const L: usize> LaneSimulation<L> {
+    /// `L` tables at rest at zero angles, integrated with step `dt` (checked as by
+    /// [`Simulation::new`]).
+    pub fn new(params: &Params, dt: f64) -> Result<Self, SimError> {
+        Ok(LaneSimulation {
+            drive: checked_drive(params, dt)?,
+            dt,
+            steps: [0; L],
+            y: [[0.0; L]; NSTATE],
+            kernel: Kernel::default(),
+            load: [0.0; L],
+        })
+    }
+
+    /// The integration step, s.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// The compiled model.
+    pub fn drive(&self) -> &Drive {
+        &self.drive
+    }
+
+    /// Starts a new run in lane `l` at t = 0 from state `y` (in the direct topology
+    /// the shaft follows the motor) under the external table torque `load` (N·m), as
+    /// a new [`Simulation`] with [`Simulation::set_state`] and
+    /// [`Simulation::set_load`] would.
+    pub fn start(&mut self, l: usize, mut y: [f64; NSTATE], load: f64) {
+        if !self.drive.spur {
+            y[THETA_W] = y[THETA_M];
+            y[OMEGA_W] = y[OMEGA_M];
+        }
+        for (i, v) in y.into_iter().enumerate() {
+            self.y[i][l] = v;
+        }
+        self.kernel.reset_lane(l);
+        self.steps[l] = 0;
+        self.load[l] = load;
+    }
+
+    /// Simulated time of lane `l`, s.
+    pub fn time(&self, l: usize) -> f64 {
+        self.steps[l] as f64 * self.dt
+    }
+
+    /// The state of lane `l`.
+    pub fn state(&self, l: usize) -> [f64; NSTATE] {
+        self.y.map(|s| s[l])
+    }
+
+    /// Contact events split so far, all lanes.
+    pub fn contact_events(&self) -> u64 {
+        self.kernel.events()
+    }
+
+    /// One step of every lane; `motor[s][l]` is lane `l`'s motor torque at the
+    /// step's start, middle and end (see [`TorqueInput`]). A diverged lane stops the
+    /// run with its time and state.
+    #[inline]
+    pub fn step(&mut self, motor: &[[f64; L]; 3]) -> Result<(), SimError> {
+        self.kernel
+            .step(&self.drive, &mut self.y, motor, &self.load, self.dt);
+        for s in &mut self.steps {
+            *s += 1;
+        }
+        match diverged(&self.y) {
+            None => Ok(()),
+            Some(l) => Err(SimError::Diverged {
+                time: self.time(l),
+                state: describe(&self.state(l)),
+            }),
         }
     }
 }

@@ -1,10 +1,14 @@
 //! The frequency-response test as a virtual experiment (paper §4.1, MODEL.md §5.1).
 //!
 //! Open loop, motor torque `preload·Rg·Rw + A·sin(2πft)`, table brake `−preload`.
-//! Every frequency is an independent nonlinear time simulation, run in parallel
-//! (rayon, one simulation per task). Gain = 20·log10 of the steady amplitude of the
-//! table angle over that of the motor angle × Rg·Rw; its peaks are the resonances
-//! (the damped motor-held modes).
+//! Every frequency is an independent nonlinear time simulation. They run in
+//! [`LANES`]-wide batches advanced in lockstep ([`LaneSimulation`], vectorised), one
+//! batch per rayon worker; a lane whose frequency has settled is refilled at once
+//! with the next frequency of the shared queue, so lanes rarely idle. A lane
+//! computes bit for bit what a lone simulation of its frequency computes
+//! ([`simulate_point`] is the same code with one lane). Gain = 20·log10 of the
+//! steady amplitude of the table angle over that of the motor angle × Rg·Rw; its
+//! peaks are the resonances (the damped motor-held modes).
 //!
 //! **Start.** Each run starts from the steady state of the linearised model (exact
 //! complex response to the sine, plus the static twist of the preload with the
@@ -23,15 +27,20 @@
 //! each mesh is out of contact (inside its gap) is reported. Where it is not zero the
 //! table rattles in the gap and the "gain" is not a property of the drive.
 
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
 use nalgebra::{Complex, DVector};
 use rayon::prelude::*;
 
 use crate::input::Sine;
 use crate::model::drive::{idx::*, Drive, NSTATE};
+use crate::model::lanes::Lanes;
 use crate::model::modes::LinearModel;
 use crate::model::Params;
-use crate::recorder::Recorder;
-use crate::sim::{SimError, Simulation};
+use crate::sim::{default_step, LaneSimulation, SimError};
+
+/// Frequencies advanced together by one worker (two AVX2 registers per state).
+pub const LANES: usize = 4;
 
 /// Conditions of the test (defaults: MODEL.md §5.1).
 #[derive(Clone, Debug, PartialEq)]
@@ -104,7 +113,8 @@ pub struct Peak {
 /// Samples of one window: time, motor angle, table angle, and contact counts.
 struct Window {
     every: usize,
-    count: usize,
+    /// Records left until the next sample.
+    until: usize,
     t: Vec<f64>,
     motor: Vec<f64>,
     table: Vec<f64>,
@@ -112,12 +122,18 @@ struct Window {
     drive: Drive,
 }
 
-impl Recorder for Window {
-    fn record(&mut self, t: f64, y: &[f64; NSTATE], _u: f64) {
-        self.count += 1;
-        if self.count % self.every != 0 {
-            return;
+impl Window {
+    /// Counts one recorded state; true if it is to be sampled.
+    #[inline]
+    fn tick(&mut self) -> bool {
+        self.until -= 1;
+        if self.until == 0 {
+            self.until = self.every;
         }
+        self.until == self.every
+    }
+
+    fn sample(&mut self, t: f64, y: &[f64; NSTATE]) {
         self.t.push(t);
         self.motor.push(y[THETA_M]);
         self.table.push(y[THETA_T]);
@@ -127,11 +143,9 @@ impl Recorder for Window {
             self.open[i] += usize::from(gaps[i] > 0.0 && dz[i] == 0.0);
         }
     }
-}
 
-impl Window {
     fn clear(&mut self) {
-        self.count = 0;
+        self.until = self.every;
         self.t.clear();
         self.motor.clear();
         self.table.clear();
@@ -139,28 +153,35 @@ impl Window {
     }
 }
 
-/// Amplitude and phase (rad) of the component at `omega` of `x(t)`, fitted with an
-/// offset and a quadratic drift: least squares on [1, τ, τ², sin ωt, cos ωt].
-fn sine_component(t: &[f64], x: &[f64], omega: f64) -> (f64, f64) {
+/// Amplitude and phase (rad) of the component at `omega` of each signal `x[k](t)`,
+/// fitted with an offset and a quadratic drift: least squares on
+/// [1, τ, τ², sin ωt, cos ωt] (one normal matrix for all signals; (0, 0) without
+/// samples).
+fn sine_components<const K: usize>(t: &[f64], x: [&[f64]; K], omega: f64) -> [(f64, f64); K] {
+    if t.is_empty() {
+        return [(0.0, 0.0); K];
+    }
     let (t0, t1) = (t[0], t[t.len() - 1]);
     let span = (t1 - t0).max(f64::MIN_POSITIVE);
     let mut ata = nalgebra::Matrix5::<f64>::zeros();
-    let mut atb = nalgebra::Vector5::<f64>::zeros();
-    let x0 = x[0];
-    for (&ti, &xi) in t.iter().zip(x) {
+    let mut atb = [nalgebra::Vector5::<f64>::zeros(); K];
+    let x0 = x.map(|x| x[0]);
+    for (i, &ti) in t.iter().enumerate() {
         let tau = 2.0 * (ti - t0) / span - 1.0;
         let (s, c) = (omega * ti).sin_cos();
         let row = nalgebra::Vector5::new(1.0, tau, tau * tau, s, c);
         ata += row * row.transpose();
-        atb += row * (xi - x0);
+        for k in 0..K {
+            atb[k] += row * (x[k][i] - x0[k]);
+        }
     }
-    let coef = ata
-        .lu()
-        .solve(&atb)
-        .unwrap_or_else(nalgebra::Vector5::zeros);
-    let (a_s, a_c) = (coef[3], coef[4]);
-    // a_s·sin + a_c·cos = A·sin(ωt + φ)
-    ((a_s * a_s + a_c * a_c).sqrt(), a_c.atan2(a_s))
+    let lu = ata.lu();
+    atb.map(|atb| {
+        let coef = lu.solve(&atb).unwrap_or_else(nalgebra::Vector5::zeros);
+        let (a_s, a_c) = (coef[3], coef[4]);
+        // a_s·sin + a_c·cos = A·sin(ωt + φ)
+        ((a_s * a_s + a_c * a_c).sqrt(), a_c.atan2(a_s))
+    })
 }
 
 /// The initial state: the linear steady state of the sine, plus the static twist of
@@ -216,50 +237,257 @@ pub fn simulate_point(
     frequency_hz: f64,
     test: &FrequencyTest,
 ) -> Result<Point, SimError> {
-    let omega = std::f64::consts::TAU * frequency_hz;
-    let mut sim = match test.dt {
-        Some(dt) => Simulation::new(p, dt)?,
-        None => Simulation::with_default_step(p)?,
-    };
-    let dt = sim.dt();
-    sim.set_state(initial_state(p, omega, test));
-    sim.set_load(-test.preload_nm);
-    let mut input = Sine::new(frequency_hz, test.amplitude_nm, test.preload_nm * p.ratio());
-    let period = 1.0 / frequency_hz;
-    let cycles = (test.window_s / period).ceil().max(1.0);
-    let window = cycles * period;
-    let every = ((period / 40.0 / dt).floor() as usize).max(1);
-    let capacity = (window / dt / every as f64).ceil() as usize + 2;
-    let mut rec = Window {
-        every,
-        count: 0,
-        t: Vec::with_capacity(capacity),
-        motor: Vec::with_capacity(capacity),
-        table: Vec::with_capacity(capacity),
-        open: [0, 0],
-        drive: *sim.drive(),
-    };
-    let ratio = p.ratio();
-    // The smallest table amplitude a measurement resolves (0.0001° encoder), and a
-    // floor for the ideal-encoder case, so that a table at rest gives a finite gain.
-    let floor = p.controller.table_encoder_resolution.max(1e-12);
-    let mut previous: Option<(f64, f64, f64)> = None;
-    loop {
-        rec.clear();
-        // Windows end on whole cycles of the absolute time.
-        let end = ((sim.time() + window) / period).round() * period;
-        sim.run_open_loop(&mut input, end - sim.time(), &mut rec)?;
-        let (am, pm) = sine_component(&rec.t, &rec.motor, omega);
-        let (at, pt) = sine_component(&rec.t, &rec.table, omega);
+    let dt = step(p, test)?;
+    let next = AtomicUsize::new(0);
+    let mut out = Vec::with_capacity(1);
+    run_lanes::<1>(
+        p,
+        &[frequency_hz],
+        test,
+        dt,
+        &|| take(&next, 1, None),
+        &|| {},
+        &mut out,
+    )?;
+    Ok(out[0].1)
+}
+
+/// The integration step of the test.
+fn step(p: &Params, test: &FrequencyTest) -> Result<f64, SimError> {
+    match test.dt {
+        Some(dt) => Ok(dt),
+        None => default_step(p),
+    }
+}
+
+/// The next index of a queue of `n` shared by workers, unless one has failed.
+fn take(next: &AtomicUsize, n: usize, failed: Option<&AtomicBool>) -> Option<usize> {
+    if failed.is_some_and(|f| f.load(Ordering::Relaxed)) {
+        return None;
+    }
+    let i = next.fetch_add(1, Ordering::Relaxed);
+    (i < n).then_some(i)
+}
+
+/// The motor torques `offset + amplitude·sin(ωt)` of `L` lanes, each exactly as
+/// [`Sine::step_torques`] computes them for its own clock `t` = steps·dt (the same
+/// rotations of (sin, cos) by half steps, the same resynchronisation every
+/// [`Sine::RESYNC`] steps or on a clock jump), but advanced lane-wise.
+struct Sines<const L: usize> {
+    dt: f64,
+    amplitude: [f64; L],
+    offset: [f64; L],
+    omega: [f64; L],
+    /// sin, cos of ω·t at the next step start, and of ω·dt/2.
+    sin: [f64; L],
+    cos: [f64; L],
+    half_sin: [f64; L],
+    half_cos: [f64; L],
+    /// Steps taken (the lane's clock is steps·dt), and steps left before the next
+    /// resynchronisation (0: now).
+    steps: [f64; L],
+    count: [u32; L],
+    next_t: [f64; L],
+}
+
+impl<const L: usize> Sines<L> {
+    /// Zero torque in every lane.
+    fn new(dt: f64) -> Self {
+        Sines {
+            dt,
+            amplitude: [0.0; L],
+            offset: [0.0; L],
+            omega: [0.0; L],
+            sin: [0.0; L],
+            cos: [1.0; L],
+            half_sin: [0.0; L],
+            half_cos: [1.0; L],
+            steps: [0.0; L],
+            count: [u32::MAX; L],
+            next_t: [0.0; L],
+        }
+    }
+
+    /// Lane `l` starts `input`'s sine at t = 0 (a fresh [`Sine`]).
+    fn start(&mut self, l: usize, frequency_hz: f64, amplitude_nm: f64, offset_nm: f64) {
+        self.amplitude[l] = amplitude_nm;
+        self.offset[l] = offset_nm;
+        self.omega[l] = std::f64::consts::TAU * frequency_hz;
+        (self.half_sin[l], self.half_cos[l]) = (0.5 * self.omega[l] * self.dt).sin_cos();
+        self.steps[l] = 0.0;
+        self.count[l] = 0;
+        self.next_t[l] = f64::NAN;
+    }
+
+    /// Lane `l` applies no torque.
+    fn stop(&mut self, l: usize) {
+        (self.amplitude[l], self.offset[l]) = (0.0, 0.0);
+        self.count[l] = u32::MAX;
+    }
+
+    /// The torques of every lane at the start, middle and end of the next step.
+    #[inline]
+    fn step_torques(&mut self) -> [[f64; L]; 3] {
+        let h = self.dt;
+        let t = Lanes(self.steps) * h;
+        let jump = t.zip(Lanes(self.next_t), |t, n| {
+            if (t - n).abs() > 1e-6 * h {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let mut resync = jump.any(|j| j != 0.0);
+        for c in &mut self.count {
+            resync |= *c == 0;
+        }
+        if resync {
+            self.resync(t, jump);
+        }
+        for c in &mut self.count {
+            *c = c.wrapping_sub(1);
+        }
+        let rotate = |s: Lanes<L>, c: Lanes<L>| {
+            let (sh, ch) = (Lanes(self.half_sin), Lanes(self.half_cos));
+            (s * ch + c * sh, c * ch - s * sh)
+        };
+        let (s0, c0) = (Lanes(self.sin), Lanes(self.cos));
+        let (s1, c1) = rotate(s0, c0);
+        let (s2, c2) = rotate(s1, c1);
+        let (a, o) = (Lanes(self.amplitude), Lanes(self.offset));
+        self.sin = s2.0;
+        self.cos = c2.0;
+        self.next_t = (t + h).0;
+        self.steps = (Lanes(self.steps) + 1.0).0;
+        [s0, s1, s2].map(|s| (o + a * s).0)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn resync(&mut self, t: Lanes<L>, jump: Lanes<L>) {
+        for l in 0..L {
+            if self.count[l] == 0 || jump.0[l] != 0.0 {
+                (self.sin[l], self.cos[l]) = (self.omega[l] * t.0[l]).sin_cos();
+                self.count[l] = Sine::RESYNC;
+            }
+        }
+    }
+}
+
+/// One frequency in progress in a lane: its input, its current window and the
+/// amplitudes of the previous one.
+struct Run {
+    index: usize,
+    frequency_hz: f64,
+    omega: f64,
+    period: f64,
+    window: f64,
+    rec: Window,
+    /// Steps left in the current window.
+    remaining: u64,
+    previous: Option<(f64, f64, f64)>,
+}
+
+impl Run {
+    /// Starts frequency `index` in lane `l` of `sim`, from the linear steady state.
+    fn start<const L: usize>(
+        sim: &mut LaneSimulation<L>,
+        sines: &mut Sines<L>,
+        l: usize,
+        p: &Params,
+        index: usize,
+        frequency_hz: f64,
+        test: &FrequencyTest,
+    ) -> Self {
+        let omega = std::f64::consts::TAU * frequency_hz;
+        let dt = sim.dt();
+        sim.start(l, initial_state(p, omega, test), -test.preload_nm);
+        let period = 1.0 / frequency_hz;
+        let cycles = (test.window_s / period).ceil().max(1.0);
+        let window = cycles * period;
+        let every = ((period / 40.0 / dt).floor() as usize).max(1);
+        let capacity = (window / dt / every as f64).ceil() as usize + 2;
+        let mut run = Run {
+            index,
+            frequency_hz,
+            omega,
+            period,
+            window,
+            rec: Window {
+                every,
+                until: every,
+                t: Vec::with_capacity(capacity),
+                motor: Vec::with_capacity(capacity),
+                table: Vec::with_capacity(capacity),
+                open: [0, 0],
+                drive: *sim.drive(),
+            },
+            remaining: 0,
+            previous: None,
+        };
+        sines.start(
+            l,
+            frequency_hz,
+            test.amplitude_nm,
+            test.preload_nm * p.ratio(),
+        );
+        run.begin_window(sim, l);
+        // The initial state is the first record of the first window.
+        if run.rec.tick() {
+            run.rec.sample(0.0, &sim.state(l));
+        }
+        run
+    }
+
+    /// Clears the window and sets its length: whole cycles of the absolute time.
+    fn begin_window<const L: usize>(&mut self, sim: &LaneSimulation<L>, l: usize) {
+        self.rec.clear();
+        let now = sim.time(l);
+        let end = ((now + self.window) / self.period).round() * self.period;
+        self.remaining = (((end - now) / sim.dt()).round() as u64).max(1);
+    }
+
+    /// After a step of lane `l`: records, and at the end of a window evaluates it;
+    /// returns the point when the run is over.
+    #[inline]
+    fn after_step<const L: usize>(
+        &mut self,
+        sim: &LaneSimulation<L>,
+        l: usize,
+        p: &Params,
+        test: &FrequencyTest,
+    ) -> Option<Point> {
+        if self.rec.tick() {
+            self.rec.sample(sim.time(l), &sim.state(l));
+        }
+        self.remaining -= 1;
+        if self.remaining > 0 {
+            return None;
+        }
+        let point = self.end_window(sim.time(l), p, test);
+        if point.is_none() {
+            self.begin_window(sim, l);
+        }
+        point
+    }
+
+    /// Fits the window; the point if it settled or the time is up.
+    fn end_window(&mut self, time: f64, p: &Params, test: &FrequencyTest) -> Option<Point> {
+        let rec = &self.rec;
+        let ratio = p.ratio();
+        // The smallest table amplitude a measurement resolves (0.0001° encoder), and a
+        // floor for the ideal-encoder case, so that a table at rest gives a finite gain.
+        let floor = p.controller.table_encoder_resolution.max(1e-12);
+        let [(am, pm), (at, pt)] = sine_components(&rec.t, [&rec.motor, &rec.table], self.omega);
         let below_resolution = at < floor;
         let gain = 20.0 * (at.max(floor) / (am.max(f64::MIN_POSITIVE) * ratio)).log10();
-        let settled = previous.is_some_and(|(g, a, b)| {
+        let settled = self.previous.is_some_and(|(g, a, b)| {
             (gain - g).abs() < test.tolerance_db
                 && ((am - a) / a).abs() < 10.0 * test.tolerance_db / 8.686
                 && (below_resolution || ((at - b) / b).abs() < 10.0 * test.tolerance_db / 8.686)
         });
         let n = rec.t.len().max(1) as f64;
-        if settled || sim.time() >= test.max_duration_s {
+        if settled || time >= test.max_duration_s {
             let mut phase = (pt - pm).to_degrees();
             while phase > 180.0 {
                 phase -= 360.0;
@@ -267,8 +495,8 @@ pub fn simulate_point(
             while phase <= -180.0 {
                 phase += 360.0;
             }
-            return Ok(Point {
-                frequency_hz,
+            return Some(Point {
+                frequency_hz: self.frequency_hz,
                 gain_db: gain,
                 phase_deg: phase,
                 motor_amplitude_rad: am,
@@ -276,11 +504,98 @@ pub fn simulate_point(
                 contact_loss: rec.open.map(|k| k as f64 / n),
                 settled,
                 below_resolution,
-                simulated_s: sim.time(),
+                simulated_s: time,
             });
         }
-        previous = Some((gain, am, at));
+        self.previous = Some((gain, am, at));
+        None
     }
+}
+
+/// Runs frequencies taken from `next` (indices into `freqs`) in the `L` lanes of one
+/// simulation until the queue is empty, refilling each lane as its point finishes;
+/// pushes (index, point) to `out` and calls `progress` after each point.
+fn run_lanes<const L: usize>(
+    p: &Params,
+    freqs: &[f64],
+    test: &FrequencyTest,
+    dt: f64,
+    next: &dyn Fn() -> Option<usize>,
+    progress: &(dyn Fn() + Sync),
+    out: &mut Vec<(usize, Point)>,
+) -> Result<(), SimError> {
+    let mut sim = LaneSimulation::<L>::new(p, dt)?;
+    let mut sines = Sines::<L>::new(dt);
+    let mut runs: [Option<Run>; L] = std::array::from_fn(|_| None);
+    let mut queue_open = true;
+    loop {
+        if queue_open {
+            for (l, run) in runs.iter_mut().enumerate() {
+                if run.is_none() {
+                    match next() {
+                        Some(i) => {
+                            *run = Some(Run::start(&mut sim, &mut sines, l, p, i, freqs[i], test))
+                        }
+                        None => {
+                            queue_open = false;
+                            break;
+                        }
+                    }
+                }
+            }
+        }
+        if runs.iter().all(Option::is_none) {
+            return Ok(());
+        }
+        sim.step(&sines.step_torques())?;
+        for (l, slot) in runs.iter_mut().enumerate() {
+            if let Some(run) = slot {
+                if let Some(point) = run.after_step(&sim, l, p, test) {
+                    out.push((run.index, point));
+                    progress();
+                    *slot = None;
+                    // Idle until refilled: at rest, without load or torque.
+                    sim.start(l, [0.0; NSTATE], 0.0);
+                    sines.stop(l);
+                }
+            }
+        }
+    }
+}
+
+/// Every frequency of `freqs`, in [`LANES`]-wide batches on the rayon workers;
+/// points in the order of `freqs`.
+fn simulate_all(
+    p: &Params,
+    freqs: &[f64],
+    test: &FrequencyTest,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<Point>, SimError> {
+    let dt = step(p, test)?;
+    let next = AtomicUsize::new(0);
+    let failed = AtomicBool::new(false);
+    let workers = rayon::current_num_threads()
+        .min(freqs.len().div_ceil(LANES))
+        .max(1);
+    let done: Vec<Result<Vec<(usize, Point)>, SimError>> = (0..workers)
+        .into_par_iter()
+        .map(|_| {
+            let mut out = Vec::new();
+            let take = || take(&next, freqs.len(), Some(&failed));
+            let r = run_lanes::<LANES>(p, freqs, test, dt, &take, progress, &mut out);
+            if r.is_err() {
+                failed.store(true, Ordering::Relaxed);
+            }
+            r.map(|()| out)
+        })
+        .collect();
+    let mut points: Vec<Option<Point>> = vec![None; freqs.len()];
+    for worker in done {
+        for (i, point) in worker? {
+            points[i] = Some(point);
+        }
+    }
+    Ok(points.into_iter().flatten().collect())
 }
 
 /// The whole test: the coarse grid, then `refine_step_hz` steps around each local
@@ -291,21 +606,11 @@ pub fn sweep(
     test: &FrequencyTest,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<Point>, SimError> {
-    let run = |freqs: &[f64]| -> Result<Vec<Point>, SimError> {
-        freqs
-            .par_iter()
-            .map(|&f| {
-                let r = simulate_point(p, f, test);
-                progress();
-                r
-            })
-            .collect()
-    };
-    let mut points = run(&test.frequencies_hz)?;
+    let mut points = simulate_all(p, &test.frequencies_hz, test, progress)?;
     points.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     if test.refine_step_hz > 0.0 {
         let extra = refinement(&points, test);
-        points.extend(run(&extra)?);
+        points.extend(simulate_all(p, &extra, test, progress)?);
         points.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     }
     Ok(points)
@@ -393,11 +698,36 @@ mod tests {
             .iter()
             .map(|&t| 3.0 + 20.0 * t - 5.0 * t * t + 0.7 * (omega * t + 0.4).sin())
             .collect();
-        let (a, phi) = sine_component(&t, &x, omega);
+        let [(a, phi)] = sine_components(&t, [&x], omega);
         assert!(
             (a - 0.7).abs() < 1e-9 && (phi - 0.4).abs() < 1e-9,
             "{a} {phi}"
         );
+    }
+
+    #[test]
+    fn lanes_of_sines_equal_lone_sines() {
+        use crate::input::TorqueInput;
+        let dt = 1e-5;
+        let mut lanes = Sines::<4>::new(dt);
+        let mut lone: Vec<(Sine, u64)> = Vec::new();
+        for (l, f) in [10.0, 230.0, 599.0, 47.5].into_iter().enumerate() {
+            lanes.start(l, f, 5.0, 0.1 * l as f64);
+            lone.push((Sine::new(f, 5.0, 0.1 * l as f64), 0));
+        }
+        for k in 0..20_000 {
+            if k == 7_000 {
+                // Lane 2 restarts with another frequency, out of step with the rest.
+                lanes.start(2, 321.0, 3.0, -1.0);
+                lone[2] = (Sine::new(321.0, 3.0, -1.0), 0);
+            }
+            let m = lanes.step_torques();
+            for (l, (sine, steps)) in lone.iter_mut().enumerate() {
+                let expected = sine.step_torques(*steps as f64 * dt, dt);
+                *steps += 1;
+                assert_eq!([m[0][l], m[1][l], m[2][l]], expected, "lane {l}, step {k}");
+            }
+        }
     }
 
     #[test]

@@ -1,16 +1,22 @@
 //! Gear meshes with free play (MODEL.md §2): a dead zone of half-width `b` that
 //! transmits stiffness plus internal damping only while the teeth touch, and never
 //! pulls while they separate.
+//!
+//! The laws are written as selects between values computed unconditionally (no
+//! branch depends on the state), so the kernel's lane-wise forms ([`mesh_torque_lanes`])
+//! vectorise; each lane gets exactly the scalar result.
+
+use super::lanes::Lanes;
 
 /// The dead-zone deflection: δ − b above the gap, δ + b below it, 0 inside.
 #[inline(always)]
 pub fn dead_zone(delta: f64, b: f64) -> f64 {
+    // One level of select at a time: compiles to blends, not branches.
+    let below = if delta < -b { delta + b } else { 0.0 };
     if delta > b {
         delta - b
-    } else if delta < -b {
-        delta + b
     } else {
-        0.0
+        below
     }
 }
 
@@ -27,14 +33,34 @@ pub fn mesh_torque(k: f64, c: f64, b: f64, delta: f64, rate: f64) -> f64 {
         return k * delta + c * rate;
     }
     let dz = dead_zone(delta, b);
-    let t = k * dz + c * rate;
+    contact_torque(dz, k * dz + c * rate)
+}
+
+/// The torque `t` = k·dz + c·rate clamped to the sign of the contact `dz` (0 in the gap).
+#[inline(always)]
+fn contact_torque(dz: f64, t: f64) -> f64 {
+    let pull = if dz < 0.0 { t.min(0.0) } else { 0.0 };
     if dz > 0.0 {
         t.max(0.0)
-    } else if dz < 0.0 {
-        t.min(0.0)
     } else {
-        0.0
+        pull
     }
+}
+
+/// [`mesh_torque`] for each lane (`k`, `c`, `b` shared by all lanes).
+#[inline(always)]
+pub fn mesh_torque_lanes<const L: usize>(
+    k: f64,
+    c: f64,
+    b: f64,
+    delta: Lanes<L>,
+    rate: Lanes<L>,
+) -> Lanes<L> {
+    if b == 0.0 {
+        return k * delta + c * rate;
+    }
+    let dz = delta.map(|d| dead_zone(d, b));
+    dz.zip(k * dz + c * rate, contact_torque)
 }
 
 #[cfg(test)]
@@ -63,6 +89,19 @@ mod tests {
         // In contact on the positive flank but separating fast: damping would pull.
         assert_eq!(mesh_torque(3e5, 100.0, 1e-4, 1.01e-4, -50.0), 0.0);
         assert_eq!(mesh_torque(3e5, 100.0, 1e-4, -1.01e-4, 50.0), 0.0);
+    }
+
+    #[test]
+    fn the_lane_form_equals_the_scalar_law() {
+        let delta = Lanes([-3e-4, -1.01e-4, -1e-4, 0.0, 5e-5, 1e-4, 1.01e-4, 3e-4]);
+        for rate in [-50.0, -2.0, 0.0, 2.0, 50.0] {
+            for b in [0.0, 1e-4] {
+                let t = mesh_torque_lanes(3e5, 100.0, b, delta, Lanes::splat(rate));
+                for l in 0..8 {
+                    assert_eq!(t.0[l], mesh_torque(3e5, 100.0, b, delta.0[l], rate));
+                }
+            }
+        }
     }
 
     #[test]

@@ -195,35 +195,11 @@ impl Drive {
         (self.w * s, self.w * self.n * c)
     }
 
-    /// sin and cos of the fluctuation phase N·θ + φ at a step's start, carried
-    /// forward from the previous step's start `base` by a small rotation; computed
-    /// afresh every [`PHASE_RESYNC`] steps (`fresh` counts down), after a jump
-    /// (|N·Δθ| ≥ 0.01) and on the first step (`fresh` = 0). Rounding drift between
-    /// resynchronisations stays below 1e-13.
-    #[inline(always)]
-    pub(crate) fn fluctuation_phase(
-        &self,
-        shaft_angle: f64,
-        base: f64,
-        (s0, c0): (f64, f64),
-        fresh: &mut u32,
-    ) -> (f64, f64) {
-        let x = self.n * (shaft_angle - base);
-        if *fresh > 0 && x.abs() < 0.01 {
-            *fresh -= 1;
-            let (sx, cx) = small_sin_cos(x);
-            (s0 * cx + c0 * sx, c0 * cx - s0 * sx)
-        } else {
-            *fresh = PHASE_RESYNC;
-            self.exact_phase(shaft_angle)
-        }
-    }
-
     /// sin and cos of N·θ + φ by the library (kept out of line: a call inside the
     /// hot loop makes the compiler spill every live register around it).
     #[cold]
     #[inline(never)]
-    fn exact_phase(&self, shaft_angle: f64) -> (f64, f64) {
+    pub(crate) fn exact_phase(&self, shaft_angle: f64) -> (f64, f64) {
         (self.n * shaft_angle + self.phase).sin_cos()
     }
 
@@ -250,14 +226,23 @@ pub(crate) const PHASE_RESYNC: u32 = 1024;
 /// x⁶/720, i.e. < 2e-18 and 1.4e-15), the library functions otherwise.
 #[inline(always)]
 fn small_sin_cos(x: f64) -> (f64, f64) {
-    if x.abs() < 0.01 {
-        let x2 = x * x;
-        let s = x * (1.0 - x2 * (1.0 / 6.0 - x2 * (1.0 / 120.0)));
-        let c = 1.0 - x2 * (0.5 - x2 * (1.0 / 24.0));
-        (s, c)
+    if x.abs() < SMALL_ANGLE {
+        taylor_sin_cos(x)
     } else {
         x.sin_cos()
     }
+}
+
+/// Below this |x| the Taylor polynomials of [`taylor_sin_cos`] are used.
+pub(crate) const SMALL_ANGLE: f64 = 0.01;
+
+/// The Taylor polynomials of sin and cos used for |x| < [`SMALL_ANGLE`].
+#[inline(always)]
+pub(crate) fn taylor_sin_cos(x: f64) -> (f64, f64) {
+    let x2 = x * x;
+    let s = x * (1.0 - x2 * (1.0 / 6.0 - x2 * (1.0 / 120.0)));
+    let c = 1.0 - x2 * (0.5 - x2 * (1.0 / 24.0));
+    (s, c)
 }
 
 #[cfg(test)]

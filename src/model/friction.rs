@@ -9,6 +9,12 @@
 //! within a step is put to rest at the end of the step (its velocity set to exactly
 //! zero), so the next step decides between sticking and reversing. A stuck body's
 //! velocity is exactly zero and stays so: it cannot creep.
+//!
+//! The decision is a select among constants (no branch on the state), so the
+//! kernel's lane-wise form [`decide_lanes`] vectorises with the scalar result in
+//! every lane.
+
+use super::lanes::Lanes;
 
 /// The friction state of one body over one step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -25,21 +31,10 @@ impl Friction {
     /// torque it slides otherwise (breaking away from rest: opposing `t`).
     #[inline(always)]
     pub fn decide(t: f64, w: f64, fc: f64) -> Self {
-        let torque = if w > 0.0 {
-            fc
-        } else if w < 0.0 {
-            -fc
-        } else if t > fc {
-            fc
-        } else if t < -fc {
-            -fc
-        } else {
-            return Friction {
-                torque: 0.0,
-                free: 0.0,
-            };
-        };
-        Friction { torque, free: 1.0 }
+        Friction {
+            torque: decided_torque(t, w, fc),
+            free: decided_free(t, w, fc),
+        }
     }
 
     /// The net torque on the body (0 while stuck).
@@ -51,6 +46,55 @@ impl Friction {
     /// Whether the body sticks.
     pub fn stuck(self) -> bool {
         self.free == 0.0
+    }
+}
+
+/// The friction torque of [`Friction::decide`]: fc against the motion, or against
+/// `t` when breaking away from rest; 0 when stuck.
+#[inline(always)]
+fn decided_torque(t: f64, w: f64, fc: f64) -> f64 {
+    // Written as selects (non-short-circuit `|`, one level of `if`) so that the
+    // lane-wise form compiles to compare-and-blend instructions, not branches.
+    let moving = (w > 0.0) | (w < 0.0);
+    let direction = if moving { w } else { t };
+    let slides = moving | (t > fc) | (t < -fc);
+    if slides {
+        fc.copysign(direction)
+    } else {
+        0.0
+    }
+}
+
+/// 1 if the body of [`Friction::decide`] moves, 0 if it sticks.
+#[inline(always)]
+fn decided_free(t: f64, w: f64, fc: f64) -> f64 {
+    if (w > 0.0) | (w < 0.0) | (t > fc) | (t < -fc) {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// [`Friction::decide`] for each lane: (friction torques, free flags).
+#[inline(always)]
+pub fn decide_lanes<const L: usize>(t: Lanes<L>, w: Lanes<L>, fc: f64) -> (Lanes<L>, Lanes<L>) {
+    (
+        t.zip(w, |t, w| decided_torque(t, w, fc)),
+        t.zip(w, |t, w| decided_free(t, w, fc)),
+    )
+}
+
+/// [`stop_at_reversal`] for each lane.
+#[inline(always)]
+pub fn stop_at_reversal_lanes<const L: usize>(
+    w_before: Lanes<L>,
+    w_after: Lanes<L>,
+    fc: f64,
+) -> Lanes<L> {
+    if fc > 0.0 {
+        w_before.zip(w_after, |b, a| if b * a < 0.0 { 0.0 } else { a })
+    } else {
+        w_after
     }
 }
 

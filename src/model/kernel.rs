@@ -20,6 +20,17 @@
 //!
 //! Friction is the stick/slip clamp of friction.rs.
 //!
+//! **Lanes.** The common path of a step has no per-lane control flow: the dead
+//! zones, the contact clamp, the friction decision and the stop at a velocity
+//! reversal are selects between values computed for every lane (backlash.rs,
+//! friction.rs, lanes.rs), so the compiler vectorises the `L` lanes. What is rare
+//! is taken out of line, and only when some lane needs it: the library `sin_cos` of
+//! the fluctuation phase (every 1024 steps, or after a jump), and the re-integration
+//! of a step split at a contact event (2.8 % of worm steps at ±5 N·m), which is done
+//! for the affected lane alone by the same code at `L = 1`. Lane `l` of a `Kernel<L>`
+//! therefore follows bit for bit the trajectory that a `Kernel<1>` would compute for
+//! it (tested: `tests/lanes.rs`).
+//!
 //! **Contact events.** A mesh entering or leaving contact puts a kink into the
 //! equations; RK4 stepping across it drops to second order (measured: the energy of
 //! the undamped worm with backlash drifts 1.2e-3 over 1 s at dt = 1e-5 s). So a step
@@ -27,7 +38,7 @@
 //! is interpolated over the step by the cubic Hermite polynomial of its values and
 //! rates at both ends, its crossing of the gap edge located by bisection, and the
 //! lane re-integrated from the step's start to the crossing and from there to the
-//! step's end (lanes without an event keep their full step). Inputs inside the step
+//! step's end (lanes without an event keep their full step, untouched). Inputs inside the step
 //! come from the quadratic through the three given values (exact for the held
 //! torque of the controller).
 //!
@@ -38,23 +49,32 @@
 //! The step allocates nothing: stage derivatives and step-start values live in the
 //! [`Kernel`], which the caller owns and reuses.
 
-use super::backlash::mesh_torque;
-use super::drive::{idx::*, Drive, NSTATE};
-use super::friction::{stop_at_reversal, Friction};
+use super::backlash::mesh_torque_lanes;
+use super::drive::{idx::*, taylor_sin_cos, Drive, NSTATE, PHASE_RESYNC, SMALL_ANGLE};
+use super::friction::{decide_lanes, stop_at_reversal_lanes};
+use super::lanes::Lanes;
 
 /// The state of `L` lanes: `y[i][l]` is state `i` (see [`idx`](super::drive::idx)) of lane `l`.
 pub type States<const L: usize> = [[f64; L]; NSTATE];
 
-/// Values at the start of the current (sub)step, per lane, computed by the first
-/// stage and used by the later stages and the event check.
+/// What the kernel remembers per lane: the friction decisions of the current step,
+/// and the values at the start of the current (sub)step computed by the first stage
+/// for the later stages and the event check.
 #[derive(Clone, Copy, Debug)]
-struct StepStart<const L: usize> {
+struct LaneState<const L: usize> {
+    /// Friction torque of motor, shaft, table opposing the motion (0 when stuck).
+    friction: [[f64; L]; 3],
+    /// 1 while the body moves, 0 while it sticks.
+    free: [[f64; L]; 3],
+    /// free / inertia: net torque → acceleration (0 while stuck).
+    gain: [[f64; L]; 3],
     /// Shaft angle, and sin, cos of the fluctuation phase there.
     shaft: [f64; L],
     sin: [f64; L],
     cos: [f64; L],
-    /// Steps left before the phase is computed afresh (0: compute now).
-    fresh: [u32; L],
+    /// Steps left before the phase is computed afresh (0: compute now); a whole
+    /// number, kept as `f64` so that its update vectorises with the rest.
+    fresh: [f64; L],
     /// Taylor coefficients of e(θ0 + Δ) = e0 + e1·Δ + e2·Δ²/2 + e3·Δ³/6 at the
     /// step start: [e0, e1, e2/2, e3/6, e2, e3/2].
     taylor: [[f64; L]; 6],
@@ -63,11 +83,196 @@ struct StepStart<const L: usize> {
     rate: [[f64; L]; 2],
 }
 
-/// The per-step stick decisions of motor, shaft and table.
+impl<const L: usize> Default for LaneState<L> {
+    fn default() -> Self {
+        LaneState {
+            friction: [[0.0; L]; 3],
+            free: [[1.0; L]; 3],
+            gain: [[0.0; L]; 3],
+            shaft: [0.0; L],
+            sin: [0.0; L],
+            cos: [1.0; L],
+            fresh: [0.0; L],
+            taylor: [[0.0; L]; 6],
+            twist: [[0.0; L]; 2],
+            rate: [[0.0; L]; 2],
+        }
+    }
+}
+
+impl<const L: usize> LaneState<L> {
+    /// Lane `l` alone.
+    fn lane(&self, l: usize) -> LaneState<1> {
+        LaneState {
+            friction: self.friction.map(|b| [b[l]]),
+            free: self.free.map(|b| [b[l]]),
+            gain: self.gain.map(|b| [b[l]]),
+            shaft: [self.shaft[l]],
+            sin: [self.sin[l]],
+            cos: [self.cos[l]],
+            fresh: [self.fresh[l]],
+            taylor: self.taylor.map(|t| [t[l]]),
+            twist: self.twist.map(|t| [t[l]]),
+            rate: self.rate.map(|t| [t[l]]),
+        }
+    }
+
+    /// Replaces lane `l` by `one`.
+    fn set_lane(&mut self, l: usize, one: &LaneState<1>) {
+        for b in 0..3 {
+            self.friction[b][l] = one.friction[b][0];
+            self.free[b][l] = one.free[b][0];
+            self.gain[b][l] = one.gain[b][0];
+        }
+        self.shaft[l] = one.shaft[0];
+        self.sin[l] = one.sin[0];
+        self.cos[l] = one.cos[0];
+        self.fresh[l] = one.fresh[0];
+        for k in 0..6 {
+            self.taylor[k][l] = one.taylor[k][0];
+        }
+        for m in 0..2 {
+            self.twist[m][l] = one.twist[m][0];
+            self.rate[m][l] = one.rate[m][0];
+        }
+    }
+
+    /// Decides the friction of body `b` (inverse inertia `inv_j`) from the sum `t`
+    /// of its other torques.
+    #[inline(always)]
+    fn decide(&mut self, b: usize, t: Lanes<L>, w: Lanes<L>, fc: f64, inv_j: f64) {
+        let (torque, free) = decide_lanes(t, w, fc);
+        self.friction[b] = torque.0;
+        self.free[b] = free.0;
+        self.gain[b] = (free * inv_j).0;
+    }
+
+    /// The acceleration of body `b` under the other torques `t`: (t − friction)/J,
+    /// 0 while stuck. (free ∈ {0, 1}, so this equals ((t − friction)·free)/J exactly.)
+    #[inline(always)]
+    fn accel(&self, b: usize, t: Lanes<L>) -> Lanes<L> {
+        (t - Lanes(self.friction[b])) * Lanes(self.gain[b])
+    }
+
+    /// e and e' at a step's start: sin/cos of the phase carried from the previous
+    /// step's start by a small rotation (drive.rs), computed afresh every
+    /// [`PHASE_RESYNC`] steps, after a jump and on the first step (out of line, only
+    /// for the lanes that need it). Stores the Taylor coefficients for later stages.
+    #[inline(always)]
+    fn fluctuation_first(&mut self, d: &Drive, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
+        let x = d.n * (shaft - Lanes(self.shaft));
+        let sx = x.map(|x| taylor_sin_cos(x).0);
+        let cx = x.map(|x| taylor_sin_cos(x).1);
+        let (s0, c0) = (Lanes(self.sin), Lanes(self.cos));
+        let mut s = s0 * cx + c0 * sx;
+        let mut c = c0 * cx - s0 * sx;
+        let resync_at = PHASE_RESYNC as f64;
+        let fresh = Lanes(self.fresh).zip(x, |fresh, x| {
+            if (fresh > 0.0) & (x.abs() < SMALL_ANGLE) {
+                fresh - 1.0
+            } else {
+                resync_at
+            }
+        });
+        self.fresh = fresh.0;
+        if fresh.any(|f| f == resync_at) {
+            self.resync_phase(d, shaft, &mut s, &mut c);
+        }
+        self.shaft = shaft.0;
+        self.sin = s.0;
+        self.cos = c.0;
+        let e0 = d.w * s;
+        let e1 = (d.w * d.n) * c;
+        let (e2, e3) = ((-d.n * d.n) * e0, (-d.n * d.n) * e1);
+        self.taylor = [
+            e0.0,
+            e1.0,
+            (0.5 * e2).0,
+            (e3 * (1.0 / 6.0)).0,
+            e2.0,
+            (0.5 * e3).0,
+        ];
+        (e0, e1)
+    }
+
+    /// The library sin/cos for the lanes whose counter was just reset.
+    #[cold]
+    #[inline(never)]
+    fn resync_phase(&self, d: &Drive, shaft: Lanes<L>, s: &mut Lanes<L>, c: &mut Lanes<L>) {
+        for l in 0..L {
+            if self.fresh[l] == PHASE_RESYNC as f64 {
+                (s.0[l], c.0[l]) = d.exact_phase(shaft.0[l]);
+            }
+        }
+    }
+
+    /// e and e' at a later stage: the cubic Taylor polynomial of e about the step
+    /// start (error below W·(N·Δθ)⁴/24 < 4e-10·W; its slope is the polynomial's
+    /// exact derivative, so the mesh energy stays consistent), or the exact rotation
+    /// for a lane that moved |N·Δθ| ≥ 0.01 within the step (out of line).
+    #[inline(always)]
+    fn fluctuation_later(&self, d: &Drive, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
+        let dx = shaft - Lanes(self.shaft);
+        let t = self.taylor.map(Lanes);
+        let mut e = t[0] + dx * (t[1] + dx * (t[2] + dx * t[3]));
+        let mut ep = t[1] + dx * (t[4] + dx * t[5]);
+        if (d.n * dx).any(far) {
+            self.far_fluctuation(d, shaft, &mut e, &mut ep);
+        }
+        (e, ep)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn far_fluctuation(&self, d: &Drive, shaft: Lanes<L>, e: &mut Lanes<L>, ep: &mut Lanes<L>) {
+        for l in 0..L {
+            if far(d.n * (shaft.0[l] - self.shaft[l])) {
+                (e.0[l], ep.0[l]) =
+                    d.fluctuation_near(shaft.0[l], self.shaft[l], (self.sin[l], self.cos[l]));
+            }
+        }
+    }
+
+    /// e and e' at `shaft` by the exact rotation from the step start (drive.rs's
+    /// `fluctuation_near`, lane-wise; the library `sin_cos` out of line for lanes
+    /// with |N·Δθ| ≥ 0.01).
+    #[inline(always)]
+    fn fluctuation_near(&self, d: &Drive, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
+        let x = d.n * (shaft - Lanes(self.shaft));
+        let mut sx = x.map(|x| taylor_sin_cos(x).0);
+        let mut cx = x.map(|x| taylor_sin_cos(x).1);
+        if x.any(far) {
+            library_sin_cos(x, &mut sx, &mut cx);
+        }
+        let (s0, c0) = (Lanes(self.sin), Lanes(self.cos));
+        let (s, c) = (s0 * cx + c0 * sx, c0 * cx - s0 * sx);
+        (d.w * s, (d.w * d.n) * c)
+    }
+}
+
+/// Whether the angle `x` is beyond the Taylor polynomials' range (or NaN).
+#[inline(always)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+fn far(x: f64) -> bool {
+    !(x.abs() < SMALL_ANGLE)
+}
+
+/// sin, cos of `x` by the library in the lanes where |x| ≥ 0.01.
+#[cold]
+#[inline(never)]
+fn library_sin_cos<const L: usize>(x: Lanes<L>, s: &mut Lanes<L>, c: &mut Lanes<L>) {
+    for l in 0..L {
+        if far(x.0[l]) {
+            (s.0[l], c.0[l]) = x.0[l].sin_cos();
+        }
+    }
+}
+
+/// The integrator's memory for `L` lanes: per-step stick decisions of motor, shaft
+/// and table, and step-start values. Owned and reused by the caller.
 #[derive(Clone, Debug)]
 pub struct Kernel<const L: usize> {
-    friction: [[Friction; L]; 3],
-    start: StepStart<L>,
+    lanes: LaneState<L>,
     /// Number of steps split at a contact event (all lanes), for diagnostics.
     events: u64,
 }
@@ -75,16 +280,7 @@ pub struct Kernel<const L: usize> {
 impl<const L: usize> Default for Kernel<L> {
     fn default() -> Self {
         Kernel {
-            friction: [[Friction::default(); L]; 3],
-            start: StepStart {
-                shaft: [0.0; L],
-                sin: [0.0; L],
-                cos: [1.0; L],
-                fresh: [0; L],
-                taylor: [[0.0; L]; 6],
-                twist: [[0.0; L]; 2],
-                rate: [[0.0; L]; 2],
-            },
+            lanes: LaneState::default(),
             events: 0,
         }
     }
@@ -114,12 +310,17 @@ impl<const L: usize> Kernel<L> {
 
     /// Whether motor, shaft and table of lane `l` were stuck during the last step.
     pub fn stuck(&self, l: usize) -> [bool; 3] {
-        [0, 1, 2].map(|b| self.friction[b][l].stuck())
+        [0, 1, 2].map(|b| self.lanes.free[b][l] == 0.0)
     }
 
     /// Lane-steps split at a contact event so far.
     pub fn events(&self) -> u64 {
         self.events
+    }
+
+    /// Forgets lane `l`'s memory, as for a new trajectory (a fresh `Kernel` lane).
+    pub fn reset_lane(&mut self, l: usize) {
+        self.lanes.set_lane(l, &LaneState::default());
     }
 
     #[inline(always)]
@@ -132,26 +333,48 @@ impl<const L: usize> Kernel<L> {
         h: f64,
     ) {
         let y0 = *y;
-        self.rk4::<SPUR>(d, y, motor, load, &[h; L]);
-        if !(d.bw > 0.0 || (SPUR && d.bg > 0.0)) {
+        rk4::<L, SPUR>(d, &mut self.lanes, &y0, y, motor, load, Lanes::splat(h));
+        let gaps = [SPUR && d.bg > 0.0, d.bw > 0.0];
+        if !(gaps[0] || gaps[1]) {
             return;
         }
-        let mut any = false;
-        let split: [f64; L] = std::array::from_fn(|l| {
-            let event = self.contact_event::<SPUR>(d, y, l, h);
-            any |= event.is_some();
-            event.unwrap_or(1.0)
-        });
-        if any {
-            self.split_step::<SPUR>(d, &y0, y, motor, load, h, &split);
+        // Twist and rate of both meshes at the step's end; a lane whose region
+        // (below, inside, above the gap) changed over the step had a contact event.
+        let st = &self.lanes;
+        let v = |i: usize| Lanes(y[i]);
+        let (shaft, ws) = if SPUR {
+            (v(THETA_W), v(OMEGA_W))
+        } else {
+            (v(THETA_M), v(OMEGA_M))
+        };
+        let mut twist = [Lanes::splat(0.0); 2];
+        let mut rate = [Lanes::splat(0.0); 2];
+        let mut changed = false;
+        if gaps[0] {
+            twist[0] = d.rg * v(THETA_M) - shaft;
+            rate[0] = d.rg * v(OMEGA_M) - ws;
+            changed |= region_changed(Lanes(st.twist[0]), twist[0], d.bg);
+        }
+        if gaps[1] {
+            let (e, ep) = if d.fluct {
+                st.fluctuation_near(d, shaft)
+            } else {
+                (Lanes::splat(0.0), Lanes::splat(0.0))
+            };
+            twist[1] = d.rw * shaft + e + v(X_W) * d.inv_r - v(THETA_T);
+            rate[1] = (d.rw + ep) * ws + v(V_W) * d.inv_r - v(OMEGA_T);
+            changed |= region_changed(Lanes(st.twist[1]), twist[1], d.bw);
+        }
+        if changed {
+            self.resolve_events::<SPUR>(d, &y0, y, motor, load, h, &twist, &rate);
         }
     }
 
-    /// Re-integrates the lanes with an event at fraction `split[l]` of the step in
-    /// two pieces; the others keep the full step already in `y`.
+    /// Splits the step of each lane with a contact event at the crossing.
     #[cold]
+    #[inline(never)]
     #[allow(clippy::too_many_arguments)]
-    fn split_step<const SPUR: bool>(
+    fn resolve_events<const SPUR: bool>(
         &mut self,
         d: &Drive,
         y0: &States<L>,
@@ -159,144 +382,103 @@ impl<const L: usize> Kernel<L> {
         motor: &[[f64; L]; 3],
         load: &[f64; L],
         h: f64,
-        split: &[f64; L],
+        twist: &[Lanes<L>; 2],
+        rate: &[Lanes<L>; 2],
     ) {
-        let mut part = *y0;
-        let mut first = [0.0; L];
-        let mut second = [0.0; L];
-        let mut m1 = [[0.0; L]; 3];
-        let mut m2 = [[0.0; L]; 3];
+        let gaps = [if SPUR { d.bg } else { 0.0 }, d.bw];
         for l in 0..L {
-            let s = split[l];
-            if s < 1.0 {
-                self.events += 1;
-                first[l] = s * h;
-                second[l] = (1.0 - s) * h;
-            }
-            let m = [motor[0][l], motor[1][l], motor[2][l]];
-            for (j, &at) in [0.0, 0.5 * s, s].iter().enumerate() {
-                m1[j][l] = quadratic(&m, at);
-            }
-            for (j, &at) in [s, 0.5 * (1.0 + s), 1.0].iter().enumerate() {
-                m2[j][l] = quadratic(&m, at);
-            }
-        }
-        self.rk4::<SPUR>(d, &mut part, &m1, load, &first);
-        self.rk4::<SPUR>(d, &mut part, &m2, load, &second);
-        for l in 0..L {
-            if split[l] < 1.0 {
-                for i in 0..NSTATE {
-                    y[i][l] = part[i][l];
+            let mut earliest: Option<f64> = None;
+            for mesh in 0..2 {
+                let b = gaps[mesh];
+                if b > 0.0 {
+                    let start = (self.lanes.twist[mesh][l], self.lanes.rate[mesh][l]);
+                    let end = (twist[mesh].0[l], rate[mesh].0[l]);
+                    if let Some(s) = crossing(start, end, b, h) {
+                        earliest = Some(earliest.map_or(s, |e: f64| e.min(s)));
+                    }
                 }
             }
+            if let Some(s) = earliest.filter(|&s| s > 0.0 && s < 1.0) {
+                self.split_lane::<SPUR>(d, y0, y, motor, load, h, l, s);
+            }
         }
     }
 
-    /// The earliest fraction of the last step at which a mesh of lane `l` entered or
-    /// left contact, if one did. `y` is the state at the step's end.
-    #[inline(always)]
-    fn contact_event<const SPUR: bool>(
-        &self,
-        d: &Drive,
-        y: &States<L>,
-        l: usize,
-        h: f64,
-    ) -> Option<f64> {
-        let st = &self.start;
-        let (shaft, ws) = if SPUR {
-            (y[THETA_W][l], y[OMEGA_W][l])
-        } else {
-            (y[THETA_M][l], y[OMEGA_M][l])
-        };
-        let mut earliest: Option<f64> = None;
-        let mut check = |mesh: usize, b: f64, twist: f64, rate: f64| {
-            let (t0, r0) = (st.twist[mesh][l], st.rate[mesh][l]);
-            let (g0, g1) = (region(t0, b), region(twist, b));
-            if g0 == g1 {
-                return;
-            }
-            let edge = b * if g0 != 0.0 { g0 } else { g1 };
-            if t0 == edge {
-                return;
-            }
-            let s = hermite_crossing(t0 - edge, h * r0, twist - edge, h * rate);
-            earliest = Some(earliest.map_or(s, |e: f64| e.min(s)));
-        };
-        if SPUR && d.bg > 0.0 {
-            check(
-                0,
-                d.bg,
-                d.rg * y[THETA_M][l] - shaft,
-                d.rg * y[OMEGA_M][l] - ws,
-            );
-        }
-        if d.bw > 0.0 {
-            let (e, ep) = if d.fluct {
-                d.fluctuation_near(shaft, st.shaft[l], (st.sin[l], st.cos[l]))
-            } else {
-                (0.0, 0.0)
-            };
-            check(
-                1,
-                d.bw,
-                d.rw * shaft + e + y[X_W][l] * d.inv_r - y[THETA_T][l],
-                (d.rw + ep) * ws + y[V_W][l] * d.inv_r - y[OMEGA_T][l],
-            );
-        }
-        earliest.filter(|&s| s > 0.0 && s < 1.0)
-    }
-
-    /// One classical RK4 step of length `h[l]` for each lane (0 leaves a lane as is).
-    /// Stage values are locals, not fields, so the compiler can keep them in
-    /// registers: the step is a chain of dependent stages, bound by latency.
-    #[inline(always)]
-    fn rk4<const SPUR: bool>(
+    /// Re-integrates lane `l` from the step's start in two pieces split at fraction
+    /// `s` of the step, alone (`L = 1`), so that its result does not depend on the
+    /// other lanes.
+    #[allow(clippy::too_many_arguments)]
+    fn split_lane<const SPUR: bool>(
         &mut self,
         d: &Drive,
+        y0: &States<L>,
         y: &mut States<L>,
         motor: &[[f64; L]; 3],
         load: &[f64; L],
-        h: &[f64; L],
+        h: f64,
+        l: usize,
+        s: f64,
     ) {
-        let y0 = *y;
-        let half = h.map(|h| 0.5 * h);
-        let friction = &mut self.friction;
-        let st = &mut self.start;
-        let k1 = derivative::<L, SPUR, true>(d, &y0, &motor[0], load, friction, st);
-        let k2 =
-            derivative::<L, SPUR, false>(d, &axpy(&y0, &half, &k1), &motor[1], load, friction, st);
-        let k3 =
-            derivative::<L, SPUR, false>(d, &axpy(&y0, &half, &k2), &motor[1], load, friction, st);
-        let k4 = derivative::<L, SPUR, false>(d, &axpy(&y0, h, &k3), &motor[2], load, friction, st);
-        let sixth = h.map(|h| h * (1.0 / 6.0));
+        self.events += 1;
+        let mut one = self.lanes.lane(l);
+        let mut part: States<1> = [[0.0]; NSTATE];
         for i in 0..NSTATE {
-            for l in 0..L {
-                y[i][l] = y0[i][l] + sixth[l] * (k1[i][l] + 2.0 * (k2[i][l] + k3[i][l]) + k4[i][l]);
-            }
+            part[i] = [y0[i][l]];
         }
-        for l in 0..L {
-            stop_at_reversal(y0[OMEGA_M][l], &mut y[OMEGA_M][l], d.fc[0]);
-            if SPUR {
-                stop_at_reversal(y0[OMEGA_W][l], &mut y[OMEGA_W][l], d.fc[1]);
-            } else {
-                y[THETA_W][l] = y[THETA_M][l];
-                y[OMEGA_W][l] = y[OMEGA_M][l];
-            }
-            stop_at_reversal(y0[OMEGA_T][l], &mut y[OMEGA_T][l], d.fc[2]);
+        let m = [motor[0][l], motor[1][l], motor[2][l]];
+        let m1 = [0.0, 0.5 * s, s].map(|at| [quadratic(&m, at)]);
+        let m2 = [s, 0.5 * (1.0 + s), 1.0].map(|at| [quadratic(&m, at)]);
+        let load = [load[l]];
+        let mut mid = part;
+        rk4::<1, SPUR>(d, &mut one, &part, &mut mid, &m1, &load, Lanes([s * h]));
+        rk4::<1, SPUR>(
+            d,
+            &mut one,
+            &mid,
+            &mut part,
+            &m2,
+            &load,
+            Lanes([(1.0 - s) * h]),
+        );
+        for i in 0..NSTATE {
+            y[i][l] = part[i][0];
         }
+        self.lanes.set_lane(l, &one);
     }
 }
 
 /// -1 below the gap, 0 inside it (no contact), +1 above it.
 #[inline(always)]
 fn region(twist: f64, b: f64) -> f64 {
+    let below = if twist < -b { -1.0 } else { 0.0 };
     if twist > b {
         1.0
-    } else if twist < -b {
-        -1.0
     } else {
-        0.0
+        below
     }
+}
+
+/// Whether any lane's twist changed region between `start` and `end`.
+#[inline(always)]
+fn region_changed<const L: usize>(start: Lanes<L>, end: Lanes<L>, b: f64) -> bool {
+    start
+        .zip(end, |t0, t1| region(t0, b) - region(t1, b))
+        .any(|d| d != 0.0)
+}
+
+/// The fraction of a step of length `h` at which a mesh's twist, going from
+/// (twist, rate) `start` to `end`, crosses the edge of its gap `b`; `None` if it
+/// stays in its region or starts exactly on the edge.
+fn crossing((t0, r0): (f64, f64), (t1, r1): (f64, f64), b: f64, h: f64) -> Option<f64> {
+    let (g0, g1) = (region(t0, b), region(t1, b));
+    if g0 == g1 {
+        return None;
+    }
+    let edge = b * if g0 != 0.0 { g0 } else { g1 };
+    if t0 == edge {
+        return None;
+    }
+    Some(hermite_crossing(t0 - edge, h * r0, t1 - edge, h * r1))
 }
 
 /// The root in (0, 1) of the cubic Hermite polynomial with values `f0`, `f1` and
@@ -339,131 +521,131 @@ fn unbalance_torque(d: &Drive, table_angle: f64) -> f64 {
 
 /// `y + a·k`, lane-wise.
 #[inline(always)]
-fn axpy<const L: usize>(y: &States<L>, a: &[f64; L], k: &States<L>) -> States<L> {
-    let mut out = *y;
+fn axpy<const L: usize>(y: &States<L>, a: Lanes<L>, k: &States<L>) -> States<L> {
+    let mut out = [[0.0; L]; NSTATE];
     for i in 0..NSTATE {
-        for l in 0..L {
-            out[i][l] += a[l] * k[i][l];
-        }
+        out[i] = (Lanes(y[i]) + a * Lanes(k[i])).0;
     }
     out
 }
 
-/// The right-hand side of the equations of motion for every lane. With `first`
+/// One classical RK4 step of length `h[l]` for each lane from `y0` into `y`, then
+/// the stop of sliding bodies whose velocity reversed (friction.rs). Stage values
+/// are locals, not fields, so the compiler can keep them in registers.
+#[inline(always)]
+fn rk4<const L: usize, const SPUR: bool>(
+    d: &Drive,
+    st: &mut LaneState<L>,
+    y0: &States<L>,
+    y: &mut States<L>,
+    motor: &[[f64; L]; 3],
+    load: &[f64; L],
+    h: Lanes<L>,
+) {
+    let half = h.map(|h| 0.5 * h);
+    let load = Lanes(*load);
+    let k1 = derivative::<L, SPUR, true>(d, y0, Lanes(motor[0]), load, st);
+    let k2 = derivative::<L, SPUR, false>(d, &axpy(y0, half, &k1), Lanes(motor[1]), load, st);
+    let k3 = derivative::<L, SPUR, false>(d, &axpy(y0, half, &k2), Lanes(motor[1]), load, st);
+    let k4 = derivative::<L, SPUR, false>(d, &axpy(y0, h, &k3), Lanes(motor[2]), load, st);
+    let sixth = h.map(|h| h * (1.0 / 6.0));
+    for i in 0..NSTATE {
+        let (a, b, c, e) = (Lanes(k1[i]), Lanes(k2[i]), Lanes(k3[i]), Lanes(k4[i]));
+        y[i] = (Lanes(y0[i]) + sixth * (a + 2.0 * (b + c) + e)).0;
+    }
+    let stop =
+        |y: &States<L>, i: usize, fc: f64| stop_at_reversal_lanes(Lanes(y0[i]), Lanes(y[i]), fc).0;
+    y[OMEGA_M] = stop(y, OMEGA_M, d.fc[0]);
+    if SPUR {
+        y[OMEGA_W] = stop(y, OMEGA_W, d.fc[1]);
+    } else {
+        y[THETA_W] = y[THETA_M];
+        y[OMEGA_W] = y[OMEGA_M];
+    }
+    y[OMEGA_T] = stop(y, OMEGA_T, d.fc[2]);
+}
+
+/// The right-hand side of the equations of motion for every lane. With `FIRST`
 /// (a step's first stage), each body's stick state is decided from the torques at
 /// `y`, and the step-start values are stored in `st` for the later stages.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
     d: &Drive,
     y: &States<L>,
-    motor: &[f64; L],
-    load: &[f64; L],
-    friction: &mut [[Friction; L]; 3],
-    st: &mut StepStart<L>,
+    motor: Lanes<L>,
+    load: Lanes<L>,
+    st: &mut LaneState<L>,
 ) -> States<L> {
-    let first = FIRST;
-    let mut out = [[0.0; L]; NSTATE];
-    for l in 0..L {
-        let (wm, xw, vw, tt, wt) = (
-            y[OMEGA_M][l],
-            y[X_W][l],
-            y[V_W][l],
-            y[THETA_T][l],
-            y[OMEGA_T][l],
-        );
-        let (shaft, ws) = if SPUR {
-            (y[THETA_W][l], y[OMEGA_W][l])
-        } else {
-            (y[THETA_M][l], wm)
-        };
-        let (e, ep) = if !d.fluct {
-            (0.0, 0.0)
-        } else if first {
-            let (s, c) =
-                d.fluctuation_phase(shaft, st.shaft[l], (st.sin[l], st.cos[l]), &mut st.fresh[l]);
-            st.shaft[l] = shaft;
-            st.sin[l] = s;
-            st.cos[l] = c;
-            let (e0, e1) = (d.w * s, d.w * d.n * c);
-            let (e2, e3) = (-d.n * d.n * e0, -d.n * d.n * e1);
-            st.taylor[0][l] = e0;
-            st.taylor[1][l] = e1;
-            st.taylor[2][l] = 0.5 * e2;
-            st.taylor[3][l] = e3 * (1.0 / 6.0);
-            st.taylor[4][l] = e2;
-            st.taylor[5][l] = 0.5 * e3;
-            (e0, e1)
-        } else {
-            let dx = shaft - st.shaft[l];
-            if (d.n * dx).abs() < 0.01 {
-                // Cubic Taylor polynomial of e about the step start (error below
-                // W·(N·Δθ)⁴/24 < 4e-10·W); its slope is the polynomial's exact
-                // derivative, so the mesh energy stays consistent.
-                let t = &st.taylor;
-                (
-                    t[0][l] + dx * (t[1][l] + dx * (t[2][l] + dx * t[3][l])),
-                    t[1][l] + dx * (t[4][l] + dx * t[5][l]),
-                )
-            } else {
-                d.fluctuation_near(shaft, st.shaft[l], (st.sin[l], st.cos[l]))
-            }
-        };
-        let lever = d.rw + ep;
-        let dw = d.rw * shaft + e + xw * d.inv_r - tt;
-        let dw_rate = lever * ws + vw * d.inv_r - wt;
-        let tw = mesh_torque(d.kw, d.ciw, d.bw, dw, dw_rate);
+    let v = |i: usize| Lanes(y[i]);
+    let zero = Lanes::splat(0.0);
+    let (wm, xw, vw, tt, wt) = (v(OMEGA_M), v(X_W), v(V_W), v(THETA_T), v(OMEGA_T));
+    let (shaft, ws) = if SPUR {
+        (v(THETA_W), v(OMEGA_W))
+    } else {
+        (v(THETA_M), wm)
+    };
+    let (e, ep) = if !d.fluct {
+        (zero, zero)
+    } else if FIRST {
+        st.fluctuation_first(d, shaft)
+    } else {
+        st.fluctuation_later(d, shaft)
+    };
+    let lever = d.rw + ep;
+    let dw = d.rw * shaft + e + xw * d.inv_r - tt;
+    let dw_rate = lever * ws + vw * d.inv_r - wt;
+    let tw = mesh_torque_lanes(d.kw, d.ciw, d.bw, dw, dw_rate);
 
-        let unbalance = if d.unbalance {
-            unbalance_torque(d, tt)
-        } else {
-            0.0
-        };
-        let table = tw - d.ct * wt + unbalance + load[l];
-        if first {
-            friction[2][l] = Friction::decide(table, wt, d.fc[2]);
-        }
-        let at = friction[2][l].net(table) * d.inv_jt;
-        let ax = (-d.cb * vw - d.kb * xw - tw * d.inv_r) * d.inv_mw;
-
-        let am = if SPUR {
-            let dg = d.rg * y[THETA_M][l] - shaft;
-            let dg_rate = d.rg * wm - ws;
-            if first {
-                st.twist[0][l] = dg;
-                st.rate[0][l] = dg_rate;
-            }
-            let tg = mesh_torque(d.kg, d.cig, d.bg, dg, dg_rate);
-            let m = motor[l] - d.cm * wm - d.rg * tg;
-            let s = tg - d.cw * ws - lever * tw;
-            if first {
-                friction[0][l] = Friction::decide(m, wm, d.fc[0]);
-                friction[1][l] = Friction::decide(s, ws, d.fc[1]);
-            }
-            out[OMEGA_W][l] = friction[1][l].net(s) * d.inv_jw;
-            out[THETA_W][l] = ws;
-            friction[0][l].net(m) * d.inv_jm
-        } else {
-            let m = motor[l] - d.cm * wm - lever * tw;
-            if first {
-                friction[0][l] = Friction::decide(m, wm, d.fc[0]);
-            }
-            let a = friction[0][l].net(m) * d.inv_jm;
-            out[OMEGA_W][l] = a;
-            out[THETA_W][l] = wm;
-            a
-        };
-        if first {
-            st.twist[1][l] = dw;
-            st.rate[1][l] = dw_rate;
-        }
-        out[THETA_M][l] = wm;
-        out[OMEGA_M][l] = am;
-        out[X_W][l] = vw;
-        out[V_W][l] = ax;
-        out[THETA_T][l] = wt;
-        out[OMEGA_T][l] = at;
+    let unbalance = if d.unbalance {
+        tt.map(|t| unbalance_torque(d, t))
+    } else {
+        zero
+    };
+    let table = tw - d.ct * wt + unbalance + load;
+    if FIRST {
+        st.decide(2, table, wt, d.fc[2], d.inv_jt);
     }
+    let at = st.accel(2, table);
+    let ax = (-d.cb * vw - d.kb * xw - tw * d.inv_r) * d.inv_mw;
+
+    let mut out = [[0.0; L]; NSTATE];
+    let am = if SPUR {
+        let dg = d.rg * v(THETA_M) - shaft;
+        let dg_rate = d.rg * wm - ws;
+        if FIRST {
+            st.twist[0] = dg.0;
+            st.rate[0] = dg_rate.0;
+        }
+        let tg = mesh_torque_lanes(d.kg, d.cig, d.bg, dg, dg_rate);
+        let m = motor - d.cm * wm - d.rg * tg;
+        let s = tg - d.cw * ws - lever * tw;
+        if FIRST {
+            st.decide(0, m, wm, d.fc[0], d.inv_jm);
+            st.decide(1, s, ws, d.fc[1], d.inv_jw);
+        }
+        out[OMEGA_W] = st.accel(1, s).0;
+        out[THETA_W] = ws.0;
+        st.accel(0, m)
+    } else {
+        let m = motor - d.cm * wm - lever * tw;
+        if FIRST {
+            st.decide(0, m, wm, d.fc[0], d.inv_jm);
+        }
+        let a = st.accel(0, m);
+        out[OMEGA_W] = a.0;
+        out[THETA_W] = wm.0;
+        a
+    };
+    if FIRST {
+        st.twist[1] = dw.0;
+        st.rate[1] = dw_rate.0;
+    }
+    out[THETA_M] = wm.0;
+    out[OMEGA_M] = am.0;
+    out[X_W] = vw.0;
+    out[V_W] = ax.0;
+    out[THETA_T] = wt.0;
+    out[OMEGA_T] = at.0;
     out
 }
 

@@ -5,6 +5,7 @@ pub mod backlash;
 pub mod drive;
 pub mod friction;
 pub mod kernel;
+pub mod lanes;
 pub mod modes;
 pub mod params;
 pub mod presets;

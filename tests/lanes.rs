@@ -1,0 +1,194 @@
+//! Lockstep lanes compute exactly what lone simulations compute: a `LaneSimulation<8>`
+//! (a `Kernel<8>`) against eight `Simulation`s (`Kernel<1>`), with contact events,
+//! stick and fluctuation resynchronisations happening in different lanes at
+//! different steps; and a batched sweep against `simulate_point`.
+
+use rtid::experiments::frequency_response::{simulate_point, sweep, FrequencyTest};
+use rtid::input::{Sine, TorqueInput};
+use rtid::model::{idx::*, presets, Params, NSTATE};
+use rtid::recorder::Recorder;
+use rtid::sim::{LaneSimulation, Simulation};
+
+const DT: f64 = 1e-5;
+
+/// One lane's run: frequency, amplitude and offset of the motor torque, table
+/// load, initial state.
+#[derive(Clone, Copy)]
+struct Case {
+    hz: f64,
+    amplitude: f64,
+    offset: f64,
+    load: f64,
+    y0: [f64; NSTATE],
+}
+
+/// Counts of steps with a body stuck, and the trajectory, of a lone simulation.
+struct Lone {
+    states: Vec<[f64; NSTATE]>,
+    stuck_steps: usize,
+    events: u64,
+}
+
+fn lone(p: &Params, c: &Case, steps: usize) -> Lone {
+    struct Keep(Vec<[f64; NSTATE]>);
+    impl Recorder for Keep {
+        fn record(&mut self, _t: f64, y: &[f64; NSTATE], _u: f64) {
+            self.0.push(*y);
+        }
+    }
+    let mut sim = Simulation::new(p, DT).unwrap();
+    sim.set_state(c.y0);
+    sim.set_load(c.load);
+    let mut input = Sine::new(c.hz, c.amplitude, c.offset);
+    let mut keep = Keep(Vec::new());
+    let mut stuck_steps = 0;
+    for _ in 0..steps {
+        sim.run_open_loop(&mut input, DT, &mut keep).unwrap();
+        stuck_steps += usize::from(sim.stuck().iter().any(|&s| s));
+    }
+    // The first record is the initial state.
+    keep.0.remove(0);
+    Lone {
+        states: keep.0,
+        stuck_steps,
+        events: sim.contact_events(),
+    }
+}
+
+fn compare(p: &Params, cases: &[Case; 8], steps: usize) -> Vec<Lone> {
+    let mut lanes = LaneSimulation::<8>::new(p, DT).unwrap();
+    for (l, c) in cases.iter().enumerate() {
+        lanes.start(l, c.y0, c.load);
+    }
+    let mut inputs = cases.map(|c| Sine::new(c.hz, c.amplitude, c.offset));
+    let lone: Vec<Lone> = cases.iter().map(|c| lone(p, c, steps)).collect();
+    let mut worst = 0.0f64;
+    for k in 0..steps {
+        let mut motor = [[0.0; 8]; 3];
+        for (l, input) in inputs.iter_mut().enumerate() {
+            let m = input.step_torques(lanes.time(l), DT);
+            for s in 0..3 {
+                motor[s][l] = m[s];
+            }
+        }
+        lanes.step(&motor).unwrap();
+        for (l, run) in lone.iter().enumerate() {
+            let (a, b) = (lanes.state(l), run.states[k]);
+            for i in 0..NSTATE {
+                let scale = b[i].abs().max(1e-300);
+                worst = worst.max((a[i] - b[i]).abs() / scale);
+            }
+        }
+    }
+    assert!(worst <= 1e-12, "lanes differ from lone runs by {worst:.3e}");
+    let events: u64 = lone.iter().map(|r| r.events).sum();
+    assert_eq!(lanes.contact_events(), events, "same contact events");
+    lone
+}
+
+#[test]
+fn eight_lanes_equal_eight_lone_simulations() {
+    let p = presets::load("worm-gear").unwrap();
+    let base = Case {
+        hz: 230.0,
+        amplitude: 5.0,
+        offset: 0.0,
+        load: 0.0,
+        y0: [0.0; NSTATE],
+    };
+    let mut fast = [0.0; NSTATE];
+    // A shaft turning ~0.012 rad per step: the fluctuation phase is recomputed by
+    // the library at every step of this lane only.
+    fast[OMEGA_M] = 1500.0;
+    fast[OMEGA_W] = 1200.0;
+    fast[OMEGA_T] = 1200.0 / 72.0;
+    let cases = [
+        base,
+        Case { hz: 180.0, ..base },
+        Case {
+            hz: 410.0,
+            amplitude: 2.0,
+            ..base
+        },
+        // Below the motor's friction: it sticks, then breaks away.
+        Case {
+            hz: 60.0,
+            amplitude: 0.3,
+            ..base
+        },
+        Case {
+            hz: 95.0,
+            amplitude: 0.12,
+            offset: 0.05,
+            ..base
+        },
+        // Preloaded: flanks loaded, fewer contact events.
+        Case {
+            hz: 250.0,
+            offset: 2.0 * p.ratio(),
+            load: -2.0,
+            ..base
+        },
+        Case {
+            hz: 300.0,
+            amplitude: 8.0,
+            y0: fast,
+            ..base
+        },
+        // A table under a load within its friction band.
+        Case {
+            hz: 20.0,
+            amplitude: 0.05,
+            load: 0.1,
+            ..base
+        },
+    ];
+    let lone = compare(&p, &cases, 30_000);
+    // The lanes really differ: events and stick at different steps.
+    let events: Vec<u64> = lone.iter().map(|r| r.events).collect();
+    let stuck: Vec<usize> = lone.iter().map(|r| r.stuck_steps).collect();
+    eprintln!("events per lane {events:?}, steps with a body stuck {stuck:?}");
+    assert!(events.iter().filter(|&&e| e > 0).count() >= 4, "{events:?}");
+    assert!(events.windows(2).any(|w| w[0] != w[1]));
+    assert!(stuck.iter().any(|&s| s > 0) && stuck.iter().any(|&s| s < 30_000));
+    assert!(stuck.windows(2).any(|w| w[0] != w[1]), "{stuck:?}");
+}
+
+#[test]
+fn lanes_of_the_direct_topology_with_unbalance_equal_lone_simulations() {
+    let mut p = presets::load("roller-gear-cam").unwrap();
+    p.unbalance_mass = 20.0;
+    p.unbalance_radius = 0.1;
+    let cases: [Case; 8] = std::array::from_fn(|l| Case {
+        hz: 30.0 + 70.0 * l as f64,
+        amplitude: 0.5 + l as f64,
+        offset: 0.0,
+        load: 0.0,
+        y0: [0.0; NSTATE],
+    });
+    compare(&p, &cases, 20_000);
+}
+
+#[test]
+fn a_batched_sweep_equals_lone_points() {
+    // More frequencies than lanes, settling at different times: lanes are refilled.
+    let p = presets::load("worm-gear").unwrap();
+    let test = FrequencyTest {
+        frequencies_hz: (0..19).map(|i| 40.0 + 29.0 * i as f64).collect(),
+        max_duration_s: 0.12,
+        refine_step_hz: 0.0,
+        tolerance_db: 0.05,
+        ..Default::default()
+    };
+    let batched = sweep(&p, &test, &|| {}).unwrap();
+    assert_eq!(batched.len(), test.frequencies_hz.len());
+    let durations: Vec<f64> = batched.iter().map(|q| q.simulated_s).collect();
+    assert!(
+        durations.windows(2).any(|w| w[0] != w[1]),
+        "points settle at different times: {durations:?}"
+    );
+    for q in &batched {
+        let alone = simulate_point(&p, q.frequency_hz, &test).unwrap();
+        assert_eq!(*q, alone, "{} Hz", q.frequency_hz);
+    }
+}
