@@ -140,32 +140,15 @@ impl Window {
 }
 
 /// Amplitude and phase (rad) of the component at `omega` of `x(t)`, fitted with an
-/// offset and a quadratic drift: least squares on [1, τ, τ², sin ωt, cos ωt].
+/// offset and a quadratic drift ([`super::stepped_sine::fit`]).
 fn sine_component(t: &[f64], x: &[f64], omega: f64) -> (f64, f64) {
-    let (t0, t1) = (t[0], t[t.len() - 1]);
-    let span = (t1 - t0).max(f64::MIN_POSITIVE);
-    let mut ata = nalgebra::Matrix5::<f64>::zeros();
-    let mut atb = nalgebra::Vector5::<f64>::zeros();
-    let x0 = x[0];
-    for (&ti, &xi) in t.iter().zip(x) {
-        let tau = 2.0 * (ti - t0) / span - 1.0;
-        let (s, c) = (omega * ti).sin_cos();
-        let row = nalgebra::Vector5::new(1.0, tau, tau * tau, s, c);
-        ata += row * row.transpose();
-        atb += row * (xi - x0);
-    }
-    let coef = ata
-        .lu()
-        .solve(&atb)
-        .unwrap_or_else(nalgebra::Vector5::zeros);
-    let (a_s, a_c) = (coef[3], coef[4]);
-    // a_s·sin + a_c·cos = A·sin(ωt + φ)
-    ((a_s * a_s + a_c * a_c).sqrt(), a_c.atan2(a_s))
+    let f = super::stepped_sine::fit(t, x, omega);
+    (f.amplitude, f.phase)
 }
 
 /// The initial state: the linear steady state of the sine, plus the static twist of
 /// the preload with the loaded flanks in contact.
-fn initial_state(p: &Params, omega: f64, test: &FrequencyTest) -> [f64; NSTATE] {
+pub(crate) fn initial_state(p: &Params, omega: f64, test: &FrequencyTest) -> [f64; NSTATE] {
     let mut y = [0.0; NSTATE];
     if let Ok(lin) = LinearModel::new(p) {
         let mut f = DVector::from_element(lin.n_dof(), Complex::new(0.0, 0.0));
