@@ -7,9 +7,13 @@
 //! also gives the compliance table angle / motor torque. Bins whose coherence is below
 //! `min_coherence` are kept in the result but flagged and left out of the peak search
 //! and the plotted curve; peaks are local maxima of the kept gain, located by
-//! [`frequency_response::peaks`]' parabola, standing at least `min_prominence_db`
-//! above the lowest gain between them and any higher point (so the noise ripple of
-//! an estimate does not count as a resonance).
+//! [`frequency_response::peaks`]' parabola, whose prominence — the height above the
+//! lowest gain between them and the nearest higher point on either side — is at least
+//! `min_prominence_db` plus twice the random errors (one standard deviation each) of
+//! the peak bin and of that lowest bin: the noise ripple of an estimate, largest where
+//! the coherence is low, does not count as a resonance, while a low mode beside a
+//! higher one (the worm's 234 Hz mode stands 2.7 dB above the valley towards its
+//! 187 Hz mode) does.
 
 use serde::Serialize;
 
@@ -19,17 +23,21 @@ use super::stepped_sine::{self, SinePoint, SteppedSineError, SteppedSineOptions}
 use super::welch::{self, WelchError, WelchOptions};
 use crate::io::experiment_file::{sample_period, Data, Excitation, Experiment, Kind};
 
+/// Default Welch segment length, s: 0.5 Hz resolution, several bins across the
+/// half-power width of the worm preset's 187 Hz mode (≈ 4.5 Hz).
+pub const DEFAULT_SEGMENT_S: f64 = 2.0;
+
 /// Settings of the evaluation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimateOptions {
-    /// H1: samples per Welch segment (default: the largest power of two ≤ 1 s of
-    /// samples and ≤ a quarter of the record, so that ≥ 7 segments are averaged).
+    /// H1: samples per Welch segment (default: 2 s of samples, 0.5 Hz resolution, or
+    /// a quarter of the record if that is shorter, so that ≥ 7 segments are averaged).
     pub segment_len: Option<usize>,
     /// H1: coherence below which a bin is flagged and left out (default 0.8).
     pub min_coherence: f64,
     /// Stepped sine: fraction of each dwell discarded (default 0.5).
     pub settle_fraction: f64,
-    /// Peaks: smallest prominence, dB (default 3).
+    /// Peaks: smallest prominence beyond the random errors, dB (default 1).
     pub min_prominence_db: f64,
     /// Peaks: how many, the highest (default 4).
     pub max_peaks: usize,
@@ -41,7 +49,7 @@ impl Default for EstimateOptions {
             segment_len: None,
             min_coherence: 0.8,
             settle_fraction: SteppedSineOptions::default().settle_fraction,
-            min_prominence_db: 3.0,
+            min_prominence_db: 1.0,
             max_peaks: 4,
         }
     }
@@ -61,6 +69,11 @@ pub struct Bin {
     pub compliance_db: f64,
     /// γ² between motor torque and table angle.
     pub compliance_coherence: f64,
+    /// Normalised random error of the gain, as dB (one standard deviation):
+    /// 8.69·√(1 − γ²)/(|γ|·√(2·n_d)), n_d the number of segments (Bendat & Piersol
+    /// eq. 9.90; 50 %-overlapped Hann segments are not quite independent, so this is
+    /// slightly optimistic). 1e9 where γ² = 0.
+    pub gain_sigma_db: f64,
     /// Whether `coherence` reaches `min_coherence` (used for peaks and the plot).
     pub kept: bool,
 }
@@ -172,8 +185,7 @@ pub fn evaluate_experiment(
     }
     let n = time_s.len();
     let segment_len = opts.segment_len.unwrap_or_else(|| {
-        let cap = ((1.0 / period).min((n - 1) as f64 / 4.0)).max(8.0) as usize;
-        1usize << (usize::BITS - 1 - cap.leading_zeros())
+        ((DEFAULT_SEGMENT_S / period).min((n - 1) as f64 / 4.0).max(8.0) as usize) & !1
     });
     let wo = WelchOptions::new(segment_len);
     let x: Vec<f64> = motor_angle_rad.iter().map(|m| m * ratio).collect();
@@ -188,6 +200,7 @@ pub fn evaluate_experiment(
             coherence: gain.coherence[k],
             compliance_db: db(compliance.h[k].norm()),
             compliance_coherence: compliance.coherence[k],
+            gain_sigma_db: random_error_db(gain.coherence[k], gain.segments),
             kept: gain.coherence[k] >= opts.min_coherence && gain.h[k].norm() > 0.0,
         })
         .collect();
@@ -203,6 +216,16 @@ pub fn evaluate_experiment(
         bins,
         peaks,
     })
+}
+
+/// 8.69·√(1 − γ²)/(|γ|·√(2·segments)), dB; a large finite number where γ² = 0 (JSON
+/// has no infinity).
+fn random_error_db(coherence: f64, segments: usize) -> f64 {
+    if coherence <= 0.0 {
+        return 1e9;
+    }
+    let e = ((1.0 - coherence).max(0.0) / coherence).sqrt() / (2.0 * segments as f64).sqrt();
+    20.0 / std::f64::consts::LN_10 * e
 }
 
 /// The runs of consecutive kept bins, as (frequency, gain) curves.
@@ -225,39 +248,56 @@ pub fn kept_runs(bins: &[Bin]) -> Vec<Vec<(f64, f64)>> {
 
 /// The prominent peaks of the kept runs (module docs), highest `max_peaks`, ascending.
 fn kept_peaks(bins: &[Bin], opts: &EstimateOptions) -> Vec<Peak> {
-    let mut found: Vec<Peak> = kept_runs(bins)
-        .iter()
-        .flat_map(|run| prominent_peaks(run, opts.min_prominence_db))
-        .collect();
+    let mut found: Vec<Peak> = Vec::new();
+    let mut start = 0;
+    while start < bins.len() {
+        if !bins[start].kept {
+            start += 1;
+            continue;
+        }
+        let end = start + bins[start..].iter().take_while(|b| b.kept).count();
+        let run = &bins[start..end];
+        let curve: Vec<(f64, f64)> = run.iter().map(|b| (b.frequency_hz, b.gain_db)).collect();
+        let sigma: Vec<f64> = run.iter().map(|b| b.gain_sigma_db).collect();
+        found.extend(prominent_peaks(&curve, &sigma, opts.min_prominence_db));
+        start = end;
+    }
     found.sort_by(|a, b| b.gain_db.total_cmp(&a.gain_db));
     found.truncate(opts.max_peaks);
     found.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     found
 }
 
-/// Interior local maxima of `curve` at least `min_prominence` above the lowest point
-/// between them and the nearest higher point on each side (or the curve's end), each
-/// located by the parabola of [`frequency_response::peaks`].
-pub fn prominent_peaks(curve: &[(f64, f64)], min_prominence: f64) -> Vec<Peak> {
+/// Interior local maxima of `curve` whose prominence (the height above the lowest
+/// point between them and the nearest higher point on each side, or the curve's end)
+/// is at least `min_prominence` + 2·(`sigma` at the peak + `sigma` at that lowest
+/// point), each located by the parabola of [`frequency_response::peaks`]. `sigma`:
+/// one standard deviation of each point (all zeros for an exact curve).
+pub fn prominent_peaks(curve: &[(f64, f64)], sigma: &[f64], min_prominence: f64) -> Vec<Peak> {
     let y: Vec<f64> = curve.iter().map(|c| c.1).collect();
     let mut out = Vec::new();
     for i in 1..y.len().saturating_sub(1) {
         if !(y[i] > y[i - 1] && y[i] >= y[i + 1]) {
             continue;
         }
+        // The lowest point on one side before a higher one: (gain, index).
         let base = |range: &mut dyn Iterator<Item = usize>| {
-            let mut low = y[i];
+            let mut low = (y[i], i);
             for j in range {
                 if y[j] > y[i] {
                     break;
                 }
-                low = low.min(y[j]);
+                if y[j] < low.0 {
+                    low = (y[j], j);
+                }
             }
             low
         };
         let left = base(&mut (0..i).rev());
         let right = base(&mut (i + 1..y.len()));
-        if y[i] - left.max(right) >= min_prominence {
+        let (low, at) = if left.0 > right.0 { left } else { right };
+        let s = |k: usize| sigma.get(k).copied().unwrap_or(0.0);
+        if y[i] - low >= min_prominence + 2.0 * (s(i) + s(at)) {
             out.extend(frequency_response::peaks(&curve[i - 1..=i + 1], 1));
         }
     }
@@ -278,10 +318,14 @@ mod tests {
                 (f, 20.0 / (1.0 + ((f - 50.0) / 3.0).powi(2)) + ripple)
             })
             .collect();
-        let p = prominent_peaks(&curve, 3.0);
+        let exact = vec![0.0; curve.len()];
+        let p = prominent_peaks(&curve, &exact, 3.0);
         assert_eq!(p.len(), 1, "{p:?}");
         assert!((p[0].frequency_hz - 50.0).abs() < 1.0, "{p:?}");
-        assert!(prominent_peaks(&curve, 0.5).len() > 10);
+        assert!(prominent_peaks(&curve, &exact, 0.5).len() > 10);
+        // The ripple as the random error it is: 1 dB of prominence suffices.
+        let sigma = vec![0.5; curve.len()];
+        assert_eq!(prominent_peaks(&curve, &sigma, 1.0).len(), 1);
     }
 
     #[test]
@@ -293,6 +337,7 @@ mod tests {
             coherence: 1.0,
             compliance_db: 0.0,
             compliance_coherence: 1.0,
+            gain_sigma_db: 0.0,
             kept,
         };
         let bins = [bin(1.0, true), bin(2.0, true), bin(3.0, false), bin(4.0, true)];

@@ -32,9 +32,10 @@ pub enum Excitation {
         frequencies_hz: Vec<f64>,
         dwell_s: f64,
     },
-    /// Gaussian white noise of standard deviation `amplitude`, a new value every
-    /// sample, held in between (a D/A's zero-order hold), seeded.
-    Noise { seed: u64 },
+    /// Gaussian noise of standard deviation `amplitude`, band-limited to
+    /// `from_hz..=to_hz` (white noise with the bins outside the band removed, rescaled),
+    /// a new value every sample, held in between (a D/A's zero-order hold), seeded.
+    Noise { seed: u64, from_hz: f64, to_hz: f64 },
     /// `amplitude·sin(φ(t))`, frequency rising linearly from `from_hz` to `to_hz` over
     /// the record.
     Chirp { from_hz: f64, to_hz: f64 },
@@ -62,7 +63,11 @@ pub struct RecordTest {
 impl Default for RecordTest {
     fn default() -> Self {
         RecordTest {
-            excitation: Excitation::Noise { seed: 1 },
+            excitation: Excitation::Noise {
+                seed: 1,
+                from_hz: 0.0,
+                to_hz: 1000.0,
+            },
             amplitude_nm: 5.0,
             preload_nm: 0.0,
             duration_s: 8.0,
@@ -180,6 +185,31 @@ impl Recorder for Sampler<'_> {
     }
 }
 
+/// `n` samples of unit-RMS Gaussian noise whose spectrum (sampling period `period`)
+/// is confined to `from_hz..=to_hz`: white noise, its FFT bins outside the band set to
+/// zero, transformed back and rescaled.
+fn band_limited_noise(n: usize, period: f64, from_hz: f64, to_hz: f64, seed: u64) -> Vec<f64> {
+    use rustfft::{num_complex::Complex, FftPlanner};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let white = Normal::new(0.0, 1.0).expect("unit normal");
+    let mut x: Vec<Complex<f64>> = (0..n)
+        .map(|_| Complex::new(white.sample(&mut rng), 0.0))
+        .collect();
+    let mut planner = FftPlanner::new();
+    planner.plan_fft_forward(n).process(&mut x);
+    let df = 1.0 / (n as f64 * period);
+    for (k, v) in x.iter_mut().enumerate() {
+        let f = k.min(n - k) as f64 * df;
+        if f < from_hz || f > to_hz || k == 0 {
+            *v = Complex::new(0.0, 0.0);
+        }
+    }
+    planner.plan_fft_inverse(n).process(&mut x);
+    let rms = (x.iter().map(|v| v.re * v.re).sum::<f64>() / n as f64).sqrt();
+    let scale = if rms > 0.0 { 1.0 / rms } else { 0.0 };
+    x.iter().map(|v| v.re * scale).collect()
+}
+
 /// Why a recorded test cannot run.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -221,8 +251,7 @@ pub fn run(
             let bad = frequencies_hz.iter().find(|f| !(**f > 0.0 && f.is_finite()));
             check("frequencies_hz", bad.copied().unwrap_or(0.0), bad.is_none() && !frequencies_hz.is_empty(), "need one or more positive frequencies")?;
         }
-        Excitation::Noise { .. } => {}
-        Excitation::Chirp { from_hz, to_hz } => {
+        Excitation::Noise { from_hz, to_hz, .. } | Excitation::Chirp { from_hz, to_hz } => {
             check("from_hz", *from_hz, *from_hz >= 0.0, "must be zero or positive")?;
             check("to_hz", *to_hz, to_hz > from_hz, "must be above from_hz")?;
         }
@@ -235,11 +264,11 @@ pub fn run(
     let period = every as f64 * dt;
     let samples = (duration / period).round() as usize;
     let held = match test.excitation {
-        Excitation::Noise { seed } => {
-            let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-            let white = Normal::new(0.0, 1.0).expect("unit normal");
-            (0..samples.max(1)).map(|_| white.sample(&mut rng)).collect()
-        }
+        Excitation::Noise {
+            seed,
+            from_hz,
+            to_hz,
+        } => band_limited_noise(samples.max(2), period, from_hz, to_hz, seed),
         _ => Vec::new(),
     };
     let drive = Drive {
@@ -317,9 +346,13 @@ pub fn manifest(p: &Params, test: &RecordTest) -> Manifest {
             c.dwell_s = Some(*dwell_s);
             format!("stepped sine, {} frequencies, {dwell_s} s each", frequencies_hz.len())
         }
-        Excitation::Noise { seed } => {
+        Excitation::Noise {
+            seed,
+            from_hz,
+            to_hz,
+        } => {
             c.excitation = Some(experiment_file::Excitation::Broadband);
-            format!("Gaussian white noise torque (held per sample, seed {seed})")
+            format!("Gaussian noise torque, {from_hz}–{to_hz} Hz, held per sample, seed {seed}")
         }
         Excitation::Chirp { from_hz, to_hz } => {
             c.excitation = Some(experiment_file::Excitation::Broadband);
