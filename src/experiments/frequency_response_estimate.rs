@@ -30,9 +30,10 @@ pub const DEFAULT_SEGMENT_S: f64 = 2.0;
 /// Settings of the evaluation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimateOptions {
-    /// H1: samples per Welch segment (default: 2 s of samples, 0.5 Hz resolution, or
-    /// a quarter of the record if that is shorter, so that ≥ 7 segments are averaged).
-    pub segment_len: Option<usize>,
+    /// H1: length of a Welch segment, s, rounded to an even number of samples; the
+    /// resolution is its inverse (default [`DEFAULT_SEGMENT_S`], or a quarter of the
+    /// record if that is shorter, so that ≥ 7 segments are averaged).
+    pub segment_s: Option<f64>,
     /// H1: coherence below which a bin is flagged and left out (default 0.8).
     pub min_coherence: f64,
     /// Stepped sine: fraction of each dwell discarded (default 0.5).
@@ -46,7 +47,7 @@ pub struct EstimateOptions {
 impl Default for EstimateOptions {
     fn default() -> Self {
         EstimateOptions {
-            segment_len: None,
+            segment_s: None,
             min_coherence: 0.8,
             settle_fraction: SteppedSineOptions::default().settle_fraction,
             min_prominence_db: 1.0,
@@ -127,6 +128,8 @@ pub enum EstimateError {
     SteppedSine(#[from] SteppedSineError),
     #[error("the record has {0} samples: too short to estimate anything")]
     TooShort(usize),
+    #[error("the segment length {0} s must be positive")]
+    BadSegment(f64),
     #[error("the coherence threshold {0} must be in [0, 1]")]
     BadCoherence(f64),
 }
@@ -184,9 +187,11 @@ pub fn evaluate_experiment(
         return Err(EstimateError::BadCoherence(opts.min_coherence));
     }
     let n = time_s.len();
-    let segment_len = opts.segment_len.unwrap_or_else(|| {
-        ((DEFAULT_SEGMENT_S / period).min((n - 1) as f64 / 4.0).max(8.0) as usize) & !1
-    });
+    let segment_len = match opts.segment_s {
+        Some(s) if !(s > 0.0 && s.is_finite()) => return Err(EstimateError::BadSegment(s)),
+        Some(s) => ((s / period).round() as usize) & !1,
+        None => ((DEFAULT_SEGMENT_S / period).min((n - 1) as f64 / 4.0).max(8.0) as usize) & !1,
+    };
     let wo = WelchOptions::new(segment_len);
     let x: Vec<f64> = motor_angle_rad.iter().map(|m| m * ratio).collect();
     let gain = welch::h1(&x, table_angle_rad, period, &wo)?;
