@@ -535,7 +535,7 @@ fn malformed_frequency_response_records_name_file_line_and_column() {
     }
     let dir = tempfile::tempdir().unwrap();
     let err = write(&dir.path().join("w.json"), &e.manifest, &bad).unwrap_err();
-    assert!(err.to_string().contains("column `time_s`, row 3: the step"), "{err}");
+    assert!(err.to_string().contains("column `time_s`, row 2: the step from the previous row is 1.000000e-3 s where the record steps 2.500000e-3 s"), "{err}");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
 
