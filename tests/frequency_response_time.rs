@@ -5,7 +5,9 @@ use rtid::experiments::frequency_response::{linear, peaks};
 use rtid::experiments::frequency_response_estimate::{
     evaluate_experiment, EstimateOptions, Evaluation,
 };
-use rtid::experiments::frequency_response_record::{manifest, run, to_data, Excitation, RecordTest};
+use rtid::experiments::frequency_response_record::{
+    manifest, run, to_data, Excitation, RecordTest,
+};
 use rtid::io::experiment_file::{self, Experiment};
 use rtid::model::{presets, Params};
 
@@ -97,7 +99,10 @@ fn h1_from_noise_matches_the_linear_response_where_coherent() {
     assert!(worst.0 < 0.25, "{worst:?}");
     assert_eq!(found.len(), 2, "{found:?}");
     for (f, e) in found.iter().zip(&exact_peaks) {
-        assert!((f.frequency_hz - e.0).abs() <= 2.0 * resolution_hz, "{f:?} vs {e:?}");
+        assert!(
+            (f.frequency_hz - e.0).abs() <= 2.0 * resolution_hz,
+            "{f:?} vs {e:?}"
+        );
         assert!((f.gain_db - e.1).abs() < 1.0, "{f:?} vs {e:?}");
     }
 }

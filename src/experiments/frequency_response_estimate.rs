@@ -190,7 +190,12 @@ pub fn evaluate_experiment(
     let segment_len = match opts.segment_s {
         Some(s) if !(s > 0.0 && s.is_finite()) => return Err(EstimateError::BadSegment(s)),
         Some(s) => ((s / period).round() as usize) & !1,
-        None => ((DEFAULT_SEGMENT_S / period).min((n - 1) as f64 / 4.0).max(8.0) as usize) & !1,
+        None => {
+            ((DEFAULT_SEGMENT_S / period)
+                .min((n - 1) as f64 / 4.0)
+                .max(8.0) as usize)
+                & !1
+        }
     };
     let wo = WelchOptions::new(segment_len);
     let x: Vec<f64> = motor_angle_rad.iter().map(|m| m * ratio).collect();
@@ -345,7 +350,12 @@ mod tests {
             gain_sigma_db: 0.0,
             kept,
         };
-        let bins = [bin(1.0, true), bin(2.0, true), bin(3.0, false), bin(4.0, true)];
+        let bins = [
+            bin(1.0, true),
+            bin(2.0, true),
+            bin(3.0, false),
+            bin(4.0, true),
+        ];
         let runs = kept_runs(&bins);
         assert_eq!(runs.len(), 2);
         assert_eq!((runs[0].len(), runs[1].len()), (2, 1));

@@ -238,21 +238,48 @@ pub fn run(
     test: &RecordTest,
     mut progress: impl FnMut(f64, f64),
 ) -> Result<Record, RecordError> {
-    check("amplitude_nm", test.amplitude_nm, test.amplitude_nm > 0.0, "must be positive")?;
+    check(
+        "amplitude_nm",
+        test.amplitude_nm,
+        test.amplitude_nm > 0.0,
+        "must be positive",
+    )?;
     check("preload_nm", test.preload_nm, true, "must be finite")?;
-    check("sample_rate_hz", test.sample_rate_hz, test.sample_rate_hz > 0.0, "must be positive")?;
-    check("table_noise_rad", test.table_noise_rad, test.table_noise_rad >= 0.0, "must be zero or positive")?;
+    check(
+        "sample_rate_hz",
+        test.sample_rate_hz,
+        test.sample_rate_hz > 0.0,
+        "must be positive",
+    )?;
+    check(
+        "table_noise_rad",
+        test.table_noise_rad,
+        test.table_noise_rad >= 0.0,
+        "must be zero or positive",
+    )?;
     match &test.excitation {
         Excitation::SteppedSine {
             frequencies_hz,
             dwell_s,
         } => {
             check("dwell_s", *dwell_s, *dwell_s > 0.0, "must be positive")?;
-            let bad = frequencies_hz.iter().find(|f| !(**f > 0.0 && f.is_finite()));
-            check("frequencies_hz", bad.copied().unwrap_or(0.0), bad.is_none() && !frequencies_hz.is_empty(), "need one or more positive frequencies")?;
+            let bad = frequencies_hz
+                .iter()
+                .find(|f| !(**f > 0.0 && f.is_finite()));
+            check(
+                "frequencies_hz",
+                bad.copied().unwrap_or(0.0),
+                bad.is_none() && !frequencies_hz.is_empty(),
+                "need one or more positive frequencies",
+            )?;
         }
         Excitation::Noise { from_hz, to_hz, .. } | Excitation::Chirp { from_hz, to_hz } => {
-            check("from_hz", *from_hz, *from_hz >= 0.0, "must be zero or positive")?;
+            check(
+                "from_hz",
+                *from_hz,
+                *from_hz >= 0.0,
+                "must be zero or positive",
+            )?;
             check("to_hz", *to_hz, to_hz > from_hz, "must be above from_hz")?;
         }
     }
@@ -291,7 +318,11 @@ pub fn run(
         every,
         count: 0,
         drive: &drive,
-        motor_quantum: if counts > 0.0 { std::f64::consts::TAU / counts } else { 0.0 },
+        motor_quantum: if counts > 0.0 {
+            std::f64::consts::TAU / counts
+        } else {
+            0.0
+        },
         table_quantum: p.controller.table_encoder_resolution,
         noise: Normal::new(0.0, test.table_noise_rad).expect("σ ≥ 0"),
         rng: rand::rngs::StdRng::seed_from_u64(test.seed),
@@ -344,7 +375,10 @@ pub fn manifest(p: &Params, test: &RecordTest) -> Manifest {
             c.excitation = Some(experiment_file::Excitation::SteppedSine);
             c.frequencies_hz = Some(frequencies_hz.clone());
             c.dwell_s = Some(*dwell_s);
-            format!("stepped sine, {} frequencies, {dwell_s} s each", frequencies_hz.len())
+            format!(
+                "stepped sine, {} frequencies, {dwell_s} s each",
+                frequencies_hz.len()
+            )
         }
         Excitation::Noise {
             seed,

@@ -182,7 +182,7 @@ pub fn demodulate(
             fit(t, &table[a..b], omega),
             fit(t, &torque[a..b], omega),
         );
-        if !(m.amplitude > 0.0) {
+        if m.amplitude <= 0.0 || !m.amplitude.is_finite() {
             return Err(SteppedSineError::NoMotion { frequency_hz: f });
         }
         let mut phase = (y.phase - m.phase).to_degrees();

@@ -125,7 +125,11 @@ pub fn h1(x: &[f64], y: &[f64], period: f64, opts: &WelchOptions) -> Result<Esti
         let range = s * hop..s * hop + l;
         for (buf, v) in [(&mut bx, &x[range.clone()]), (&mut by, &y[range])] {
             buf.clear();
-            buf.extend(detrended(v).zip(&window).map(|(a, w)| Complex::new(a * w, 0.0)));
+            buf.extend(
+                detrended(v)
+                    .zip(&window)
+                    .map(|(a, w)| Complex::new(a * w, 0.0)),
+            );
             fft.process(buf);
         }
         for k in 0..=bins {

@@ -632,31 +632,38 @@ fn manifest_error(path: &Path, message: &str) -> ExperimentFileError {
 }
 
 /// The conditions a frequency-response record needs: for a stepped sine the frequencies
-/// (positive) and the dwell (positive); a positive ratio where one is given.
+/// (positive) and the dwell (positive); a positive ratio where one is given. (JSON
+/// numbers are finite, so `<= 0` is the whole check.)
 fn check_record_conditions(c: &Conditions) -> Result<(), String> {
     let c = c.with_defaults(Kind::FrequencyResponseTime);
-    if let Some(r) = c.ratio.filter(|r| !(*r > 0.0)) {
-        return Err(format!("`conditions.ratio` is {r}: it must be positive (Rg·Rw)"));
+    if let Some(r) = c.ratio.filter(|r| *r <= 0.0) {
+        return Err(format!(
+            "`conditions.ratio` is {r}: it must be positive (Rg·Rw)"
+        ));
     }
     if c.excitation != Some(Excitation::SteppedSine) {
         return Ok(());
     }
     let frequencies = c.frequencies_hz.as_deref().unwrap_or_default();
     if frequencies.is_empty() {
-        return Err("a stepped-sine record needs `conditions.frequencies_hz`: the drive \
+        return Err(
+            "a stepped-sine record needs `conditions.frequencies_hz`: the drive \
                     frequencies in the order played, Hz"
-            .into());
+                .into(),
+        );
     }
-    if let Some(f) = frequencies.iter().find(|f| !(**f > 0.0)) {
+    if let Some(f) = frequencies.iter().find(|f| **f <= 0.0) {
         return Err(format!(
             "`conditions.frequencies_hz` holds {f}: drive frequencies must be positive"
         ));
     }
     match c.dwell_s {
-        None => Err("a stepped-sine record needs `conditions.dwell_s`: the time spent at \
+        None => Err(
+            "a stepped-sine record needs `conditions.dwell_s`: the time spent at \
                      each frequency, s"
-            .into()),
-        Some(d) if !(d > 0.0) => Err(format!(
+                .into(),
+        ),
+        Some(d) if d <= 0.0 => Err(format!(
             "`conditions.dwell_s` is {d}: the dwell at each frequency must be positive"
         )),
         Some(_) => Ok(()),

@@ -132,7 +132,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         bail!("--from-hz {from} --to-hz {to}: need 0 ≤ from < to");
     }
     if !(a.noise_arcsec >= 0.0 && a.noise_arcsec.is_finite()) {
-        bail!("--noise-arcsec {}: must be zero or positive", a.noise_arcsec);
+        bail!(
+            "--noise-arcsec {}: must be zero or positive",
+            a.noise_arcsec
+        );
     }
     if !a.preload_nm.is_finite() {
         bail!("--preload-nm {}: must be a finite torque", a.preload_nm);
@@ -247,7 +250,11 @@ fn plot_evaluation(e: &Evaluation, mechanism: &str, plot: &Path) -> anyhow::Resu
                 Series::new("gain (stepped sine)", curve, Style::Line),
                 markers,
             ];
-            write_chart(plot, chart("frequency response (stepped sine)", "gain, dB"), &series)
+            write_chart(
+                plot,
+                chart("frequency response (stepped sine)", "gain, dB"),
+                &series,
+            )
         }
         Evaluation::H1 {
             bins,
@@ -275,7 +282,11 @@ fn plot_evaluation(e: &Evaluation, mechanism: &str, plot: &Path) -> anyhow::Resu
                 })
                 .collect();
             series.push(markers);
-            write_chart(plot, chart("frequency response (H1, Welch)", "gain, dB"), &series)?;
+            write_chart(
+                plot,
+                chart("frequency response (H1, Welch)", "gain, dB"),
+                &series,
+            )?;
             let coherence: Vec<(f64, f64)> = bins
                 .iter()
                 .filter(|b| shown(b.frequency_hz))
@@ -291,7 +302,11 @@ fn plot_evaluation(e: &Evaluation, mechanism: &str, plot: &Path) -> anyhow::Resu
                 ),
             ];
             let path = coherence_path(plot);
-            write_chart(&path, chart("coherence, motor angle → table angle", "γ²"), &series)
+            write_chart(
+                &path,
+                chart("coherence, motor angle → table angle", "γ²"),
+                &series,
+            )
         }
     }
 }
@@ -300,7 +315,11 @@ fn plot_evaluation(e: &Evaluation, mechanism: &str, plot: &Path) -> anyhow::Resu
 fn summary(e: &Evaluation, source: &Path) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
-    let _ = writeln!(s, "{}: frequency response from time series", source.display());
+    let _ = writeln!(
+        s,
+        "{}: frequency response from time series",
+        source.display()
+    );
     match e {
         Evaluation::SteppedSine {
             ratio,
@@ -388,7 +407,10 @@ fn summary(e: &Evaluation, source: &Path) -> String {
             }
         }
     }
-    let _ = writeln!(s, "resonances (local maxima of the gain, parabolic interpolation):");
+    let _ = writeln!(
+        s,
+        "resonances (local maxima of the gain, parabolic interpolation):"
+    );
     for p in e.peaks() {
         let _ = writeln!(s, "  {:8.2} Hz  {:7.2} dB", p.frequency_hz, p.gain_db);
     }

@@ -523,7 +523,10 @@ fn malformed_frequency_response_records_name_file_line_and_column() {
     let manifest = format!(r#"{{"kind": "{k}", "data": "run.csv"}}"#);
     let (_dir, path) = files(&[("m.json", &manifest), ("run.csv", &csv)]);
     let e = read(&path).unwrap();
-    let c = e.manifest.conditions.with_defaults(Kind::FrequencyResponseTime);
+    let c = e
+        .manifest
+        .conditions
+        .with_defaults(Kind::FrequencyResponseTime);
     assert_eq!(c.excitation, Some(Excitation::Broadband));
     let Data::FrequencyResponseTime { mut time_s, .. } = e.data.clone() else {
         panic!("{:?}", e.data)
