@@ -16,7 +16,9 @@
 //! (backlash, friction) or leakage take a share of the output: γ² = 1/(1 + N/S) for
 //! output noise N. Bin k is at k/(L·T) Hz: the segment length sets the resolution
 //! 1/(L·T), and a peak narrower than a few bins is smeared by the window (its height
-//! underestimated, its frequency kept to a fraction of a bin).
+//! underestimated, its frequency kept to a fraction of a bin). The lowest two or three
+//! bins are unreliable: the straight line removed from each segment takes most of
+//! their content, and what is left is leakage from the bins above.
 //!
 //! **Prewhitening.** By default both records are first differenced (x[i] − x[i−1]).
 //! The same linear filter on input and output cancels in H1 and γ² exactly, but an
@@ -190,6 +192,9 @@ mod tests {
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
 
+    /// Bins not compared.
+    const LOW_BINS: usize = 3;
+
     /// White noise through y[i] = 0.5·x[i] + 0.3·x[i−1] (+ output noise): H1 must be
     /// H(f) = 0.5 + 0.3·e^{−iωT} and γ² = S/(S + N).
     fn fir(noise: f64) -> (Estimate, Vec<Complex<f64>>, f64) {
@@ -222,21 +227,27 @@ mod tests {
         assert_eq!(est.frequency_hz.len(), 128);
         assert!((est.resolution_hz - 1000.0 / 256.0).abs() < 1e-12);
         assert_eq!(est.segments, (64 * 1024 - 1 - 256) / 128 + 1);
-        for ((h, e), g) in est.h.iter().zip(&exact).zip(&est.coherence) {
-            assert!((h - e).norm() < 1e-9 * e.norm(), "{h} vs {e}");
-            assert!(*g > 1.0 - 1e-9, "{g}");
+        // The first bins hold what the per-segment detrend (a straight line) took away
+        // and the window's leakage from the bins above: skip them (module docs).
+        let mut worst = (0.0f64, 0.0f64);
+        for ((h, e), g) in est.h.iter().zip(&exact).zip(&est.coherence).skip(LOW_BINS) {
+            worst = (worst.0.max((h - e).norm() / e.norm()), worst.1.max(1.0 - g));
         }
+        // The filter remembers one sample from before each segment: errors ~ 1/L.
+        assert!(worst.0 < 1.0 / 256.0 && worst.1 < 1e-3, "{worst:?}");
     }
 
     #[test]
     fn output_noise_lowers_the_coherence_as_s_over_s_plus_n() {
         let (est, exact, noise) = fir(0.4);
         let mut worst: f64 = 0.0;
-        for ((h, e), g) in est.h.iter().zip(&exact).zip(&est.coherence) {
+        for ((h, e), g) in est.h.iter().zip(&exact).zip(&est.coherence).skip(LOW_BINS) {
             // Signal and noise spectra are both white (before the common difference).
             let expected = e.norm_sqr() / (e.norm_sqr() + noise * noise);
             worst = worst.max((g - expected).abs());
-            assert!((h - e).norm() < 0.1 * e.norm(), "{h} vs {e}");
+            // Within 4 normalised random errors √(1 − γ²)/(|γ|·√(2·n_d)).
+            let sigma = ((1.0 - expected) / expected).sqrt() / (2.0 * est.segments as f64).sqrt();
+            assert!((h - e).norm() < 4.0 * sigma * e.norm(), "{h} vs {e}");
         }
         assert!(worst < 0.08, "coherence off by {worst}");
     }
