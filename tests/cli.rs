@@ -720,4 +720,92 @@ mod experiments {
         let out = rtid(&["evaluate", "fr.json"], dir.path());
         assert_one_line_error(&out, &["fr.csv", "line 3", "gain_db"]);
     }
+
+    /// The raw-data test on the roller gear cam (no backlash): the record, the gain and
+    /// coherence plots, the resonance near the motor-held 167 Hz mode, and the same
+    /// estimate from `rtid evaluate` with a coarser segment; a dropped sample is an
+    /// error naming the line.
+    #[test]
+    fn a_recorded_frequency_response_evaluates_to_its_resonance() {
+        let dir = tempdir();
+        let args = [
+            "experiment",
+            "frequency-response-time",
+            "--preset",
+            "roller-gear-cam",
+            "--duration-s",
+            "8",
+            "--quiet",
+            "--out",
+            "raw",
+            "--json",
+        ];
+        let v = rtid_json(&args, dir.path());
+        assert_eq!(v["estimator"], "h1");
+        assert_eq!(v["segments"], 7);
+        let peaks = v["peaks"].as_array().unwrap();
+        let top = peaks
+            .iter()
+            .max_by(|a, b| {
+                a["gain_db"]
+                    .as_f64()
+                    .unwrap()
+                    .total_cmp(&b["gain_db"].as_f64().unwrap())
+            })
+            .unwrap();
+        let f = top["frequency_hz"].as_f64().unwrap();
+        assert!((f - 166.9).abs() < 1.0, "{peaks:?}");
+        for file in ["json", "csv", "svg"] {
+            assert!(dir
+                .path()
+                .join(format!("raw/frequency_response_time.{file}"))
+                .exists());
+        }
+        assert!(dir
+            .path()
+            .join("raw/frequency_response_time-coherence.svg")
+            .exists());
+        let coarse = rtid_json(
+            &[
+                "evaluate",
+                "raw/frequency_response_time.json",
+                "--json",
+                "--segment-s",
+                "0.5",
+            ],
+            dir.path(),
+        );
+        assert_eq!(coarse["resolution_hz"], 2.0);
+        let text = rtid_ok(
+            &["evaluate", "raw/frequency_response_time.json"],
+            dir.path(),
+        );
+        assert!(
+            text.contains("resonances") && text.contains("H1 with Welch averaging"),
+            "{text}"
+        );
+        // Drop the 100th sample of the CSV (line 102: a comment line, the header).
+        let csv = dir.path().join("raw/frequency_response_time.csv");
+        let lines: Vec<String> = std::fs::read_to_string(&csv)
+            .unwrap()
+            .lines()
+            .enumerate()
+            .filter(|(i, _)| *i != 101)
+            .map(|(_, l)| l.to_string())
+            .collect();
+        std::fs::write(&csv, lines.join("\n")).unwrap();
+        let out = rtid(
+            &["evaluate", "raw/frequency_response_time.json"],
+            dir.path(),
+        );
+        assert_one_line_error(
+            &out,
+            &[
+                "frequency_response_time.csv",
+                "line 102",
+                "time_s",
+                "uniformly",
+            ],
+        );
+    }
 }

@@ -4,7 +4,9 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 
-use super::experiment::{fluctuation, frequency_response, positioning, torque_curve};
+use super::experiment::{
+    fluctuation, frequency_response, frequency_response_time, positioning, torque_curve,
+};
 use crate::io::experiment_file::{self, Kind};
 
 pub const LONG_ABOUT: &str = "\
@@ -25,6 +27,15 @@ manifest's conditions.ratio, else Rg·Rw of the preset named in `mechanism`): me
 peak-to-peak, the gap between the directions (lost motion), the power spectrum over \
 cycles per revolution and its dominant orders with amplitudes, the largest step. Plots: \
 FILE.svg (Fig. 11) and FILE-spectrum.svg (Fig. 12).
+  frequency_response_time   raw motor torque, motor angle and table angle over time, \
+uniformly sampled. A stepped sine (conditions.excitation = stepped_sine, frequencies_hz, \
+dwell_s) is demodulated per dwell: the first --settle-fraction discarded, then a \
+least-squares fit of offset, drift and sine over whole cycles; gain, phase, and the fit's \
+residual (a flag for noise or backlash rattle). A broadband record (noise, chirp, \
+multisine) gives the H1 estimate with Welch averaging (Hann, 50 % overlap, --segment-s: \
+resolution 1/segment) and the coherence γ²; bins below --min-coherence are left out. \
+Gain = table angle / (motor angle × ratio); resonances as above (for H1 only peaks that \
+stand out of the random error). Plots: FILE.svg (gain) and FILE-coherence.svg.
   unbalance     as fluctuation; the step (largest change of the deviation across 0.5° of \
 table angle, and where) is the backlash crossed when the unbalance moment overcomes the \
 friction. Plots: FILE.svg (Fig. 14) and FILE-spectrum.svg.
@@ -46,6 +57,8 @@ pub struct Args {
     /// Where to write the plot (default: beside the manifest, FILE.svg).
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    #[command(flatten)]
+    pub estimate: frequency_response_time::EstimateArgs,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -59,6 +72,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Kind::FrequencyResponse => frequency_response::report(&exp, &plot, a.json),
         Kind::TorqueCurve => torque_curve::report(&exp, &plot, a.json),
         Kind::Fluctuation | Kind::Unbalance => fluctuation::report(&exp, &plot, a.json),
+        Kind::FrequencyResponseTime => {
+            frequency_response_time::report_with(&exp, &plot, a.json, &a.estimate.options())
+        }
         other => bail!(
             "{}: evaluating `{}` experiments is not part of this version yet",
             a.file.display(),

@@ -186,7 +186,7 @@ fn sine_components<const K: usize>(t: &[f64], x: [&[f64]; K], omega: f64) -> [(f
 
 /// The initial state: the linear steady state of the sine, plus the static twist of
 /// the preload with the loaded flanks in contact.
-fn initial_state(p: &Params, omega: f64, test: &FrequencyTest) -> [f64; NSTATE] {
+pub(crate) fn initial_state(p: &Params, omega: f64, test: &FrequencyTest) -> [f64; NSTATE] {
     let mut y = [0.0; NSTATE];
     if let Ok(lin) = LinearModel::new(p) {
         let mut f = DVector::from_element(lin.n_dof(), Complex::new(0.0, 0.0));

@@ -51,17 +51,21 @@ pub enum Kind {
     Fluctuation,
     /// As [`Kind::Fluctuation`], with an offset mass on a vertical table.
     Unbalance,
+    /// Raw time series of a frequency-response test (motor torque, motor and table
+    /// angle, uniformly sampled), from which the gain curve is estimated.
+    FrequencyResponseTime,
 }
 
 impl Kind {
     /// Every kind, in the order of MODEL.md §7.
-    pub const ALL: [Kind; 6] = [
+    pub const ALL: [Kind; 7] = [
         Kind::FrequencyResponse,
         Kind::Resonance,
         Kind::TorqueCurve,
         Kind::Positioning,
         Kind::Fluctuation,
         Kind::Unbalance,
+        Kind::FrequencyResponseTime,
     ];
 
     /// The name used in manifests (`frequency_response`, …).
@@ -73,6 +77,7 @@ impl Kind {
             Kind::Positioning => "positioning",
             Kind::Fluctuation => "fluctuation",
             Kind::Unbalance => "unbalance",
+            Kind::FrequencyResponseTime => "frequency_response_time",
         }
     }
 
@@ -136,6 +141,26 @@ impl std::str::FromStr for Direction {
     }
 }
 
+/// How a frequency-response record was excited.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Excitation {
+    /// A sine held for `dwell_s` at each of `frequencies_hz` in turn.
+    SteppedSine,
+    /// Random noise, a chirp or a multisine: every frequency at once.
+    Broadband,
+}
+
+impl Excitation {
+    /// The name written to manifests.
+    pub fn name(self) -> &'static str {
+        match self {
+            Excitation::SteppedSine => "stepped_sine",
+            Excitation::Broadband => "broadband",
+        }
+    }
+}
+
 /// The `conditions` of a manifest: how the experiment was run. Every field is optional,
 /// in the unit its name carries; [`Conditions::with_defaults`] fills in MODEL.md §7's
 /// defaults. Unknown keys are kept in `extra`.
@@ -158,14 +183,15 @@ pub struct Conditions {
     /// torque curve, `semi_closed` for positioning, fluctuation and unbalance).
     #[serde(rename = "loop", default, skip_serializing_if = "Option::is_none")]
     pub loop_mode: Option<LoopMode>,
-    /// Positioning: dwell at each target, s (default 1).
+    /// Positioning: dwell at each target, s (default 1). Stepped-sine frequency
+    /// response record: time spent at each frequency, s.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dwell_s: Option<f64>,
     /// Fluctuation and unbalance: table speed, deg/min (default 180 and 360).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub speed_deg_per_min: Option<f64>,
-    /// Fluctuation and unbalance: table turns per motor turn, Rg·Rw (no default here: it
-    /// comes from the mechanism).
+    /// Fluctuation, unbalance and frequency-response records: table turns per motor
+    /// turn, Rg·Rw (no default here: it comes from the mechanism).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ratio: Option<f64>,
     /// Unbalance: the offset mass, kg.
@@ -174,6 +200,14 @@ pub struct Conditions {
     /// Unbalance: the mass's distance from the table axis, m.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub radius_m: Option<f64>,
+    /// Frequency-response record: `stepped_sine` or `broadband` (default: stepped_sine
+    /// when `frequencies_hz` is given, else broadband).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub excitation: Option<Excitation>,
+    /// Stepped-sine frequency-response record: the drive frequencies in the order
+    /// played, Hz, each held for `dwell_s` from the first sample on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frequencies_hz: Option<Vec<f64>>,
     /// Condition keys this version does not know, kept as written.
     #[serde(flatten)]
     pub extra: Map<String, Value>,
@@ -181,7 +215,7 @@ pub struct Conditions {
 
 impl Conditions {
     /// The JSON keys of the typed fields.
-    const KEYS: [&'static str; 10] = [
+    const KEYS: [&'static str; 12] = [
         "torque_amplitude_nm",
         "preload_nm",
         "amplitude_deg",
@@ -192,6 +226,8 @@ impl Conditions {
         "ratio",
         "mass_kg",
         "radius_m",
+        "excitation",
+        "frequencies_hz",
     ];
 
     /// True when no condition is given.
@@ -226,6 +262,14 @@ impl Conditions {
                 };
                 c.speed_deg_per_min.get_or_insert(speed);
                 c.loop_mode.get_or_insert(LoopMode::SemiClosed);
+            }
+            Kind::FrequencyResponseTime => {
+                let stepped = c.frequencies_hz.is_some();
+                c.excitation.get_or_insert(if stepped {
+                    Excitation::SteppedSine
+                } else {
+                    Excitation::Broadband
+                });
             }
         }
         c
@@ -351,6 +395,15 @@ pub enum Data {
         table_angle_rad: Vec<f64>,
         extra: Columns,
     },
+    /// Motor torque, motor-shaft angle and table angle over uniformly sampled time
+    /// (see [`uniform_step`]).
+    FrequencyResponseTime {
+        time_s: Vec<f64>,
+        motor_torque_nm: Vec<f64>,
+        motor_angle_rad: Vec<f64>,
+        table_angle_rad: Vec<f64>,
+        extra: Columns,
+    },
 }
 
 impl Data {
@@ -363,6 +416,7 @@ impl Data {
             Data::Positioning { .. } => Kind::Positioning,
             Data::Fluctuation { .. } => Kind::Fluctuation,
             Data::Unbalance { .. } => Kind::Unbalance,
+            Data::FrequencyResponseTime { .. } => Kind::FrequencyResponseTime,
         }
     }
 
@@ -376,7 +430,8 @@ impl Data {
             | Data::TorqueCurve { time_s: v, .. }
             | Data::Positioning { target_rad: v, .. }
             | Data::Fluctuation { time_s: v, .. }
-            | Data::Unbalance { time_s: v, .. } => v.len(),
+            | Data::Unbalance { time_s: v, .. }
+            | Data::FrequencyResponseTime { time_s: v, .. } => v.len(),
         }
     }
 
@@ -393,7 +448,8 @@ impl Data {
             | Data::TorqueCurve { extra, .. }
             | Data::Positioning { extra, .. }
             | Data::Fluctuation { extra, .. }
-            | Data::Unbalance { extra, .. } => Some(extra),
+            | Data::Unbalance { extra, .. }
+            | Data::FrequencyResponseTime { extra, .. } => Some(extra),
         }
     }
 }
@@ -541,6 +597,9 @@ pub fn read_manifest(path: &Path) -> Result<Manifest, ExperimentFileError> {
                 }
             },
         })?;
+    if manifest.kind == Kind::FrequencyResponseTime {
+        check_record_conditions(&manifest.conditions).map_err(|m| manifest_error(path, &m))?;
+    }
     if let (Some(peaks), Some(gains)) = (&manifest.peaks_hz, &manifest.peak_gain_db) {
         if peaks.len() != gains.len() {
             return Err(manifest_error(
@@ -570,4 +629,101 @@ fn manifest_error(path: &Path, message: &str) -> ExperimentFileError {
         path: path.to_path_buf(),
         message: message.to_string(),
     }
+}
+
+/// The conditions a frequency-response record needs: for a stepped sine the frequencies
+/// (positive) and the dwell (positive); a positive ratio where one is given. (JSON
+/// numbers are finite, so `<= 0` is the whole check.)
+fn check_record_conditions(c: &Conditions) -> Result<(), String> {
+    let c = c.with_defaults(Kind::FrequencyResponseTime);
+    if let Some(r) = c.ratio.filter(|r| *r <= 0.0) {
+        return Err(format!(
+            "`conditions.ratio` is {r}: it must be positive (Rg·Rw)"
+        ));
+    }
+    if c.excitation != Some(Excitation::SteppedSine) {
+        return Ok(());
+    }
+    let frequencies = c.frequencies_hz.as_deref().unwrap_or_default();
+    if frequencies.is_empty() {
+        return Err(
+            "a stepped-sine record needs `conditions.frequencies_hz`: the drive \
+                    frequencies in the order played, Hz"
+                .into(),
+        );
+    }
+    if let Some(f) = frequencies.iter().find(|f| **f <= 0.0) {
+        return Err(format!(
+            "`conditions.frequencies_hz` holds {f}: drive frequencies must be positive"
+        ));
+    }
+    match c.dwell_s {
+        None => Err(
+            "a stepped-sine record needs `conditions.dwell_s`: the time spent at \
+                     each frequency, s"
+                .into(),
+        ),
+        Some(d) if d <= 0.0 => Err(format!(
+            "`conditions.dwell_s` is {d}: the dwell at each frequency must be positive"
+        )),
+        Some(_) => Ok(()),
+    }
+}
+
+/// Largest departure of one time step from the record's median step, as a fraction of
+/// that step, that a frequency-response record may have (a DAQ writing times rounded
+/// to 1 µs at 20 kHz stays within 2 %; one dropped sample is a 100 % departure).
+pub const SAMPLING_TOLERANCE: f64 = 0.05;
+
+/// A time step of a record that should be uniformly sampled but is not.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NonUniform {
+    /// Index of the sample that ends the step.
+    pub row: usize,
+    /// The step there, s.
+    pub step: f64,
+    /// The record's median step, s.
+    pub median: f64,
+}
+
+impl fmt::Display for NonUniform {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "the step from the previous row is {:.6e} s where the record steps {:.6e} s: \
+             the samples must be uniformly spaced (within {:.0} % of a step)",
+            self.step,
+            self.median,
+            100.0 * SAMPLING_TOLERANCE
+        )
+    }
+}
+
+/// Checks that strictly increasing `time` is uniformly sampled: every step within
+/// [`SAMPLING_TOLERANCE`] of the median step. Fewer than two samples pass.
+pub fn check_uniform(time: &[f64]) -> Result<(), NonUniform> {
+    let steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+    if steps.is_empty() {
+        return Ok(());
+    }
+    let mut sorted = steps.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    match steps
+        .iter()
+        .position(|s| (s - median).abs() > SAMPLING_TOLERANCE * median)
+    {
+        Some(i) => Err(NonUniform {
+            row: i + 1,
+            step: steps[i],
+            median,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The sampling period of a uniformly sampled record: the mean step, which rounding
+/// of the individual times does not bias. `None` for fewer than two samples.
+pub fn sample_period(time: &[f64]) -> Option<f64> {
+    (time.len() >= 2).then(|| (time[time.len() - 1] - time[0]) / (time.len() - 1) as f64)
 }

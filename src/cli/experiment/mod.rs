@@ -4,6 +4,7 @@
 
 pub mod fluctuation;
 pub mod frequency_response;
+pub mod frequency_response_time;
 pub mod positioning;
 pub mod torque_curve;
 pub mod unbalance;
@@ -27,6 +28,9 @@ pub enum Test {
     /// Frequency response, 10–600 Hz, nonlinear simulation per frequency (paper §4.1, Fig. 8).
     #[command(long_about = frequency_response::LONG_ABOUT)]
     FrequencyResponse(frequency_response::Args),
+    /// Frequency response recorded as raw time series (stepped sine, noise or chirp) and estimated from them (H1/Welch with coherence, or sine demodulation).
+    #[command(long_about = frequency_response_time::LONG_ABOUT)]
+    FrequencyResponseTime(frequency_response_time::Args),
     /// ISO 230-2 positioning accuracy and repeatability (paper §4.3, Fig. 10).
     #[command(long_about = positioning::LONG_ABOUT)]
     Positioning(positioning::Args),
@@ -92,6 +96,7 @@ impl Common {
 pub fn run(test: Test) -> anyhow::Result<()> {
     match test {
         Test::FrequencyResponse(a) => frequency_response::run(a),
+        Test::FrequencyResponseTime(a) => frequency_response_time::run(a),
         Test::Positioning(a) => positioning::run(a),
         Test::TorqueCurve(a) => torque_curve::run(a),
         Test::Fluctuation(a) => fluctuation::run(a),

@@ -101,6 +101,22 @@ impl Table {
                 }
             }
             Kind::Positioning => self.positioning()?,
+            Kind::FrequencyResponseTime => {
+                let (t, q) = (self.column("time_s")?, self.column("motor_torque_nm")?);
+                let m = self.required_angle("motor_angle")?;
+                let a = self.required_angle("table_angle")?;
+                let time_s = self.numbers(t, Increasing)?;
+                if let Err(e) = super::check_uniform(&time_s) {
+                    return Err(self.cell(self.rows[e.row].0, t.index, e.to_string()));
+                }
+                Data::FrequencyResponseTime {
+                    time_s,
+                    motor_torque_nm: self.numbers(q, Any)?,
+                    motor_angle_rad: self.numbers(m, Any)?,
+                    table_angle_rad: self.numbers(a, Any)?,
+                    extra: self.extras(),
+                }
+            }
             Kind::Fluctuation | Kind::Unbalance => {
                 let t = self.column("time_s")?;
                 let m = self.required_angle("motor_angle")?;

@@ -88,6 +88,13 @@ fn samples() -> Vec<Data> {
             table_angle_rad: series(n, 3.0),
             extra: extra(n),
         },
+        Data::FrequencyResponseTime {
+            time_s: times(n),
+            motor_torque_nm: series(n, 5.0),
+            motor_angle_rad: series(n, -0.1),
+            table_angle_rad: series(n, 2e-4),
+            extra: extra(n),
+        },
     ]
 }
 
@@ -144,6 +151,18 @@ fn numbers(data: &Data) -> Vec<Vec<f64>> {
             motor_angle_rad.clone(),
             table_angle_rad.clone(),
         ],
+        Data::FrequencyResponseTime {
+            time_s,
+            motor_torque_nm,
+            motor_angle_rad,
+            table_angle_rad,
+            ..
+        } => vec![
+            time_s.clone(),
+            motor_torque_nm.clone(),
+            motor_angle_rad.clone(),
+            table_angle_rad.clone(),
+        ],
     };
     v.extend(data.extra().into_iter().flat_map(|e| e.values().cloned()));
     v
@@ -159,6 +178,11 @@ fn every_kind_survives_a_round_trip() {
         manifest.mechanism = Some("worm-gear".into());
         manifest.notes = Some("round trip".into());
         manifest.conditions = Conditions::default().with_defaults(kind);
+        if kind == Kind::FrequencyResponseTime {
+            manifest.conditions.frequencies_hz = Some(vec![10.0, 1.0 / 3.0]);
+            manifest.conditions.dwell_s = Some(0.25);
+            manifest.conditions.excitation = Some(Excitation::SteppedSine);
+        }
         write(&path, &manifest, &data).unwrap();
         let back = read(&path).unwrap();
         assert_eq!(back.data.kind(), kind);
@@ -417,6 +441,105 @@ fn malformed_csv_files_name_file_line_and_column() {
         let err = read_csv(kind, csv).unwrap_err().to_string();
         assert!(err.contains(expected), "{csv:?}:\n  got  {err}\n  want {expected}");
     }
+}
+
+/// The raw frequency-response record: every fault names file, line and column.
+#[test]
+fn malformed_frequency_response_records_name_file_line_and_column() {
+    let k = "frequency_response_time";
+    let head = "time_s,motor_torque_nm,motor_angle_deg,table_angle_deg\n";
+    let ok_rows = "0,1,0,0\n0.001,1,0.1,0.001\n0.002,1,0.2,0.002\n";
+    let with = |rows: &str| format!("{head}{rows}");
+    for (csv, expected) in [
+        (
+            "time_s,motor_angle_deg,table_angle_deg\n0,0,0\n".to_string(),
+            "run.csv, line 1: missing column `motor_torque_nm` (header: time_s,motor_angle_deg,table_angle_deg)".to_string(),
+        ),
+        (
+            "time_s,motor_torque_nm,table_angle_deg\n0,0,0\n".into(),
+            "run.csv, line 1: missing column `motor_angle_deg` (or `motor_angle_rad`, `motor_angle_arcsec`)".into(),
+        ),
+        (
+            "time_s,motor_torque_nm,motor_angle_deg\n0,0,0\n".into(),
+            "run.csv, line 1: missing column `table_angle_deg` (or `table_angle_rad`, `table_angle_arcsec`)".into(),
+        ),
+        (
+            "time_s,motor_torque_nm,motor_angle_deg,motor_angle_rad,table_angle_deg\n0,0,0,0,0\n".into(),
+            "run.csv, line 1: columns `motor_angle_deg` and `motor_angle_rad` give the same angle".into(),
+        ),
+        (
+            with("0,1,0,0\n0.001,x,0,0\n"),
+            "run.csv, line 3, column `motor_torque_nm`: `x` is not a number".into(),
+        ),
+        (
+            with("0,1,0,0\n0.001,1,NaN,0\n"),
+            "run.csv, line 3, column `motor_angle_deg`: `NaN` is not a finite number".into(),
+        ),
+        (
+            with("0,1,0,0\n0.001,1,0,\n"),
+            "run.csv, line 3, column `table_angle_deg`: empty cell".into(),
+        ),
+        (
+            with("0,1,0,0\n0.001,1,0,0\n0.001,1,0,0\n"),
+            "run.csv, line 4, column `time_s`: 0.001 does not increase (previous row 0.001)".into(),
+        ),
+        (
+            // A dropped sample: the step doubles at line 5 (comment on line 2).
+            format!("{head}# c\n{ok_rows}0.004,1,0,0\n0.005,1,0,0\n"),
+            "run.csv, line 6, column `time_s`: the step from the previous row is 2.000000e-3 s where the record steps 1.000000e-3 s".into(),
+        ),
+        (
+            with("0,1,0,0\n0.001,1,0,0\n0.00206,1,0,0\n0.003,1,0,0\n0.004,1,0,0\n"),
+            "run.csv, line 4, column `time_s`: the step from the previous row is 1.060000e-3 s".into(),
+        ),
+        (
+            with("0,1,0,0\n0.001,1,0\n"),
+            "run.csv, line 3: 3 fields where the rows before have 4".into(),
+        ),
+        (head.to_string(), "run.csv, line 1: no data rows".into()),
+    ] {
+        let err = read_csv(k, &csv).unwrap_err().to_string();
+        assert!(err.contains(&expected), "{csv:?}:\n  got  {err}\n  want {expected}");
+    }
+    // Rounding of the times within the tolerance (2 %) is accepted.
+    let jitter = with("0,1,0,0\n0.00102,1,0,0\n0.002,1,0,0\n0.00299,1,0,0\n");
+    assert_eq!(read_csv(k, &jitter).unwrap().data.len(), 4);
+    // The conditions a stepped sine needs, named.
+    let csv = with(ok_rows);
+    for (conditions, expected) in [
+        (r#"{"excitation": "stepped_sine", "dwell_s": 1}"#, "m.json: a stepped-sine record needs `conditions.frequencies_hz`"),
+        (r#"{"frequencies_hz": [10, 20]}"#, "m.json: a stepped-sine record needs `conditions.dwell_s`"),
+        (r#"{"frequencies_hz": [10, -20], "dwell_s": 1}"#, "m.json: `conditions.frequencies_hz` holds -20"),
+        (r#"{"frequencies_hz": [10], "dwell_s": 0}"#, "m.json: `conditions.dwell_s` is 0"),
+        (r#"{"ratio": -0.01}"#, "m.json: `conditions.ratio` is -0.01"),
+        (r#"{"excitation": "sweep"}"#, "m.json, line 1, column 91: unknown variant `sweep`, expected `stepped_sine` or `broadband`"),
+    ] {
+        let manifest = format!(r#"{{"kind": "{k}", "data": "run.csv", "conditions": {conditions}}}"#);
+        let (_dir, path) = files(&[("m.json", &manifest), ("run.csv", &csv)]);
+        let err = read(&path).unwrap_err().to_string();
+        assert!(err.contains(expected), "{conditions}:\n  got  {err}\n  want {expected}");
+    }
+    // Broadband needs neither; the writer refuses what the reader would.
+    let manifest = format!(r#"{{"kind": "{k}", "data": "run.csv"}}"#);
+    let (_dir, path) = files(&[("m.json", &manifest), ("run.csv", &csv)]);
+    let e = read(&path).unwrap();
+    let c = e
+        .manifest
+        .conditions
+        .with_defaults(Kind::FrequencyResponseTime);
+    assert_eq!(c.excitation, Some(Excitation::Broadband));
+    let Data::FrequencyResponseTime { mut time_s, .. } = e.data.clone() else {
+        panic!("{:?}", e.data)
+    };
+    time_s[2] = 0.0035;
+    let mut bad = e.data.clone();
+    if let Data::FrequencyResponseTime { time_s: t, .. } = &mut bad {
+        *t = time_s;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let err = write(&dir.path().join("w.json"), &e.manifest, &bad).unwrap_err();
+    assert!(err.to_string().contains("column `time_s`, row 2: the step from the previous row is 1.000000e-3 s where the record steps 2.500000e-3 s"), "{err}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
 
 #[test]

@@ -108,6 +108,12 @@ fn check_manifest(m: &Manifest) -> Result<(), String> {
     {
         return Err(format!("condition `{key}` is {v}"));
     }
+    if let Some(f) = c.frequencies_hz.iter().flatten().find(|v| !v.is_finite()) {
+        return Err(format!("condition `frequencies_hz` holds {f}"));
+    }
+    if m.kind == Kind::FrequencyResponseTime {
+        super::check_record_conditions(c)?;
+    }
     for (key, values) in [("peaks_hz", &m.peaks_hz), ("peak_gain_db", &m.peak_gain_db)] {
         if let Some(v) = values.iter().flatten().find(|v| !v.is_finite()) {
             return Err(format!("`{key}` holds {v}"));
@@ -231,6 +237,21 @@ fn out_columns(data: &Data) -> Vec<(Cow<'_, str>, Cells<'_>)> {
             ],
             extra,
         ),
+        Data::FrequencyResponseTime {
+            time_s,
+            motor_torque_nm,
+            motor_angle_rad,
+            table_angle_rad,
+            extra,
+        } => (
+            vec![
+                plain("time_s", time_s),
+                plain("motor_torque_nm", motor_torque_nm),
+                angle("motor_angle_deg", motor_angle_rad, DEG),
+                angle("table_angle_deg", table_angle_rad, DEG),
+            ],
+            extra,
+        ),
     };
     for (name, v) in extra {
         columns.push((name.as_str().into(), Cells::Numbers(v.as_slice().into())));
@@ -246,6 +267,10 @@ fn reserved(kind: Kind) -> Vec<String> {
         Kind::TorqueCurve => (&["time_s", "motor_torque_nm"], &["table_angle"]),
         Kind::Positioning => (&["direction", "run"], &["target", "deviation"]),
         Kind::Fluctuation | Kind::Unbalance => (&["time_s"], &["motor_angle", "table_angle"]),
+        Kind::FrequencyResponseTime => (
+            &["time_s", "motor_torque_nm"],
+            &["motor_angle", "table_angle"],
+        ),
     };
     let angle_names = angles.iter().flat_map(|base| {
         ANGLE_UNITS
@@ -300,6 +325,11 @@ fn check_columns(data: &Data, columns: &[(Cow<'_, str>, Cells<'_>)]) -> Result<(
                             row + 2,
                             v[row + 1]
                         ));
+                    }
+                    if data.kind() == Kind::FrequencyResponseTime {
+                        if let Err(e) = super::check_uniform(v) {
+                            return Err(format!("column `{name}`, row {}: {e}", e.row + 1));
+                        }
                     }
                 }
             }

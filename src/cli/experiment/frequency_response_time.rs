@@ -1,0 +1,421 @@
+//! `rtid experiment frequency-response-time` and the evaluation of
+//! `frequency_response_time` files (raw torque and angles over time).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::bail;
+
+use super::fluctuation::positive;
+use super::Common;
+use crate::cli::progress;
+use crate::experiments::frequency_response_estimate::{
+    self as estimate, EstimateOptions, Evaluation,
+};
+use crate::experiments::frequency_response_record::{self as record, Excitation, RecordTest};
+use crate::io::experiment_file::{self, Experiment};
+use crate::report::plot::{write, Chart, Series, Style};
+
+pub const LONG_ABOUT: &str = "\
+The frequency-response test (paper §4.1) recorded as raw time series, the way a DAQ on a \
+real rig records it: one continuous open-loop run under a stepped sine, band-limited \
+random noise or a chirp, sampling motor torque, motor angle and table angle (encoders \
+quantised, table 0.0001°, plus optional --noise-arcsec) at --sample-rate-hz. Written as a \
+`frequency_response_time` experiment file (docs/experiment-files.md), which `rtid \
+evaluate` turns into the gain curve; a measured recording in the same format is evaluated \
+the same way.
+
+Evaluation (docs/experiments.md): a stepped sine is demodulated per dwell (the first \
+--settle-fraction of each dwell discarded, then a least-squares sine + drift fit over whole \
+cycles); noise and chirp records give the H1 estimate with Welch averaging (Hann window, \
+50 % overlap, --segment-s long segments: resolution 1/segment) and the coherence γ². Bins \
+with γ² below --min-coherence are flagged and left out of the peak search. Gain = table \
+angle / (motor angle × Rg·Rw), in dB; its peaks are the resonances.
+
+Outputs, in --out DIR: frequency_response_time.json/.csv, frequency_response_time.svg (the \
+gain, kept bins only, with the resonances) and, for noise and chirp, \
+frequency_response_time-coherence.svg.
+
+Examples:
+  rtid experiment frequency-response-time --preset worm-gear --out runs/worm
+  rtid experiment frequency-response-time --preset worm-gear --excitation stepped-sine --from-hz 150 --to-hz 260 --step-hz 2 --out runs/stepped
+  rtid experiment frequency-response-time --preset worm-gear --preload-nm 6 --noise-arcsec 1 --out runs/noisy";
+
+/// The excitations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExcitationKind {
+    /// A sine held for --dwell-s at each frequency --from-hz, +--step-hz, … --to-hz.
+    SteppedSine,
+    /// Gaussian noise band-limited to --from-hz … --to-hz, held per sample.
+    Noise,
+    /// A linear chirp from --from-hz to --to-hz over --duration-s.
+    Chirp,
+}
+
+/// How a record is evaluated (shared with `rtid evaluate`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct EstimateArgs {
+    /// Noise/chirp records: Welch segment length, s (resolution = 1/segment; default 2 s,
+    /// or a quarter of the record if shorter).
+    #[arg(long, value_name = "SECONDS")]
+    pub segment_s: Option<f64>,
+    /// Noise/chirp records: coherence γ² below which a frequency bin is flagged and left
+    /// out of the peak search and the plot.
+    #[arg(long, value_name = "GAMMA2", default_value_t = 0.8)]
+    pub min_coherence: f64,
+    /// Stepped-sine records: fraction of each dwell discarded as settling.
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.5)]
+    pub settle_fraction: f64,
+}
+
+impl EstimateArgs {
+    pub fn options(&self) -> EstimateOptions {
+        EstimateOptions {
+            segment_s: self.segment_s,
+            min_coherence: self.min_coherence,
+            settle_fraction: self.settle_fraction,
+            ..Default::default()
+        }
+    }
+}
+
+/// Arguments of `rtid experiment frequency-response-time`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub common: Common,
+    /// The motor-torque excitation.
+    #[arg(long, value_enum, default_value = "noise")]
+    pub excitation: ExcitationKind,
+    /// Sine or chirp amplitude, or the noise's standard deviation, N·m.
+    #[arg(long, value_name = "NM", default_value_t = 5.0)]
+    pub amplitude_nm: f64,
+    /// Table brake torque balanced by a motor DC torque, N·m (keeps the flanks loaded).
+    #[arg(
+        long,
+        value_name = "NM",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub preload_nm: f64,
+    /// Lowest frequency (stepped sine: first step; noise: band edge; chirp: start), Hz.
+    #[arg(long, value_name = "HZ", default_value_t = 10.0)]
+    pub from_hz: f64,
+    /// Highest frequency, Hz.
+    #[arg(long, value_name = "HZ", default_value_t = 600.0)]
+    pub to_hz: f64,
+    /// Stepped sine: frequency step, Hz.
+    #[arg(long, value_name = "HZ", default_value_t = 10.0)]
+    pub step_hz: f64,
+    /// Stepped sine: time at each frequency, s.
+    #[arg(long, value_name = "SECONDS", default_value_t = 0.5)]
+    pub dwell_s: f64,
+    /// Noise and chirp: record length, s.
+    #[arg(long, value_name = "SECONDS", default_value_t = 16.0)]
+    pub duration_s: f64,
+    /// Sampling rate of the record, Hz (period rounded to whole integration steps).
+    #[arg(long, value_name = "HZ", default_value_t = 5000.0)]
+    pub sample_rate_hz: f64,
+    /// Gaussian noise added to the table reading, arc-seconds rms.
+    #[arg(long, value_name = "ARCSEC", default_value_t = 0.0)]
+    pub noise_arcsec: f64,
+    /// Seed of the noise excitation and the measurement noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    #[command(flatten)]
+    pub estimate: EstimateArgs,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let p = a.common.model.load()?;
+    let (from, to) = (a.from_hz, a.to_hz);
+    if !(from >= 0.0 && to > from && to.is_finite()) {
+        bail!("--from-hz {from} --to-hz {to}: need 0 ≤ from < to");
+    }
+    if !(a.noise_arcsec >= 0.0 && a.noise_arcsec.is_finite()) {
+        bail!(
+            "--noise-arcsec {}: must be zero or positive",
+            a.noise_arcsec
+        );
+    }
+    if !a.preload_nm.is_finite() {
+        bail!("--preload-nm {}: must be a finite torque", a.preload_nm);
+    }
+    let excitation = match a.excitation {
+        ExcitationKind::SteppedSine => {
+            let step = positive(a.step_hz, "--step-hz")?;
+            let first = positive(from, "--from-hz")?;
+            let count = ((to - first) / step + 1e-9).floor() as usize;
+            Excitation::SteppedSine {
+                frequencies_hz: (0..=count).map(|i| first + step * i as f64).collect(),
+                dwell_s: positive(a.dwell_s, "--dwell-s")?,
+            }
+        }
+        ExcitationKind::Noise => Excitation::Noise {
+            seed: a.seed,
+            from_hz: from,
+            to_hz: to,
+        },
+        ExcitationKind::Chirp => Excitation::Chirp {
+            from_hz: from,
+            to_hz: to,
+        },
+    };
+    let test = RecordTest {
+        excitation,
+        amplitude_nm: positive(a.amplitude_nm, "--amplitude-nm")?,
+        preload_nm: a.preload_nm,
+        duration_s: positive(a.duration_s, "--duration-s")?,
+        sample_rate_hz: positive(a.sample_rate_hz, "--sample-rate-hz")?,
+        table_noise_rad: (a.noise_arcsec / 3600.0).to_radians(),
+        seed: a.seed,
+    };
+    a.common.create_out()?;
+    let bar = progress::bar(test.duration().ceil() as u64, "simulated s", a.common.quiet);
+    let rec = record::run(&p, &test, |done, _| bar.set_position(done as u64))?;
+    bar.finish_and_clear();
+    let stem = "frequency_response_time";
+    let path = a.common.out.join(format!("{stem}.json"));
+    let mut manifest = record::manifest(&p, &test);
+    manifest.data = Some(format!("{stem}.csv"));
+    experiment_file::write(&path, &manifest, &record::to_data(&rec))?;
+    report_with(
+        &experiment_file::read(&path)?,
+        &a.common.out.join(format!("{stem}.svg")),
+        a.common.json,
+        &a.estimate.options(),
+    )
+}
+
+/// `FILE.svg` → `FILE-coherence.svg`.
+fn coherence_path(plot: &Path) -> PathBuf {
+    let stem = plot
+        .file_stem()
+        .map_or("plot".into(), |s| s.to_string_lossy());
+    plot.with_file_name(format!("{stem}-coherence.svg"))
+}
+
+/// Evaluates a `frequency_response_time` experiment: printed (table or JSON), the gain
+/// plot written to `plot` and, for H1, the coherence beside it (`…-coherence.svg`).
+pub fn report_with(
+    exp: &Experiment,
+    plot: &Path,
+    json: bool,
+    opts: &EstimateOptions,
+) -> anyhow::Result<()> {
+    let e = estimate::evaluate_experiment(exp, opts).map_err(|err| match err {
+        estimate::EstimateError::Ratio(r) => anyhow::anyhow!("{r}"),
+        other => anyhow::anyhow!("{}: {other}", exp.path.display()),
+    })?;
+    let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
+    plot_evaluation(&e, mechanism, plot)?;
+    if json {
+        let mut value = serde_json::to_value(&e)?;
+        value["kind"] = serde_json::json!(exp.manifest.kind.name());
+        value["source"] = serde_json::json!(exp.path);
+        println!("{}", serde_json::to_string_pretty(&value)?);
+        return Ok(());
+    }
+    println!("{}", summary(&e, &exp.path));
+    Ok(())
+}
+
+fn plot_evaluation(e: &Evaluation, mechanism: &str, plot: &Path) -> anyhow::Result<()> {
+    let chart = |title: &str, y: &'static str| (format!("{mechanism}: {title}"), y);
+    let markers = Series::new(
+        "resonances",
+        e.peaks()
+            .iter()
+            .map(|p| (p.frequency_hz, p.gain_db))
+            .collect(),
+        Style::Markers,
+    );
+    let write_chart = |path: &Path, (title, y): (String, &str), series: &[Series]| {
+        write(
+            path,
+            &Chart {
+                title: &title,
+                x_label: "frequency, Hz",
+                y_label: y,
+            },
+            series,
+        )
+        .map_err(|err| anyhow::anyhow!("writing {}: {err}", path.display()))
+    };
+    match e {
+        Evaluation::SteppedSine { points, .. } => {
+            let mut curve: Vec<(f64, f64)> =
+                points.iter().map(|q| (q.frequency_hz, q.gain_db)).collect();
+            curve.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let series = [
+                Series::new("gain (stepped sine)", curve, Style::Line),
+                markers,
+            ];
+            write_chart(
+                plot,
+                chart("frequency response (stepped sine)", "gain, dB"),
+                &series,
+            )
+        }
+        Evaluation::H1 {
+            bins,
+            min_coherence,
+            ..
+        } => {
+            // Up to a little beyond the highest kept bin: above it is noise.
+            let top = bins
+                .iter()
+                .filter(|b| b.kept)
+                .map(|b| b.frequency_hz)
+                .fold(0.0, f64::max);
+            let top = if top > 0.0 { 1.2 * top } else { f64::INFINITY };
+            let shown = |f: f64| f <= top;
+            let mut series: Vec<Series> = estimate::kept_runs(bins)
+                .into_iter()
+                .enumerate()
+                .map(|(i, run)| {
+                    let name = if i == 0 {
+                        format!("H1 gain where γ² ≥ {min_coherence}")
+                    } else {
+                        String::new()
+                    };
+                    Series::new(name, run, Style::Line)
+                })
+                .collect();
+            series.push(markers);
+            write_chart(
+                plot,
+                chart("frequency response (H1, Welch)", "gain, dB"),
+                &series,
+            )?;
+            let coherence: Vec<(f64, f64)> = bins
+                .iter()
+                .filter(|b| shown(b.frequency_hz))
+                .map(|b| (b.frequency_hz, b.coherence))
+                .collect();
+            let x1 = coherence.last().map_or(1.0, |c| c.0);
+            let series = [
+                Series::new("coherence γ²", coherence, Style::Line),
+                Series::new(
+                    "threshold",
+                    vec![(0.0, *min_coherence), (x1, *min_coherence)],
+                    Style::Dashed,
+                ),
+            ];
+            let path = coherence_path(plot);
+            write_chart(
+                &path,
+                chart("coherence, motor angle → table angle", "γ²"),
+                &series,
+            )
+        }
+    }
+}
+
+/// The printed evaluation.
+fn summary(e: &Evaluation, source: &Path) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{}: frequency response from time series",
+        source.display()
+    );
+    match e {
+        Evaluation::SteppedSine {
+            ratio,
+            settle_fraction,
+            points,
+            ..
+        } => {
+            let _ = writeln!(
+                s,
+                "stepped sine, {} frequencies, first {:.0} % of each dwell discarded; ratio {ratio:.6e}",
+                points.len(),
+                100.0 * settle_fraction
+            );
+            let _ = writeln!(
+                s,
+                "  freq Hz   gain dB  phase deg  table amp ″  cycles  residual"
+            );
+            for q in points {
+                let flag = if q.table_residual > 0.5 {
+                    "  not a clean sine"
+                } else {
+                    ""
+                };
+                let _ = writeln!(
+                    s,
+                    "{:9.2} {:9.3} {:10.2} {:12.3} {:7} {:9.3}{flag}",
+                    q.frequency_hz,
+                    q.gain_db,
+                    q.phase_deg,
+                    q.table_amplitude_rad.to_degrees() * 3600.0,
+                    q.cycles,
+                    q.table_residual
+                );
+            }
+        }
+        Evaluation::H1 {
+            ratio,
+            sample_rate_hz,
+            segment_len,
+            segments,
+            resolution_hz,
+            min_coherence,
+            kept,
+            bins,
+            ..
+        } => {
+            let _ = writeln!(
+                s,
+                "H1 with Welch averaging: {sample_rate_hz:.1} Hz sampling, segments of {segment_len} \
+                 samples (resolution {resolution_hz:.3} Hz), {segments} averaged, Hann, 50 % overlap; \
+                 ratio {ratio:.6e}"
+            );
+            let _ = writeln!(
+                s,
+                "{kept} of {} bins with γ² ≥ {min_coherence} (the others are left out)",
+                bins.len()
+            );
+            let _ = writeln!(s, "  band Hz      kept   mean γ²   gain dB (kept)");
+            let nyquist = sample_rate_hz / 2.0;
+            let mut lo = 0.0;
+            while lo < nyquist.min(1000.0) {
+                let hi = lo + 100.0;
+                let band: Vec<_> = bins
+                    .iter()
+                    .filter(|b| b.frequency_hz >= lo && b.frequency_hz < hi)
+                    .collect();
+                if !band.is_empty() {
+                    let k: Vec<f64> = band.iter().filter(|b| b.kept).map(|b| b.gain_db).collect();
+                    let mean = band.iter().map(|b| b.coherence).sum::<f64>() / band.len() as f64;
+                    let range = if k.is_empty() {
+                        "—".to_string()
+                    } else {
+                        let (a, b) = k
+                            .iter()
+                            .fold((f64::MAX, f64::MIN), |(a, b), &g| (a.min(g), b.max(g)));
+                        format!("{a:.1} … {b:.1}")
+                    };
+                    let _ = writeln!(
+                        s,
+                        "  {lo:4.0}–{hi:<4.0} {:5.0} %  {mean:8.3}   {range}",
+                        100.0 * k.len() as f64 / band.len() as f64
+                    );
+                }
+                lo = hi;
+            }
+        }
+    }
+    let _ = writeln!(
+        s,
+        "resonances (local maxima of the gain, parabolic interpolation):"
+    );
+    for p in e.peaks() {
+        let _ = writeln!(s, "  {:8.2} Hz  {:7.2} dB", p.frequency_hz, p.gain_db);
+    }
+    if e.peaks().is_empty() {
+        let _ = writeln!(s, "  none found");
+    }
+    s.trim_end().to_string()
+}
