@@ -459,7 +459,10 @@ fn nonlinear_check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, I
             .iter()
             .zip(&measured)
             .map(|(a, b)| (a - b).abs())
-            .fold(0.0, |a: f64, b| if b.is_nan() { f64::INFINITY } else { a.max(b) });
+            .fold(
+                0.0,
+                |a: f64, b| if b.is_nan() { f64::INFINITY } else { a.max(b) },
+            );
         out.push(NonlinearCheck {
             source: file.clone(),
             measured_hz: measured,
