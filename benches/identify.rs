@@ -10,7 +10,7 @@ use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rtid::identify::setup::frequency_test;
-use rtid::identify::{identify, Config, FidelityChoice, Monitor, Settings};
+use rtid::identify::{identify, Config, Monitor};
 use rtid::io::experiment_file;
 use rtid::model::presets;
 use rtid::objectives::{resonance::ResonanceMatch, Fidelity, Objective};
@@ -39,18 +39,11 @@ fn bench(c: &mut Criterion) {
     start.kg = start.kg.map(|k| k * 1.4);
     group.bench_function("fit/worm-gear", |b| {
         b.iter(|| {
-            let config = Config {
-                experiments: vec![("fixture".into(), exp.clone())],
-                base: start.clone(),
-                fit: vec!["Kw".into(), "Kg".into()],
-                bounds: Vec::new(),
-                objectives: None,
-                weights: Vec::new(),
-                fidelity: FidelityChoice::Auto,
-                settings: Settings::default(),
-                checkpoint: None,
-                resume: false,
-            };
+            let config = Config::new(
+                vec![("fixture".into(), exp.clone())],
+                start.clone(),
+                &["Kw", "Kg"],
+            );
             identify(&config, &Monitor::default()).unwrap()
         })
     });

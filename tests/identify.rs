@@ -4,9 +4,7 @@
 use std::path::Path;
 
 use rtid::identify::setup::ObjectiveKind;
-use rtid::identify::{
-    identify, Bound, Config, FidelityChoice, Identified, Method, Monitor, Settings,
-};
+use rtid::identify::{identify, Bound, Config, FidelityChoice, Identified, Method, Monitor};
 use rtid::io::experiment_file::{self, Data, Experiment, Kind, Manifest};
 use rtid::model::{presets, Params};
 use rtid::objectives::peak_search::linear_peaks;
@@ -27,18 +25,7 @@ fn preset_with(name: &str, set: &[(&str, f64)]) -> Params {
 }
 
 fn config(experiments: Vec<(String, Experiment)>, base: Params, fit: &[&str]) -> Config {
-    Config {
-        experiments,
-        base,
-        fit: fit.iter().map(|s| s.to_string()).collect(),
-        bounds: Vec::new(),
-        objectives: None,
-        weights: Vec::new(),
-        fidelity: FidelityChoice::Auto,
-        settings: Settings::default(),
-        checkpoint: None,
-        resume: false,
-    }
+    Config::new(experiments, base, fit)
 }
 
 fn run(c: &Config) -> Identified {

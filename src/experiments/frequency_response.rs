@@ -153,37 +153,6 @@ impl Window {
     }
 }
 
-/// Amplitude and phase (rad) of the component at `omega` of each signal `x[k](t)`,
-/// fitted with an offset and a quadratic drift: least squares on
-/// [1, τ, τ², sin ωt, cos ωt] (one normal matrix for all signals; (0, 0) without
-/// samples).
-fn sine_components<const K: usize>(t: &[f64], x: [&[f64]; K], omega: f64) -> [(f64, f64); K] {
-    if t.is_empty() {
-        return [(0.0, 0.0); K];
-    }
-    let (t0, t1) = (t[0], t[t.len() - 1]);
-    let span = (t1 - t0).max(f64::MIN_POSITIVE);
-    let mut ata = nalgebra::Matrix5::<f64>::zeros();
-    let mut atb = [nalgebra::Vector5::<f64>::zeros(); K];
-    let x0 = x.map(|x| x[0]);
-    for (i, &ti) in t.iter().enumerate() {
-        let tau = 2.0 * (ti - t0) / span - 1.0;
-        let (s, c) = (omega * ti).sin_cos();
-        let row = nalgebra::Vector5::new(1.0, tau, tau * tau, s, c);
-        ata += row * row.transpose();
-        for k in 0..K {
-            atb[k] += row * (x[k][i] - x0[k]);
-        }
-    }
-    let lu = ata.lu();
-    atb.map(|atb| {
-        let coef = lu.solve(&atb).unwrap_or_else(nalgebra::Vector5::zeros);
-        let (a_s, a_c) = (coef[3], coef[4]);
-        // a_s·sin + a_c·cos = A·sin(ωt + φ)
-        ((a_s * a_s + a_c * a_c).sqrt(), a_c.atan2(a_s))
-    })
-}
-
 /// The initial state: the linear steady state of the sine, plus the static twist of
 /// the preload with the loaded flanks in contact.
 pub(crate) fn initial_state(p: &Params, omega: f64, test: &FrequencyTest) -> [f64; NSTATE] {
@@ -478,7 +447,8 @@ impl Run {
         // The smallest table amplitude a measurement resolves (0.0001° encoder), and a
         // floor for the ideal-encoder case, so that a table at rest gives a finite gain.
         let floor = p.controller.table_encoder_resolution.max(1e-12);
-        let [(am, pm), (at, pt)] = sine_components(&rec.t, [&rec.motor, &rec.table], self.omega);
+        let [(am, pm), (at, pt)] =
+            super::stepped_sine::components(&rec.t, [&rec.motor, &rec.table], self.omega);
         let below_resolution = at < floor;
         let gain = 20.0 * (at.max(floor) / (am.max(f64::MIN_POSITIVE) * ratio)).log10();
         let settled = self.previous.is_some_and(|(g, a, b)| {
@@ -698,7 +668,7 @@ mod tests {
             .iter()
             .map(|&t| 3.0 + 20.0 * t - 5.0 * t * t + 0.7 * (omega * t + 0.4).sin())
             .collect();
-        let [(a, phi)] = sine_components(&t, [&x], omega);
+        let [(a, phi)] = super::super::stepped_sine::components(&t, [&x], omega);
         assert!(
             (a - 0.7).abs() < 1e-9 && (phi - 0.4).abs() < 1e-9,
             "{a} {phi}"

@@ -41,44 +41,79 @@ pub struct SineFit {
     pub residual_rms: f64,
 }
 
-/// Least squares of `x(t)` on [1, τ, τ², sin ωt, cos ωt] (τ the time scaled to [−1, 1]).
-pub fn fit(t: &[f64], x: &[f64], omega: f64) -> SineFit {
-    let zero = SineFit {
-        amplitude: 0.0,
-        phase: 0.0,
-        residual_rms: 0.0,
-    };
-    if t.is_empty() || t.len() != x.len() {
-        return zero;
+/// The design row [1, τ, τ², sin ωt, cos ωt] at `ti` (τ the time scaled to [−1, 1]
+/// over [t0, t0 + span]).
+fn row(ti: f64, t0: f64, span: f64, omega: f64) -> nalgebra::Vector5<f64> {
+    let tau = 2.0 * (ti - t0) / span - 1.0;
+    let (s, c) = (omega * ti).sin_cos();
+    nalgebra::Vector5::new(1.0, tau, tau * tau, s, c)
+}
+
+/// Least-squares coefficients of each `x[k](t) − x[k](0)` on the design row, with one
+/// normal matrix for all signals (`None` without samples or when it is singular).
+fn coefficients<const K: usize>(
+    t: &[f64],
+    x: [&[f64]; K],
+    omega: f64,
+) -> Option<[nalgebra::Vector5<f64>; K]> {
+    if t.is_empty() || x.iter().any(|x| x.len() != t.len()) {
+        return None;
     }
-    let (t0, t1) = (t[0], t[t.len() - 1]);
-    let span = (t1 - t0).max(f64::MIN_POSITIVE);
-    let row = |ti: f64| {
-        let tau = 2.0 * (ti - t0) / span - 1.0;
-        let (s, c) = (omega * ti).sin_cos();
-        nalgebra::Vector5::new(1.0, tau, tau * tau, s, c)
-    };
+    let (t0, span) = (t[0], (t[t.len() - 1] - t[0]).max(f64::MIN_POSITIVE));
     let mut ata = nalgebra::Matrix5::<f64>::zeros();
-    let mut atb = nalgebra::Vector5::<f64>::zeros();
-    let x0 = x[0];
-    for (&ti, &xi) in t.iter().zip(x) {
-        let r = row(ti);
+    let mut atb = [nalgebra::Vector5::<f64>::zeros(); K];
+    let x0 = x.map(|x| x[0]);
+    for (i, &ti) in t.iter().enumerate() {
+        let r = row(ti, t0, span, omega);
         ata += r * r.transpose();
-        atb += r * (xi - x0);
+        for k in 0..K {
+            atb[k] += r * (x[k][i] - x0[k]);
+        }
     }
-    let Some(coef) = ata.lu().solve(&atb) else {
-        return zero;
+    let lu = ata.lu();
+    let mut out = [nalgebra::Vector5::<f64>::zeros(); K];
+    for k in 0..K {
+        out[k] = lu.solve(&atb[k])?;
+    }
+    Some(out)
+}
+
+/// Amplitude and phase: a_s·sin + a_c·cos = A·sin(ωt + φ).
+fn amplitude_phase(coef: &nalgebra::Vector5<f64>) -> (f64, f64) {
+    let (a_s, a_c) = (coef[3], coef[4]);
+    ((a_s * a_s + a_c * a_c).sqrt(), a_c.atan2(a_s))
+}
+
+/// Amplitude and phase (rad) of the component at `omega` of each signal `x[k](t)`,
+/// fitted with an offset and a quadratic drift; (0, 0) without samples. One normal
+/// matrix serves all signals (the frequency-response test fits motor and table).
+pub fn components<const K: usize>(t: &[f64], x: [&[f64]; K], omega: f64) -> [(f64, f64); K] {
+    match coefficients(t, x, omega) {
+        Some(c) => c.map(|c| amplitude_phase(&c)),
+        None => [(0.0, 0.0); K],
+    }
+}
+
+/// Least squares of `x(t)` on [1, τ, τ², sin ωt, cos ωt] (τ the time scaled to [−1, 1]),
+/// with the RMS of what the fit leaves.
+pub fn fit(t: &[f64], x: &[f64], omega: f64) -> SineFit {
+    let Some([coef]) = coefficients(t, [x], omega) else {
+        return SineFit {
+            amplitude: 0.0,
+            phase: 0.0,
+            residual_rms: 0.0,
+        };
     };
+    let (t0, span) = (t[0], (t[t.len() - 1] - t[0]).max(f64::MIN_POSITIVE));
     let sum_sq: f64 = t
         .iter()
         .zip(x)
-        .map(|(&ti, &xi)| (xi - x0 - row(ti).dot(&coef)).powi(2))
+        .map(|(&ti, &xi)| (xi - x[0] - row(ti, t0, span, omega).dot(&coef)).powi(2))
         .sum();
-    let (a_s, a_c) = (coef[3], coef[4]);
-    // a_s·sin + a_c·cos = A·sin(ωt + φ)
+    let (amplitude, phase) = amplitude_phase(&coef);
     SineFit {
-        amplitude: (a_s * a_s + a_c * a_c).sqrt(),
-        phase: a_c.atan2(a_s),
+        amplitude,
+        phase,
         residual_rms: (sum_sq / t.len() as f64).sqrt(),
     }
 }

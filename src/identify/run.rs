@@ -51,6 +51,26 @@ pub struct Config {
     pub resume: bool,
 }
 
+impl Config {
+    /// `fit` from `experiments` on `base`, everything else at its default (default
+    /// bounds and objectives, weights 1, `--model auto`, [`Settings::default`], no
+    /// checkpoint).
+    pub fn new(experiments: Vec<(String, Experiment)>, base: Params, fit: &[&str]) -> Config {
+        Config {
+            experiments,
+            base,
+            fit: fit.iter().map(|s| s.to_string()).collect(),
+            bounds: Vec::new(),
+            objectives: None,
+            weights: Vec::new(),
+            fidelity: FidelityChoice::Auto,
+            settings: Settings::default(),
+            checkpoint: None,
+            resume: false,
+        }
+    }
+}
+
 /// Why an identification could not run.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -159,7 +179,7 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
         if k < checkpoint.stage {
             // Finished before the resume.
             if let Some(v) = &checkpoint.stage0_best {
-                space = space_from(&space0, v)?;
+                space = space_from(&space0, v);
             }
             continue;
         }
@@ -171,7 +191,7 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
             checkpoint.stage0_best = Some(best.values.clone());
             checkpoint.stage = k;
             checkpoint.starts.clear();
-            space = space_from(&space0, &best.values)?;
+            space = space_from(&space0, &best.values);
             monitor.reset_best();
         }
         let joint = build(
@@ -224,7 +244,12 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
     let interrupted = monitor.stopped();
     if let Some(path) = &config.checkpoint {
         checkpoint.evaluations = monitor.evaluations();
-        let _ = checkpoint.write(path);
+        if let Err(e) = checkpoint.write(path) {
+            notes.push(format!(
+                "the checkpoint {} could not be written: {e}",
+                path.display()
+            ));
+        }
     }
 
     let mut warnings = notes;
@@ -356,10 +381,10 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
     Ok(Identified { result, params })
 }
 
-fn space_from(space0: &ParamSpace, values: &[f64]) -> Result<ParamSpace, IdentifyError> {
+fn space_from(space0: &ParamSpace, values: &[f64]) -> ParamSpace {
     let mut s = space0.clone();
     s.start = values.to_vec();
-    Ok(s)
+    s
 }
 
 /// Identity of a problem for checkpoints.
