@@ -59,6 +59,29 @@ fn kw_and_kg_from_the_worm_frequency_response_within_1_percent_from_50_percent_o
 }
 
 #[test]
+fn kw_and_kg_from_nonlinear_simulations_within_0_2_percent_from_40_percent_off() {
+    // Issue 4's speed reference case (+40 % starts). The linear fit alone ends at
+    // −0.36 % / −0.18 % on this nonlinear data (the bias of backlash and friction), so
+    // 0.2 % needs the nonlinear stage; it must converge in a few evaluations of the
+    // nonlinear test (docs/identification.md, `--model nonlinear`).
+    let base = preset_with("worm-gear", &[("Kw", 3.1e5 * 1.4), ("Kg", 850.0 * 1.4)]);
+    let mut c = config(
+        vec![fixture("worm-gear/frequency_response.json")],
+        base,
+        &["Kw", "Kg"],
+    );
+    c.fidelity = FidelityChoice::Nonlinear;
+    let r = run(&c);
+    assert_within(&r, &[("Kw", 3.1e5), ("Kg", 850.0)], 0.002);
+    let stage = &r.result.starts[0];
+    assert!(
+        stage.termination.starts_with("converged") && stage.iterations <= 6,
+        "{stage:?}"
+    );
+    assert_eq!(r.result.residuals[0].objective, "gain_curve");
+}
+
+#[test]
 fn kw_and_kb_of_the_roller_from_two_resonances() {
     let base = preset_with(
         "roller-gear-cam",

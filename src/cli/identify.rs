@@ -27,8 +27,8 @@ values.
 
 What each experiment feeds (--objective to choose):
   frequency_response  resonance: the measured resonance frequencies (peaks of the gain curve) \
-against the model's; also peak-amplitude (peak heights, dB: for Ciw, Cig) and gain-curve (the \
-whole gain curve, dB).
+against the model's; also peak-amplitude (peak heights, dB: for Ciw, Cig), gain-curve (the \
+whole gain curve, dB) and gain-near-peaks (the gain within ±3 % of each resonance).
   resonance           resonance (and peak-amplitude when the manifest has peak_gain_db).
   torque_curve        torque-curve: the motor torque of the closed-loop torque test, sample by \
 sample. A torque curve determines one Coulomb and one viscous sum (fm + fw·Rg + ft·Rg·Rw, and \
@@ -38,9 +38,10 @@ Default --fit: Kw (and Kg with a spur stage) from resonances; fm and Cm from a t
 hardly shows in its torque).
 
 The model's frequency response (--model): `linear` is the exact linear response with damping \
-(no backlash, no friction; microseconds); `nonlinear` searches on the linear one, then polishes \
-the best with Gauss–Newton on the virtual test at the experiment's conditions (amplitude, \
-preload; a time simulation per frequency, minutes); `auto` (default) searches on the linear \
+(no backlash, no friction; microseconds); `nonlinear` searches on the linear one, then \
+corrects that fit by the virtual test at the experiment's conditions (amplitude, preload; a \
+time simulation per frequency) until the gain near the measured peaks matches — a few \
+evaluations of the test, about a second for the worm fixture; `auto` (default) searches on the linear \
 one and then checks the result on the nonlinear test, warning when backlash or friction move \
 the resonances by more than 1 %. By default a gain curve feeds the resonance frequencies and, \
 at weight 0.01, the peak heights: the worm's two resonances alone admit two (Kw, Kg) pairs, \

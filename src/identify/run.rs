@@ -12,7 +12,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use super::result::{bounds_map, Checkpoint, ExperimentResidual, IdentifyResult, NonlinearCheck};
-use super::setup::{build, default_fit, has_frequency_response, ObjectiveKind, SetupError};
+use super::setup::{
+    build, build_with, default_fit, has_frequency_response, ObjectiveKind, SetupError,
+};
 use super::space::{Bound, ParamSpace, SpaceError};
 use super::uncertainty::{at_optimum, Uncertainty};
 use super::{search, Monitor, Settings, StartRecord};
@@ -135,11 +137,12 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
     if two_stage {
         stages.push(Stage {
             fidelity: Fidelity::Nonlinear,
+            // The settings of the linear sub-searches of the corrections.
             settings: Settings {
                 method: super::Method::Lsq,
                 starts: 1,
-                max_iters: 6,
-                fd_step: 1e-3,
+                max_iters: 50,
+                fd_step: if simulated { 1e-3 } else { 1e-5 },
                 ..config.settings
             },
         });
@@ -194,11 +197,17 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
             space = space_from(&space0, &best.values);
             monitor.reset_best();
         }
-        let joint = build(
+        let defaults = if k > 0 {
+            super::setup::default_nonlinear_objectives
+        } else {
+            super::setup::default_objectives
+        };
+        let joint = build_with(
             &config.experiments,
             config.objectives.as_deref(),
             &config.weights,
             stage.fidelity,
+            defaults,
         )?;
         let mut stage_settings = stage.settings;
         if stage_settings.method == super::Method::Lsq && joint.len() < space.dim() {
@@ -211,6 +220,28 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
                 joint.len(),
                 space.dim()
             ));
+        }
+        if k > 0 {
+            // The nonlinear stage: corrections of the linear fit (see `correction`).
+            let linear = build_with(
+                &config.experiments,
+                config.objectives.as_deref(),
+                &config.weights,
+                Fidelity::Linear,
+                defaults,
+            )?;
+            let out = super::correction::polish(
+                &space0,
+                &linear,
+                &joint,
+                &space.start,
+                &stage_settings,
+                monitor,
+            )?;
+            all_starts = vec![out.record];
+            objective = Some(joint);
+            last_fidelity = stage.fidelity;
+            continue;
         }
         let done = checkpoint.starts.clone();
         let saved = std::sync::Mutex::new(checkpoint.clone());
@@ -284,7 +315,9 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
             "{name} ended at its {side} bound: the data pull it further — widen --bound {name}=LO..HI, or another parameter (fixed now) must change"
         ));
     }
-    let residuals = residual_report(&joint, &params)?;
+    let parts = joint.part_residuals(&params)?;
+    let cost = joint.cost_of_parts(&parts);
+    let residuals = residual_report(&joint, parts);
     for r in &residuals {
         if let Some(miss) = r
             .detail
@@ -326,7 +359,7 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
                 );
             if worst > 1e-2 {
                 warnings.push(format!(
-                    "{}: fitted on the linear response, but the nonlinear virtual test at the measured conditions puts the resonances at {} Hz (measured {} Hz): a shift of up to {:.2} Hz (over 1 %, or out of the ±3 % band): backlash or friction bias the linear fit — use --model nonlinear (slower), or a preloaded test",
+                    "{}: fitted on the linear response, but the nonlinear virtual test at the measured conditions puts the resonances at {} Hz (measured {} Hz): a shift of up to {:.2} Hz (over 1 %): backlash or friction bias the linear fit — use --model nonlinear (slower), or a preloaded test",
                     c.source,
                     fmt_hz(&c.model_hz),
                     fmt_hz(&c.measured_hz),
@@ -367,7 +400,7 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
             .map(|s| s.fidelity.name())
             .collect::<Vec<_>>()
             .join(", then "),
-        cost: sum_of_squares(&joint.residuals(&params)?),
+        cost,
         residuals,
         evaluations: monitor.evaluations(),
         wall_time_s: clock.elapsed().as_secs_f64(),
@@ -412,10 +445,10 @@ fn fingerprint(config: &Config, space: &ParamSpace, two_stage: bool) -> String {
     )
 }
 
-/// Each part's residuals at the result, with the resonance misses in Hz.
-fn residual_report(joint: &Joint, p: &Params) -> Result<Vec<ExperimentResidual>, ObjectiveError> {
-    let parts = joint.part_residuals(p)?;
-    Ok(joint
+/// Each part's residuals at the result (`parts`, from [`Joint::part_residuals`]),
+/// with the resonance misses in Hz.
+fn residual_report(joint: &Joint, parts: Vec<Vec<f64>>) -> Vec<ExperimentResidual> {
+    joint
         .parts
         .iter()
         .zip(parts)
@@ -432,62 +465,38 @@ fn residual_report(joint: &Joint, p: &Params) -> Result<Vec<ExperimentResidual>,
                 detail,
             }
         })
-        .collect())
+        .collect()
 }
 
 /// The measured resonances against those of the nonlinear virtual test at the
 /// identified parameters, per frequency-response experiment — like for like: the
-/// test is simulated at the measured frequencies within ±3 % of each measured peak
-/// and its peak located as the measurement's was (a parabola through the highest
-/// point and its neighbours), so that at the true parameters it reproduces the
-/// measurement exactly and a difference is the linearisation's bias.
+/// test is simulated at the measured frequencies near each measured peak and its peak
+/// located as the measurement's was
+/// ([`crate::objectives::peak_search::nonlinear_peak_on_grid`]), so that at the true
+/// parameters it reproduces the measurement exactly and a difference is the
+/// linearisation's bias.
 fn nonlinear_check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, IdentifyError> {
-    use crate::io::experiment_file::{Data, Kind};
+    use crate::objectives::peak_search::nonlinear_peak_on_grid;
     let mut out = Vec::new();
     for (file, exp) in &config.experiments {
-        let Data::FrequencyResponse { frequency_hz, .. } = &exp.data else {
+        let Some(grid) = super::setup::measured_grid(exp) else {
             continue;
         };
-        debug_assert_eq!(exp.manifest.kind, Kind::FrequencyResponse);
         let measured: Vec<f64> = super::setup::measured_peaks(file, exp)?
             .iter()
             .map(|pk| pk.frequency_hz)
             .collect();
         let test = super::setup::frequency_test(exp);
-        let mut model = Vec::new();
-        for &f in &measured {
-            let near: Vec<f64> = frequency_hz
-                .iter()
-                .copied()
-                .filter(|&x| (x - f).abs() <= 0.03 * f)
-                .collect();
-            let gains = crate::objectives::peak_search::nonlinear_gains(p, &test, &near)
-                .map_err(ObjectiveError::from)?;
-            let k = gains
-                .iter()
-                .enumerate()
-                .max_by(|a, b| a.1.total_cmp(b.1))
-                .map_or(0, |(k, _)| k);
-            model.push(if near.len() >= 3 && k > 0 && k + 1 < near.len() {
-                crate::objectives::peak_search::vertex(
-                    (near[k - 1], gains[k - 1]),
-                    (near[k], gains[k]),
-                    (near[k + 1], gains[k + 1]),
-                )
-                .frequency_hz
-            } else {
-                // The maximum on the edge of the band: the peak moved out of it.
-                f64::NAN
-            });
-        }
+        let model = measured
+            .iter()
+            .map(|&f| nonlinear_peak_on_grid(p, &test, &grid, f).map(|pk| pk.frequency_hz))
+            .collect::<Result<Vec<f64>, _>>()
+            .map_err(ObjectiveError::from)?;
         let max_miss_hz = model
             .iter()
             .zip(&measured)
             .map(|(a, b)| (a - b).abs())
-            .fold(
-                0.0,
-                |a: f64, b| if b.is_nan() { f64::INFINITY } else { a.max(b) },
-            );
+            .fold(0.0, f64::max);
         out.push(NonlinearCheck {
             source: file.clone(),
             measured_hz: measured,

@@ -33,6 +33,16 @@ impl Joint {
         (part.weight / part.objective.len().max(1) as f64).sqrt()
     }
 
+    /// The joint cost from each part's own residuals (as [`Joint::part_residuals`]
+    /// gives them): Σ weight · mean(r²).
+    pub fn cost_of_parts(&self, parts: &[Vec<f64>]) -> f64 {
+        self.parts
+            .iter()
+            .zip(parts)
+            .map(|(part, r)| Self::factor(part).powi(2) * super::sum_of_squares(r))
+            .sum()
+    }
+
     /// Each part's own (unweighted) residuals, for reports.
     pub fn part_residuals(&self, p: &Params) -> Result<Vec<Vec<f64>>, ObjectiveError> {
         self.parts
@@ -96,5 +106,7 @@ mod tests {
         j.push("b", 0.5, Box::new(Constant(vec![4.0; 8])));
         let cost = sum_of_squares(&j.residuals(&p).unwrap());
         assert!((cost - (2.0 * 5.0 + 0.5 * 16.0)).abs() < 1e-12, "{cost}");
+        let from_parts = j.cost_of_parts(&j.part_residuals(&p).unwrap());
+        assert!((from_parts - cost).abs() < 1e-12, "{from_parts}");
     }
 }

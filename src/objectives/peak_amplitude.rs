@@ -26,6 +26,9 @@ pub struct PeakAmplitude {
     pub fidelity: Fidelity,
     pub test: FrequencyTest,
     pub band: (f64, f64),
+    /// The measured frequencies, on which the nonlinear model is sampled (like for
+    /// like), when the peaks come from a measured gain curve.
+    pub grid_hz: Option<Vec<f64>>,
 }
 
 impl PeakAmplitude {
@@ -38,7 +41,14 @@ impl PeakAmplitude {
             fidelity,
             test,
             band: (lo, hi),
+            grid_hz: None,
         }
+    }
+
+    /// Locate the nonlinear model's peaks on the measured frequencies `grid_hz`.
+    pub fn on_grid(mut self, grid_hz: Vec<f64>) -> Self {
+        self.grid_hz = Some(grid_hz);
+        self
     }
 }
 
@@ -48,7 +58,14 @@ impl Objective for PeakAmplitude {
     }
 
     fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
-        let peaks = model_peaks(p, self.fidelity, &self.test, self.band, self.measured.len())?;
+        let peaks = model_peaks(
+            p,
+            self.fidelity,
+            &self.test,
+            self.band,
+            self.measured.len(),
+            self.grid_hz.as_deref(),
+        )?;
         Ok(self
             .measured
             .iter()

@@ -159,21 +159,68 @@ pub fn nonlinear_peak(p: &Params, test: &FrequencyTest, guess_hz: f64) -> Result
     Ok(vertex((fine[0], g[0]), (fine[1], g[1]), (fine[2], g[2])))
 }
 
+/// Relative half-width of the band of measured frequencies in which
+/// [`nonlinear_peak_on_grid`] samples the model.
+pub const GRID_BAND: f64 = 0.03;
+
+/// The peak of the nonlinear virtual test near `guess_hz`, located as a measurement
+/// on the frequencies `grid_hz` locates its own: the test run at the grid's
+/// frequencies within ±[`GRID_BAND`] of the guess, a parabola through the highest
+/// point and its neighbours — like for like, so that at the parameters that made a
+/// measurement the model reproduces its peak exactly, whatever the nonlinear test's
+/// irregularities. If the band holds fewer than three frequencies, or its highest
+/// point is on its edge (the peak moved out of it), the grid-free
+/// [`nonlinear_peak`] is used instead.
+pub fn nonlinear_peak_on_grid(
+    p: &Params,
+    test: &FrequencyTest,
+    grid_hz: &[f64],
+    guess_hz: f64,
+) -> Result<Peak, SimError> {
+    let near: Vec<f64> = grid_hz
+        .iter()
+        .copied()
+        .filter(|&f| (f - guess_hz).abs() <= GRID_BAND * guess_hz)
+        .collect();
+    if near.len() < 3 {
+        return nonlinear_peak(p, test, guess_hz);
+    }
+    let gains = nonlinear_gains(p, test, &near)?;
+    let k = argmax(&gains);
+    if k == 0 || k + 1 == near.len() {
+        return nonlinear_peak(p, test, guess_hz);
+    }
+    Ok(vertex(
+        (near[k - 1], gains[k - 1]),
+        (near[k], gains[k]),
+        (near[k + 1], gains[k + 1]),
+    ))
+}
+
 /// The model's `n` resonances in the band: the highest linear peaks, each located in
-/// the nonlinear virtual test when `fidelity` asks for it (peaks in parallel).
+/// the nonlinear virtual test when `fidelity` asks for it (peaks in parallel) — on
+/// the measured frequencies `grid_hz` when they are given
+/// ([`nonlinear_peak_on_grid`]).
 pub fn model_peaks(
     p: &Params,
     fidelity: super::Fidelity,
     test: &FrequencyTest,
     band: (f64, f64),
     n: usize,
+    grid_hz: Option<&[f64]>,
 ) -> Result<Vec<Peak>, super::ObjectiveError> {
     let guesses = linear_peaks(p, band.0, band.1, n)?;
     match fidelity {
         super::Fidelity::Linear => Ok(guesses),
         super::Fidelity::Nonlinear => guesses
             .par_iter()
-            .map(|g| nonlinear_peak(p, test, g.frequency_hz).map_err(Into::into))
+            .map(|g| {
+                match grid_hz {
+                    Some(grid) => nonlinear_peak_on_grid(p, test, grid, g.frequency_hz),
+                    None => nonlinear_peak(p, test, g.frequency_hz),
+                }
+                .map_err(Into::into)
+            })
             .collect(),
     }
 }

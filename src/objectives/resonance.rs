@@ -5,7 +5,8 @@
 //! motor-held modes — never the undamped eigenvalues (fitting those to measured peaks
 //! biases Kw by ~6 %, MODEL.md §6). With [`Fidelity::Linear`] they come from the exact
 //! linear response with damping; with [`Fidelity::Nonlinear`] from the nonlinear
-//! virtual test at the experiment's conditions ([`super::peak_search`]).
+//! virtual test at the experiment's conditions ([`super::peak_search`]), sampled on
+//! the measured frequencies when there is a measured gain curve.
 //!
 //! Pairing: the model's `n` highest peaks in the band (n = measured peaks), in
 //! ascending frequency, against the measured ones in ascending frequency. A measured
@@ -29,6 +30,9 @@ pub struct ResonanceMatch {
     pub test: FrequencyTest,
     /// Band in which the model's peaks are sought, Hz.
     pub band: (f64, f64),
+    /// The measured frequencies, when the resonances come from a measured gain curve:
+    /// the nonlinear model is then sampled on them (like for like).
+    pub grid_hz: Option<Vec<f64>>,
 }
 
 impl ResonanceMatch {
@@ -42,7 +46,14 @@ impl ResonanceMatch {
             fidelity,
             test,
             band: (lo, hi),
+            grid_hz: None,
         }
+    }
+
+    /// Locate the nonlinear model's peaks on the measured frequencies `grid_hz`.
+    pub fn on_grid(mut self, grid_hz: Vec<f64>) -> Self {
+        self.grid_hz = Some(grid_hz);
+        self
     }
 
     /// The model's resonances paired with the measured ones (`None`: missing).
@@ -53,6 +64,7 @@ impl ResonanceMatch {
             &self.test,
             self.band,
             self.measured_hz.len(),
+            self.grid_hz.as_deref(),
         )?;
         Ok((0..self.measured_hz.len())
             .map(|k| peaks.get(k).map(|pk| pk.frequency_hz))
