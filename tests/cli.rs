@@ -809,3 +809,23 @@ mod experiments {
         );
     }
 }
+
+#[test]
+fn a_reader_that_closes_the_pipe_early_is_not_an_error() {
+    // `rtid modes … | head -0`: the reader is gone before the first line is written.
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rtid"))
+        .args(["modes", "--preset", "worm-gear"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the rtid binary runs");
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = stderr(&out);
+    assert!(
+        out.status.success() && !err.contains("panicked"),
+        "{}: {err}",
+        out.status
+    );
+}

@@ -38,7 +38,9 @@ pub struct IdentifyResult {
     /// Name → [lo, hi].
     pub bounds: BTreeMap<String, [f64; 2]>,
     pub method: String,
-    /// `linear`, `nonlinear`, or `linear, then nonlinear` (two stages).
+    /// The frequency-response model: `linear`, `nonlinear`, or `linear, then
+    /// nonlinear` (two stages); `nonlinear time simulation` when no experiment is a
+    /// frequency response (a torque curve is always simulated).
     pub fidelity: String,
     pub cost: f64,
     pub residuals: Vec<ExperimentResidual>,

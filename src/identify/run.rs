@@ -395,11 +395,16 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
             .collect(),
         bounds: bounds_map(&names, &space0.bounds),
         method: config.settings.method.name().into(),
-        fidelity: stages
-            .iter()
-            .map(|s| s.fidelity.name())
-            .collect::<Vec<_>>()
-            .join(", then "),
+        fidelity: if frequency_dependent(&config.experiments) {
+            stages
+                .iter()
+                .map(|s| s.fidelity.name())
+                .collect::<Vec<_>>()
+                .join(", then ")
+        } else {
+            // Torque curves and the like: always a time simulation.
+            "nonlinear time simulation".into()
+        },
         cost,
         residuals,
         evaluations: monitor.evaluations(),
@@ -412,6 +417,15 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
         warnings,
     };
     Ok(Identified { result, params })
+}
+
+/// Whether any experiment feeds a frequency-response objective, for which the
+/// fidelity (linear or nonlinear response) means something.
+fn frequency_dependent(experiments: &[(String, Experiment)]) -> bool {
+    use crate::io::experiment_file::Kind;
+    experiments
+        .iter()
+        .any(|(_, e)| matches!(e.manifest.kind, Kind::FrequencyResponse | Kind::Resonance))
 }
 
 fn space_from(space0: &ParamSpace, values: &[f64]) -> ParamSpace {
