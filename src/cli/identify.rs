@@ -134,8 +134,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         bounds.push(parse_bound(b).map_err(anyhow::Error::msg)?);
     }
     anyhow::ensure!(a.starts >= 1, "--starts must be at least 1");
+    // Objectives on a time simulation with quantised encoders: rough on the scale of
+    // finite differences.
     let has_torque = experiments.iter().any(|(_, e): &(String, Experiment)| {
-        e.manifest.kind == crate::io::experiment_file::Kind::TorqueCurve
+        use crate::io::experiment_file::Kind;
+        matches!(e.manifest.kind, Kind::TorqueCurve | Kind::Unbalance)
     });
     let config = Config {
         experiments,
@@ -281,6 +284,21 @@ fn print_summary(r: &crate::identify::result::IdentifyResult) {
             Some(d) if d.get("error_db").is_some() => {
                 format!("  errors {} dB", list(&d["error_db"]))
             }
+            Some(d) if d.get("measured_step_deg").is_some() => {
+                let model: Vec<String> = d["model_step_deg"]
+                    .as_array()
+                    .map(|a| {
+                        a.iter()
+                            .map(|x| x.as_f64().map_or("none".into(), |v| format!("{v:.3}")))
+                            .collect()
+                    })
+                    .unwrap_or_default();
+                format!(
+                    "  step angles measured {} °, model {} °",
+                    list3(&d["measured_step_deg"]),
+                    model.join(", ")
+                )
+            }
             Some(d) if d.get("rms_error_nm").is_some() => {
                 format!(
                     "  RMS error {:.4} N·m",
@@ -316,6 +334,17 @@ fn print_summary(r: &crate::identify::result::IdentifyResult) {
     for w in &r.warnings {
         println!("warning: {w}");
     }
+}
+
+fn list3(v: &serde_json::Value) -> String {
+    v.as_array()
+        .map(|a| {
+            a.iter()
+                .map(|x| format!("{:.3}", x.as_f64().unwrap_or(f64::NAN)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
+        .unwrap_or_default()
 }
 
 fn list(v: &serde_json::Value) -> String {
@@ -410,8 +439,46 @@ fn write_plots(
                     ],
                 )?;
             }
+            Data::Unbalance { .. } => plot_unbalance(&path, &title, exp, fitted)?,
             _ => {}
         }
     }
+    Ok(())
+}
+
+/// The measured deviation over table angle and the identified model's (a full run
+/// of the test at the file's conditions), one curve per direction each.
+fn plot_unbalance(path: &Path, title: &str, exp: &Experiment, fitted: &Params) -> anyhow::Result<()> {
+    use crate::experiments::fluctuation::{self, FluctuationTest};
+    let measured = fluctuation::evaluate_experiment(exp)?;
+    let test = FluctuationTest::from_conditions(exp)?;
+    let record = fluctuation::run(fitted, &test, |_, _| {})?;
+    let model = fluctuation::evaluate(&record, fitted.ratio())?;
+    let mut series = Vec::new();
+    for (who, e, style) in [
+        ("measured", &measured, Style::Line),
+        ("identified model", &model, Style::Dashed),
+    ] {
+        for p in &e.passes {
+            let every = p.angle_deg.len().div_ceil(3000).max(1);
+            let pts: Vec<(f64, f64)> = p
+                .angle_deg
+                .iter()
+                .copied()
+                .zip(p.deviation_arcsec.iter().copied())
+                .step_by(every)
+                .collect();
+            series.push(Series::new(format!("{who}, {}", p.direction), pts, style));
+        }
+    }
+    plot::write(
+        path,
+        &Chart {
+            title,
+            x_label: "table angle, deg",
+            y_label: "θt − θm·Rg·Rw, arc-sec",
+        },
+        &series,
+    )?;
     Ok(())
 }

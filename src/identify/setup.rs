@@ -8,7 +8,7 @@ use crate::io::experiment_file::{Data, Experiment, Kind};
 use crate::model::{ParamError, Params, Topology};
 use crate::objectives::{
     gain_curve::GainCurve, peak_amplitude::PeakAmplitude, resonance::ResonanceMatch,
-    torque_curve::TorqueResidual, Fidelity, Joint, Objective,
+    torque_curve::TorqueResidual, unbalance_step::UnbalanceStep, Fidelity, Joint, Objective,
 };
 
 /// An objective by name (`--objective`).
@@ -23,6 +23,9 @@ pub enum ObjectiveKind {
     GainCurve,
     /// Error of the motor torque of the torque test.
     TorqueCurve,
+    /// Error of the table angles where the unbalance test's deviation steps across
+    /// the backlash (the table friction ft).
+    UnbalanceStep,
 }
 
 /// Why experiments and objectives do not fit together.
@@ -38,8 +41,10 @@ pub enum SetupError {
         objective: ObjectiveKind,
         needs: &'static str,
     },
-    #[error("{file}: {kind} experiments are not used for identification (use frequency_response, resonance or torque_curve)")]
+    #[error("{file}: {kind} experiments are not used for identification (use frequency_response, resonance, torque_curve or unbalance)")]
     Unsupported { file: String, kind: &'static str },
+    #[error("{file}: {reason}")]
+    Data { file: String, reason: String },
     #[error("{file}: no resonance peak found in the gain curve")]
     NoPeaks { file: String },
     #[error("{given} weights for {count} experiments: give one --weight per experiment, in order")]
@@ -67,6 +72,7 @@ pub fn default_objectives(kind: Kind) -> Vec<(ObjectiveKind, f64)> {
         ],
         Kind::Resonance => vec![(ObjectiveKind::Resonance, 1.0)],
         Kind::TorqueCurve => vec![(ObjectiveKind::TorqueCurve, 1.0)],
+        Kind::Unbalance => vec![(ObjectiveKind::UnbalanceStep, 1.0)],
         _ => Vec::new(),
     }
 }
@@ -74,7 +80,8 @@ pub fn default_objectives(kind: Kind) -> Vec<(ObjectiveKind, f64)> {
 /// The parameters fitted when `--fit` is not given: the drive stiffnesses from
 /// resonances (Kw, and Kg where there is a spur stage), the motor's Coulomb friction
 /// and viscous damping from a torque curve (the table's reach the motor divided by
-/// the ratio, 1/90 for the worm, and hardly show in its torque).
+/// the ratio, 1/90 for the worm, and hardly show in its torque), the table's Coulomb
+/// friction ft from an unbalance test (where its step stands).
 pub fn default_fit(experiments: &[(String, Experiment)], p: &Params) -> Vec<String> {
     let mut fit: Vec<String> = Vec::new();
     let kinds: Vec<Kind> = experiments.iter().map(|(_, e)| e.manifest.kind).collect();
@@ -89,6 +96,9 @@ pub fn default_fit(experiments: &[(String, Experiment)], p: &Params) -> Vec<Stri
     }
     if kinds.contains(&Kind::TorqueCurve) {
         fit.extend(["fm".to_string(), "Cm".to_string()]);
+    }
+    if kinds.contains(&Kind::Unbalance) {
+        fit.push("ft".into());
     }
     fit
 }
@@ -255,6 +265,7 @@ fn usable(o: ObjectiveKind, kind: Kind) -> bool {
         ObjectiveKind::PeakAmplitude => matches!(kind, Kind::FrequencyResponse | Kind::Resonance),
         ObjectiveKind::GainCurve => kind == Kind::FrequencyResponse,
         ObjectiveKind::TorqueCurve => kind == Kind::TorqueCurve,
+        ObjectiveKind::UnbalanceStep => kind == Kind::Unbalance,
     }
 }
 
@@ -265,6 +276,7 @@ fn needs(o: ObjectiveKind) -> &'static str {
         }
         ObjectiveKind::GainCurve => "a frequency_response experiment",
         ObjectiveKind::TorqueCurve => "a torque_curve experiment",
+        ObjectiveKind::UnbalanceStep => "an unbalance experiment",
     }
 }
 
@@ -316,6 +328,17 @@ fn objective(
             )),
             _ => unreachable!("usable() admits torque_curve only"),
         },
+        ObjectiveKind::UnbalanceStep => {
+            Box::new(
+                UnbalanceStep::new(file, exp).map_err(|e| SetupError::Data {
+                    file: file.into(),
+                    reason: match e {
+                        crate::objectives::ObjectiveError::Data { reason, .. } => reason,
+                        other => other.to_string(),
+                    },
+                })?,
+            )
+        }
     })
 }
 

@@ -62,5 +62,5 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         )),
         ..a.run.test(a.speed_deg_per_min)?
     };
-    run_test(&a.common, &p, &test)
+    run_test(&a.common, &p, &test, &a.run)
 }
