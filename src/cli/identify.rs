@@ -448,7 +448,12 @@ fn write_plots(
 
 /// The measured deviation over table angle and the identified model's (a full run
 /// of the test at the file's conditions), one curve per direction each.
-fn plot_unbalance(path: &Path, title: &str, exp: &Experiment, fitted: &Params) -> anyhow::Result<()> {
+fn plot_unbalance(
+    path: &Path,
+    title: &str,
+    exp: &Experiment,
+    fitted: &Params,
+) -> anyhow::Result<()> {
     use crate::experiments::fluctuation::{self, FluctuationTest};
     let measured = fluctuation::evaluate_experiment(exp)?;
     let test = FluctuationTest::from_conditions(exp)?;

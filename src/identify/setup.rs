@@ -329,15 +329,13 @@ fn objective(
             _ => unreachable!("usable() admits torque_curve only"),
         },
         ObjectiveKind::UnbalanceStep => {
-            Box::new(
-                UnbalanceStep::new(file, exp).map_err(|e| SetupError::Data {
-                    file: file.into(),
-                    reason: match e {
-                        crate::objectives::ObjectiveError::Data { reason, .. } => reason,
-                        other => other.to_string(),
-                    },
-                })?,
-            )
+            Box::new(UnbalanceStep::new(file, exp).map_err(|e| SetupError::Data {
+                file: file.into(),
+                reason: match e {
+                    crate::objectives::ObjectiveError::Data { reason, .. } => reason,
+                    other => other.to_string(),
+                },
+            })?)
         }
     })
 }
