@@ -33,9 +33,13 @@ whole gain curve, dB).
   torque_curve        torque-curve: the motor torque of the closed-loop torque test, sample by \
 sample. A torque curve determines one Coulomb and one viscous sum (fm + fw·Rg + ft·Rg·Rw, and \
 the viscous alike): fit one of each.
+  unbalance           unbalance-step: the table angles where the deviation θt − θm·Rg·Rw steps \
+across the backlash (where the unbalance moment overcomes the table friction), model against \
+measured, 0.05° per unit. It determines ft (the manifest must give mass_kg and radius_m).
 Default --fit: Kw (and Kg with a spur stage) from resonances; fm and Cm from a torque curve \
 (the table's friction reaches the motor divided by the ratio — 1/90 for the worm — and \
-hardly shows in its torque).
+hardly shows in its torque); ft from an unbalance test. fm and ft together: give both files \
+and --fit fm,ft.
 
 The model's frequency response (--model): `linear` is the exact linear response with damping \
 (no backlash, no friction; microseconds); `nonlinear` searches on the linear one, then polishes \
@@ -50,7 +54,7 @@ biases Kw by ~6 %).
 Search: positive parameters in log space inside --bound (default 0.1×..10× the start); \
 --starts N starts (the preset's values, then a Latin hypercube in the bounds) in parallel; \
 --method lsq (Gauss–Newton with line search; default), nelder-mead (default with a torque \
-curve, whose quantised encoders make finite differences rough) or pso. Ctrl-C ends the \
+curve or an unbalance test, whose quantised encoders make finite differences rough) or pso. Ctrl-C ends the \
 search and still writes the best result; with --checkpoint FILE, --resume continues.
 
 Output: a table of parameter, start, identified ± standard error; warnings when the data \
@@ -63,7 +67,9 @@ wall_time_s, termination, uncertainty); an SVG per experiment of the fit against
 Examples:
   rtid identify fixtures/worm-gear/frequency_response.json --preset worm-gear --out fit.json
   rtid identify fixtures/worm-gear/frequency_response.json fixtures/worm-gear/torque_curve.json \\
-      --preset worm-gear --fit Kw,Kg,ft,Ct --out fit.json --save-params worm-fit.json
+      --preset worm-gear --fit Kw,Kg,fm,Cm --out fit.json --save-params worm-fit.json
+  rtid identify fixtures/worm-gear/torque_curve.json fixtures/worm-gear/unbalance.json \\
+      --preset worm-gear --fit fm,ft --out friction.json
   rtid identify fixtures/paper/worm-gear.json --preset worm-gear --fit Kw,Kg,Jt --model linear
   rtid modes --params worm-fit.json";
 

@@ -29,9 +29,10 @@ use crate::experiments::fluctuation::{
 use crate::io::experiment_file::{Direction, Experiment};
 use crate::model::Params;
 
-/// One scaled residual is this much table angle, deg: a twentieth of a degree, about
-/// 0.9 % of ft for the worm preset with 10 kg at 0.1 m (∂θ/∂ft = 1/(m·g·e) rad per
-/// N·m = 5.8°/N·m), and several times the locating error on encoder-quantised data.
+/// One scaled residual is this much table angle, deg: a twentieth of a degree, 0.009
+/// N·m = 3.3 % of ft for the worm preset with 10 kg at 0.1 m (∂θ/∂ft = 1/(m·g·e) rad
+/// per N·m = 5.8°/N·m), five times the locating error on the 4 ms encoder-quantised
+/// record, about the error with 2″ of table-angle noise.
 pub const SCALE_DEG: f64 = 0.05;
 /// Table travel before the locating window in the model's run, rad (5°: the step
 /// angles then equal the full run's; see the tests).
