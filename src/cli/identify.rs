@@ -33,9 +33,13 @@ whole gain curve, dB) and gain-near-peaks (the gain within ±3 % of each resonan
   torque_curve        torque-curve: the motor torque of the closed-loop torque test, sample by \
 sample. A torque curve determines one Coulomb and one viscous sum (fm + fw·Rg + ft·Rg·Rw, and \
 the viscous alike): fit one of each.
+  unbalance           unbalance-step: the table angles where the deviation θt − θm·Rg·Rw steps \
+across the backlash (where the unbalance moment overcomes the table friction), model against \
+measured, 0.05° per unit. It determines ft (the manifest must give mass_kg and radius_m).
 Default --fit: Kw (and Kg with a spur stage) from resonances; fm and Cm from a torque curve \
 (the table's friction reaches the motor divided by the ratio — 1/90 for the worm — and \
-hardly shows in its torque).
+hardly shows in its torque); ft from an unbalance test. fm and ft together: give both files \
+and --fit fm,ft.
 
 The model's frequency response (--model): `linear` is the exact linear response with damping \
 (no backlash, no friction; microseconds); `nonlinear` searches on the linear one, then \
@@ -51,7 +55,7 @@ biases Kw by ~6 %).
 Search: positive parameters in log space inside --bound (default 0.1×..10× the start); \
 --starts N starts (the preset's values, then a Latin hypercube in the bounds) in parallel; \
 --method lsq (Gauss–Newton with line search; default), nelder-mead (default with a torque \
-curve, whose quantised encoders make finite differences rough) or pso. Ctrl-C ends the \
+curve or an unbalance test, whose quantised encoders make finite differences rough) or pso. Ctrl-C ends the \
 search and still writes the best result; with --checkpoint FILE, --resume continues.
 
 Output: a table of parameter, start, identified ± standard error; warnings when the data \
@@ -64,7 +68,9 @@ wall_time_s, termination, uncertainty); an SVG per experiment of the fit against
 Examples:
   rtid identify fixtures/worm-gear/frequency_response.json --preset worm-gear --out fit.json
   rtid identify fixtures/worm-gear/frequency_response.json fixtures/worm-gear/torque_curve.json \\
-      --preset worm-gear --fit Kw,Kg,ft,Ct --out fit.json --save-params worm-fit.json
+      --preset worm-gear --fit Kw,Kg,fm,Cm --out fit.json --save-params worm-fit.json
+  rtid identify fixtures/worm-gear/torque_curve.json fixtures/worm-gear/unbalance.json \\
+      --preset worm-gear --fit fm,ft --out friction.json
   rtid identify fixtures/paper/worm-gear.json --preset worm-gear --fit Kw,Kg,Jt --model linear
   rtid modes --params worm-fit.json";
 
@@ -135,8 +141,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         bounds.push(parse_bound(b).map_err(anyhow::Error::msg)?);
     }
     anyhow::ensure!(a.starts >= 1, "--starts must be at least 1");
+    // Objectives on a time simulation with quantised encoders: rough on the scale of
+    // finite differences.
     let has_torque = experiments.iter().any(|(_, e): &(String, Experiment)| {
-        e.manifest.kind == crate::io::experiment_file::Kind::TorqueCurve
+        use crate::io::experiment_file::Kind;
+        matches!(e.manifest.kind, Kind::TorqueCurve | Kind::Unbalance)
     });
     let config = Config {
         experiments,
@@ -282,6 +291,21 @@ fn print_summary(r: &crate::identify::result::IdentifyResult) {
             Some(d) if d.get("error_db").is_some() => {
                 format!("  errors {} dB", list(&d["error_db"]))
             }
+            Some(d) if d.get("measured_step_deg").is_some() => {
+                let model: Vec<String> = d["model_step_deg"]
+                    .as_array()
+                    .map(|a| {
+                        a.iter()
+                            .map(|x| x.as_f64().map_or("none".into(), |v| format!("{v:.3}")))
+                            .collect()
+                    })
+                    .unwrap_or_default();
+                format!(
+                    "  step angles measured {} °, model {} °",
+                    list3(&d["measured_step_deg"]),
+                    model.join(", ")
+                )
+            }
             Some(d) if d.get("rms_error_nm").is_some() => {
                 format!(
                     "  RMS error {:.4} N·m",
@@ -317,6 +341,17 @@ fn print_summary(r: &crate::identify::result::IdentifyResult) {
     for w in &r.warnings {
         println!("warning: {w}");
     }
+}
+
+fn list3(v: &serde_json::Value) -> String {
+    v.as_array()
+        .map(|a| {
+            a.iter()
+                .map(|x| format!("{:.3}", x.as_f64().unwrap_or(f64::NAN)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
+        .unwrap_or_default()
 }
 
 fn list(v: &serde_json::Value) -> String {
@@ -411,8 +446,51 @@ fn write_plots(
                     ],
                 )?;
             }
+            Data::Unbalance { .. } => plot_unbalance(&path, &title, exp, fitted)?,
             _ => {}
         }
     }
+    Ok(())
+}
+
+/// The measured deviation over table angle and the identified model's (a full run
+/// of the test at the file's conditions), one curve per direction each.
+fn plot_unbalance(
+    path: &Path,
+    title: &str,
+    exp: &Experiment,
+    fitted: &Params,
+) -> anyhow::Result<()> {
+    use crate::experiments::fluctuation::{self, FluctuationTest};
+    let measured = fluctuation::evaluate_experiment(exp)?;
+    let test = FluctuationTest::from_conditions(exp)?;
+    let record = fluctuation::run(fitted, &test, |_, _| {})?;
+    let model = fluctuation::evaluate(&record, fitted.ratio())?;
+    let mut series = Vec::new();
+    for (who, e, style) in [
+        ("measured", &measured, Style::Line),
+        ("identified model", &model, Style::Dashed),
+    ] {
+        for p in &e.passes {
+            let every = p.angle_deg.len().div_ceil(3000).max(1);
+            let pts: Vec<(f64, f64)> = p
+                .angle_deg
+                .iter()
+                .copied()
+                .zip(p.deviation_arcsec.iter().copied())
+                .step_by(every)
+                .collect();
+            series.push(Series::new(format!("{who}, {}", p.direction), pts, style));
+        }
+    }
+    plot::write(
+        path,
+        &Chart {
+            title,
+            x_label: "table angle, deg",
+            y_label: "θt − θm·Rg·Rw, arc-sec",
+        },
+        &series,
+    )?;
     Ok(())
 }

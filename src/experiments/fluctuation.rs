@@ -42,6 +42,18 @@ pub const REVERSAL_THRESHOLD: f64 = 0.05 * std::f64::consts::PI / 180.0;
 /// The angle across which a step of the deviation is measured, rad (0.5°: a tenth of
 /// the worm's 5° fluctuation period, while crossing the backlash takes far less).
 pub const STEP_WINDOW: f64 = 0.5 * std::f64::consts::PI / 180.0;
+/// Half-width of the window in which a step is located precisely ([`locate_step`]),
+/// rad (5°: wider than the ~1.5° of rattling across the backlash, far narrower than
+/// the ~177° between the two steps of a pass).
+pub const STEP_LOCATE_HALF_WIDTH: f64 = 5.0 * std::f64::consts::PI / 180.0;
+/// The levels before and after a step are the mean deviation over this much table
+/// angle at each end of the locating window, rad (2.5°: a level's error moves the
+/// located step by (distance to the window's far end) × error / step size, so the
+/// levels average as many samples as the window leaves clear of the step).
+pub const STEP_LEVEL_SPAN: f64 = 2.5 * std::f64::consts::PI / 180.0;
+/// A change of the deviation counts as one of a pass's steps when it is at least this
+/// fraction of the pass's largest step.
+pub const STEP_MIN_FRACTION: f64 = 0.5;
 /// Unbalance used when neither the parameters nor the caller give one: 10 kg at 0.1 m.
 pub const DEFAULT_UNBALANCE: (f64, f64) = (10.0, 0.1);
 /// Dominant orders reported.
@@ -89,6 +101,47 @@ impl FluctuationTest {
             unbalance: Some((mass, radius)),
             ..Default::default()
         }
+    }
+
+    /// The test an experiment file describes: speed and loop from its conditions
+    /// (defaults of [`FluctuationTest::default`] / [`FluctuationTest::unbalance`]),
+    /// and for the unbalance kind the mass and radius, which must be given.
+    pub fn from_conditions(exp: &Experiment) -> Result<Self, FluctuationError> {
+        let c = &exp.manifest.conditions;
+        let bad = |field: &'static str, reason: String| FluctuationError::Condition {
+            path: exp.path.clone(),
+            field,
+            reason,
+        };
+        let mut test = if exp.manifest.kind == Kind::Unbalance {
+            let field = |v: Option<f64>, name: &'static str| match v {
+                Some(x) if x > 0.0 && x.is_finite() => Ok(x),
+                None => Err(bad(
+                    name,
+                    "missing: an unbalance test needs the mass and its radius".into(),
+                )),
+                Some(x) => Err(bad(name, format!("{x} is not a positive number"))),
+            };
+            FluctuationTest::unbalance(
+                field(c.mass_kg, "conditions.mass_kg")?,
+                field(c.radius_m, "conditions.radius_m")?,
+            )
+        } else {
+            FluctuationTest::default()
+        };
+        if let Some(v) = c.speed_deg_per_min {
+            if !(v > 0.0 && v.is_finite()) {
+                return Err(bad(
+                    "conditions.speed_deg_per_min",
+                    format!("{v} is not a positive number"),
+                ));
+            }
+            test.speed = v.to_radians() / 60.0;
+        }
+        if let Some(l) = c.loop_mode {
+            test.loop_mode = l;
+        }
+        Ok(test)
     }
 
     /// Which experiment this is.
@@ -175,18 +228,52 @@ pub fn test_params(params: &Params, test: &FluctuationTest) -> Params {
 pub fn run(
     params: &Params,
     test: &FluctuationTest,
+    progress: impl FnMut(usize, usize),
+) -> Result<Record, SimError> {
+    let reference = |t: f64| test.reference(t);
+    run_reference(params, test, &reference, test.duration(), progress)
+}
+
+/// The test's run through one window of table angle only: at rest at `from` (rad)
+/// for the test's dwell, then at the test's speed to `to`, recorded as [`run`] records
+/// (same servo, same encoders, same sampling). Start `from` a run-in before the angles
+/// of interest, so that the speed is steady there.
+pub fn run_window(
+    params: &Params,
+    test: &FluctuationTest,
+    from: f64,
+    to: f64,
+) -> Result<Record, SimError> {
+    let sense = (to - from).signum();
+    let ramp = (to - from).abs() / test.speed;
+    let reference = |t: f64| {
+        if t < test.dwell {
+            from
+        } else {
+            from + sense * test.speed * (t - test.dwell).min(ramp)
+        }
+    };
+    run_reference(params, test, &reference, test.dwell + ramp, |_, _| {})
+}
+
+/// Runs `reference` (table angle over time, starting at rest at `reference(0)`) for
+/// `duration` s with the test's loop, unbalance and encoders.
+fn run_reference(
+    params: &Params,
+    test: &FluctuationTest,
+    reference: &dyn Fn(f64) -> f64,
+    duration: f64,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Record, SimError> {
     let p = test_params(params, test);
     let mut sim = Simulation::with_default_step(&p)?;
-    let start = test.reference(0.0);
+    let start = reference(0.0);
     let mut y = sim.state();
     y[THETA_M] = start / p.ratio();
     y[THETA_W] = start / p.rw;
     y[THETA_T] = start;
     sim.set_state(y);
     let mut controller = sim.controller(&p)?;
-    let duration = test.duration();
     let every = ((test.sample_period / sim.dt()).round() as u64).max(1);
     let samples = (duration / sim.dt()) as usize / every as usize + 2;
     let counts = p.controller.motor_encoder_counts;
@@ -199,7 +286,6 @@ pub fn run(
         motor: Vec::with_capacity(samples),
         table: Vec::with_capacity(samples),
     };
-    let reference = |t: f64| test.reference(t);
     let total = duration.ceil() as usize;
     for second in 0..total {
         let chunk = (duration - second as f64).min(1.0);
@@ -300,6 +386,12 @@ pub enum FluctuationError {
     Lengths { motor: usize, table: usize },
     #[error("the table never moves more than {threshold_deg}° in one sense: nothing to evaluate")]
     NoMotion { threshold_deg: f64 },
+    #[error("{path}: {field}: {reason}")]
+    Condition {
+        path: PathBuf,
+        field: &'static str,
+        reason: String,
+    },
 }
 
 /// A step of the deviation.
@@ -335,9 +427,141 @@ pub struct Pass {
     pub dominant: Vec<Peak>,
     /// Largest step.
     pub step: Step,
+    /// Every step of at least [`STEP_MIN_FRACTION`] of the largest, at least
+    /// 2·[`STEP_LOCATE_HALF_WIDTH`] apart, located precisely ([`locate_step`]), in the
+    /// order travelled: an unbalance test shows two per revolution and direction.
+    pub steps: Vec<Step>,
+}
+
+/// The advance-only samples of one direction pass (module docs, step 1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassSamples {
+    /// +1 up (CCW), −1 down (CW).
+    pub sense: f64,
+    /// sense·θt, rad, strictly increasing.
+    pub x: Vec<f64>,
+    /// Deviation θt − θm·ratio there, arc-sec.
+    pub deviation_arcsec: Vec<f64>,
+}
+
+impl PassSamples {
+    /// The direction of the pass.
+    pub fn direction(&self) -> Direction {
+        if self.sense > 0.0 {
+            Direction::Up
+        } else {
+            Direction::Down
+        }
+    }
+}
+
+/// The passes of a record with at least 4 advancing samples each, in the order run.
+pub fn pass_samples(record: &Record, ratio: f64) -> Vec<PassSamples> {
+    let table = &record.table_angle;
+    let mut out = Vec::new();
+    for (first, last, sense) in passes(table) {
+        let (mut x, mut d) = (Vec::new(), Vec::new());
+        let motor = &record.motor_angle[first..=last];
+        for (&t, &m) in table[first..=last].iter().zip(motor) {
+            let xi = sense * t;
+            if x.last().map_or(true, |&l| xi > l) {
+                x.push(xi);
+                d.push((t - ratio * m) * ARCSEC_PER_RAD);
+            }
+        }
+        if x.len() >= 4 {
+            out.push(PassSamples {
+                sense,
+                x,
+                deviation_arcsec: d,
+            });
+        }
+    }
+    out
+}
+
+/// ∫ of the piecewise-linear interpolant of (x, y) over [a, b] (inside [x₀, xₙ]).
+fn integral(x: &[f64], y: &[f64], a: f64, b: f64) -> f64 {
+    let at = |v: f64| {
+        let k = x.partition_point(|&xi| xi < v).clamp(1, x.len() - 1);
+        let (x0, x1) = (x[k - 1], x[k]);
+        y[k - 1] + (y[k] - y[k - 1]) * (v - x0) / (x1 - x0)
+    };
+    let lo = x.partition_point(|&xi| xi <= a);
+    let hi = x.partition_point(|&xi| xi < b);
+    let mut sum = 0.0;
+    let (mut px, mut py) = (a, at(a));
+    for k in lo..hi {
+        sum += 0.5 * (py + y[k]) * (x[k] - px);
+        (px, py) = (x[k], y[k]);
+    }
+    sum + 0.5 * (py + at(b)) * (b - px)
+}
+
+/// A step located precisely: in the window `center` ± `half_width` of a pass (in
+/// x = sense·θt, clipped to the samples), the levels before and after are the mean
+/// deviation over the first and last [`STEP_LEVEL_SPAN`] of it, and the position is
+/// where an ideal step between those levels with the same area under the curve would
+/// stand: x_a + ∫(after − d)dx / (after − before). Exact for a sharp step on flat
+/// levels; the rattle across the backlash averages out instead of deciding it; and it
+/// moves continuously with the data (an optimiser can follow it). Returns (position
+/// in x, rad; size after − before, arc-sec), `None` when the window holds less than
+/// three level spans (each at most half of `half_width`) or the levels are equal.
+pub fn locate_step(pass: &PassSamples, center: f64, half_width: f64) -> Option<(f64, f64)> {
+    let (x, d) = (&pass.x, &pass.deviation_arcsec);
+    let a = (center - half_width).max(x[0]);
+    let b = (center + half_width).min(x[x.len() - 1]);
+    let span = STEP_LEVEL_SPAN.min(0.5 * half_width);
+    if b - a < 3.0 * span {
+        return None;
+    }
+    let before = integral(x, d, a, a + span) / span;
+    let after = integral(x, d, b - span, b) / span;
+    let size = after - before;
+    if size == 0.0 || !size.is_finite() {
+        return None;
+    }
+    let position = a + ((b - a) * after - integral(x, d, a, b)) / size;
+    Some((position.clamp(a, b), size))
+}
+
+/// The steps of a pass: the changes across [`STEP_WINDOW`] on the uniform grid
+/// (`grid_x`, `dev`) of at least [`STEP_MIN_FRACTION`] of the largest, taken greedily
+/// from the largest at least 2·[`STEP_LOCATE_HALF_WIDTH`] apart, each then located
+/// with [`locate_step`] on the samples; in the order travelled.
+fn find_steps(pass: &PassSamples, grid_x: &[f64], dev: &[f64], w: usize) -> Vec<Step> {
+    let m = dev.len();
+    let change: Vec<(f64, f64)> = (0..m - w)
+        .map(|j| (0.5 * (grid_x[j] + grid_x[j + w]), dev[j + w] - dev[j]))
+        .collect();
+    let largest = change.iter().fold(0.0f64, |a, c| a.max(c.1.abs()));
+    let mut candidates: Vec<&(f64, f64)> = change
+        .iter()
+        .filter(|c| largest > 0.0 && c.1.abs() >= STEP_MIN_FRACTION * largest)
+        .collect();
+    candidates.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+    let mut centres: Vec<f64> = Vec::new();
+    for c in candidates {
+        if centres
+            .iter()
+            .all(|&x| (x - c.0).abs() >= 2.0 * STEP_LOCATE_HALF_WIDTH)
+        {
+            centres.push(c.0);
+        }
+    }
+    centres.sort_by(f64::total_cmp);
+    centres
+        .into_iter()
+        .filter_map(|c| locate_step(pass, c, STEP_LOCATE_HALF_WIDTH))
+        .map(|(x, size)| Step {
+            size_arcsec: size,
+            angle_deg: (pass.sense * x).to_degrees(),
+        })
+        .collect()
 }
 
 /// The evaluation of a fluctuation or unbalance record.
+
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Evaluation {
     /// Table turns per motor turn used.
@@ -432,20 +656,8 @@ pub fn evaluate(record: &Record, ratio: f64) -> Result<Evaluation, FluctuationEr
         });
     }
     let mut out = Vec::new();
-    for (first, last, sense) in passes(table) {
-        // Advance-only samples, in x = sense·θ (increasing).
-        let (mut x, mut d) = (Vec::new(), Vec::new());
-        let motor = &record.motor_angle[first..=last];
-        for (&t, &m) in table[first..=last].iter().zip(motor) {
-            let xi = sense * t;
-            if x.last().map_or(true, |&l| xi > l) {
-                x.push(xi);
-                d.push((t - ratio * m) * ARCSEC_PER_RAD);
-            }
-        }
-        if x.len() < 4 {
-            continue;
-        }
+    for samples in pass_samples(record, ratio) {
+        let (x, d, sense) = (&samples.x, &samples.deviation_arcsec, samples.sense);
         let travel = x[x.len() - 1] - x[0];
         let revolutions = (travel / TAU + 1e-9).floor() as u32;
         let span = if revolutions > 0 {
@@ -456,7 +668,7 @@ pub fn evaluate(record: &Record, ratio: f64) -> Result<Evaluation, FluctuationEr
         let x0 = x[0] + 0.5 * (travel - span);
         let inside = x.iter().filter(|&&v| v >= x0 && v <= x0 + span).count();
         let m = inside.max(1024).next_power_of_two();
-        let dev = spectrum::resample(&x, &d, x0, span, m);
+        let dev = spectrum::resample(x, d, x0, span, m);
         let (lo, hi) = dev
             .iter()
             .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
@@ -474,12 +686,11 @@ pub fn evaluate(record: &Record, ratio: f64) -> Result<Evaluation, FluctuationEr
             })
             .max_by(|a, b| a.size_arcsec.abs().total_cmp(&b.size_arcsec.abs()))
             .expect("m > w");
+        let grid_x: Vec<f64> = (0..m).map(|j| x0 + span * j as f64 / m as f64).collect();
+        let steps = find_steps(&samples, &grid_x, &dev, w);
         out.push(Pass {
-            direction: if sense > 0.0 {
-                Direction::Up
-            } else {
-                Direction::Down
-            },
+            direction: samples.direction(),
+            steps,
             revolutions,
             mean_arcsec: dev.iter().sum::<f64>() / m as f64,
             pp_arcsec: hi - lo,
@@ -587,6 +798,14 @@ pub fn table(e: &Evaluation, kind: Kind) -> String {
             "\nstep: {:.2}″ at table angle {:.1}°",
             e.step.size_arcsec, e.step.angle_deg
         );
+        for p in &e.passes {
+            let list: Vec<String> = p
+                .steps
+                .iter()
+                .map(|st| format!("{:.2}″ at {:.3}°", st.size_arcsec, st.angle_deg))
+                .collect();
+            s += &format!("\nsteps {} (located): {}", p.direction, list.join(", "));
+        }
     }
     s
 }
@@ -705,6 +924,39 @@ mod tests {
             (gap - 2.0 * 5e-5 * ARCSEC_PER_RAD).abs() < 0.01 * gap,
             "{gap}"
         );
+    }
+
+    #[test]
+    fn a_sharp_step_is_located_where_it_stands_and_its_size_kept() {
+        // 33″ at x = 1.2345 rad on flat levels, sampled every 0.02°, the window off
+        // centre by 2°: within half a sample interval (linear interpolation puts a
+        // jump between two samples in their middle); with ±4″ of rattle over 1.5°
+        // after the step: within 0.02°.
+        let at = 1.2345;
+        let x: Vec<f64> = (0..5000).map(|i| (i as f64 * 0.02).to_radians()).collect();
+        let step = |v: f64| if v > at { 33.0 } else { 0.0 };
+        let rattle = |v: f64| {
+            let u = (v - at).to_degrees();
+            if (0.0..1.5).contains(&u) {
+                4.0 * (u * 40.0).sin()
+            } else {
+                0.0
+            }
+        };
+        for (extra, tol) in [(false, 0.0101), (true, 0.02)] {
+            let pass = PassSamples {
+                sense: 1.0,
+                deviation_arcsec: x
+                    .iter()
+                    .map(|&v| step(v) + if extra { rattle(v) } else { 0.0 })
+                    .collect(),
+                x: x.clone(),
+            };
+            let (pos, size) =
+                locate_step(&pass, at + 2f64.to_radians(), STEP_LOCATE_HALF_WIDTH).unwrap();
+            assert!((pos - at).to_degrees().abs() < tol, "{pos} {extra}");
+            assert!((size - 33.0).abs() < 1e-9, "{size}");
+        }
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! Measurement noise for virtual experiments (seeded, Gaussian), so that fixtures
 //! can stand in for real data: a gain curve's amplitude ratio or a torque record
-//! disturbed by a given percentage.
+//! disturbed by a given percentage, an angle record by a given standard deviation.
 
 use rand::{rngs::StdRng, SeedableRng};
 use rand_distr::{Distribution, Normal};
@@ -32,6 +32,19 @@ pub fn perturb_by_rms(values: &mut [f64], percent: f64, seed: u64) {
     }
 }
 
+/// Adds N(0, σ²) to every sample (σ in the values' unit): e.g. encoder-reading noise
+/// on an angle record.
+pub fn perturb_absolute(values: &mut [f64], sigma: f64, seed: u64) {
+    if sigma <= 0.0 {
+        return;
+    }
+    let normal = Normal::new(0.0, sigma).expect("finite σ");
+    let mut rng = StdRng::seed_from_u64(seed);
+    for v in values {
+        *v += normal.sample(&mut rng);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -45,5 +58,9 @@ mod tests {
         let mut b = vec![2.0; 20_000];
         perturb_by_rms(&mut b, 1.0, 3);
         assert_eq!(a, b);
+        let mut c = vec![0.0; 20_000];
+        perturb_absolute(&mut c, 0.5, 4);
+        let sd = (c.iter().map(|v| v * v).sum::<f64>() / c.len() as f64).sqrt();
+        assert!((sd / 0.5 - 1.0).abs() < 0.03, "{sd}");
     }
 }

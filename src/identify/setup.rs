@@ -9,7 +9,7 @@ use crate::model::{ParamError, Params, Topology};
 use crate::objectives::peak_search::GRID_BAND;
 use crate::objectives::{
     gain_curve::GainCurve, peak_amplitude::PeakAmplitude, resonance::ResonanceMatch,
-    torque_curve::TorqueResidual, Fidelity, Joint, Objective,
+    torque_curve::TorqueResidual, unbalance_step::UnbalanceStep, Fidelity, Joint, Objective,
 };
 
 /// An objective by name (`--objective`).
@@ -28,6 +28,9 @@ pub enum ObjectiveKind {
     GainNearPeaks,
     /// Error of the motor torque of the torque test.
     TorqueCurve,
+    /// Error of the table angles where the unbalance test's deviation steps across
+    /// the backlash (the table friction ft).
+    UnbalanceStep,
 }
 
 /// Why experiments and objectives do not fit together.
@@ -43,8 +46,10 @@ pub enum SetupError {
         objective: ObjectiveKind,
         needs: &'static str,
     },
-    #[error("{file}: {kind} experiments are not used for identification (use frequency_response, resonance or torque_curve)")]
+    #[error("{file}: {kind} experiments are not used for identification (use frequency_response, resonance, torque_curve or unbalance)")]
     Unsupported { file: String, kind: &'static str },
+    #[error("{file}: {reason}")]
+    Data { file: String, reason: String },
     #[error("{file}: no resonance peak found in the gain curve")]
     NoPeaks { file: String },
     #[error("{given} weights for {count} experiments: give one --weight per experiment, in order")]
@@ -72,6 +77,7 @@ pub fn default_objectives(kind: Kind) -> Vec<(ObjectiveKind, f64)> {
         ],
         Kind::Resonance => vec![(ObjectiveKind::Resonance, 1.0)],
         Kind::TorqueCurve => vec![(ObjectiveKind::TorqueCurve, 1.0)],
+        Kind::Unbalance => vec![(ObjectiveKind::UnbalanceStep, 1.0)],
         _ => Vec::new(),
     }
 }
@@ -79,7 +85,8 @@ pub fn default_objectives(kind: Kind) -> Vec<(ObjectiveKind, f64)> {
 /// The parameters fitted when `--fit` is not given: the drive stiffnesses from
 /// resonances (Kw, and Kg where there is a spur stage), the motor's Coulomb friction
 /// and viscous damping from a torque curve (the table's reach the motor divided by
-/// the ratio, 1/90 for the worm, and hardly show in its torque).
+/// the ratio, 1/90 for the worm, and hardly show in its torque), the table's Coulomb
+/// friction ft from an unbalance test (where its step stands).
 pub fn default_fit(experiments: &[(String, Experiment)], p: &Params) -> Vec<String> {
     let mut fit: Vec<String> = Vec::new();
     let kinds: Vec<Kind> = experiments.iter().map(|(_, e)| e.manifest.kind).collect();
@@ -94,6 +101,9 @@ pub fn default_fit(experiments: &[(String, Experiment)], p: &Params) -> Vec<Stri
     }
     if kinds.contains(&Kind::TorqueCurve) {
         fit.extend(["fm".to_string(), "Cm".to_string()]);
+    }
+    if kinds.contains(&Kind::Unbalance) {
+        fit.push("ft".into());
     }
     fit
 }
@@ -285,6 +295,7 @@ fn usable(o: ObjectiveKind, kind: Kind) -> bool {
         ObjectiveKind::PeakAmplitude => matches!(kind, Kind::FrequencyResponse | Kind::Resonance),
         ObjectiveKind::GainCurve | ObjectiveKind::GainNearPeaks => kind == Kind::FrequencyResponse,
         ObjectiveKind::TorqueCurve => kind == Kind::TorqueCurve,
+        ObjectiveKind::UnbalanceStep => kind == Kind::Unbalance,
     }
 }
 
@@ -297,6 +308,7 @@ fn needs(o: ObjectiveKind) -> &'static str {
             "a frequency_response experiment"
         }
         ObjectiveKind::TorqueCurve => "a torque_curve experiment",
+        ObjectiveKind::UnbalanceStep => "an unbalance experiment",
     }
 }
 
@@ -372,6 +384,15 @@ fn objective(
             )),
             _ => unreachable!("usable() admits torque_curve only"),
         },
+        ObjectiveKind::UnbalanceStep => {
+            Box::new(UnbalanceStep::new(file, exp).map_err(|e| SetupError::Data {
+                file: file.into(),
+                reason: match e {
+                    crate::objectives::ObjectiveError::Data { reason, .. } => reason,
+                    other => other.to_string(),
+                },
+            })?)
+        }
     })
 }
 

@@ -8,6 +8,8 @@
 //! - [`peak_amplitude`]: dB error of the resonance peak heights;
 //! - [`gain_curve`]: dB error of the whole gain curve at the measured frequencies;
 //! - [`torque_curve`]: error of the motor torque of the closed-loop torque test;
+//! - [`unbalance_step`]: error of the table angles where the unbalance test's
+//!   deviation steps across the backlash (the table friction ft);
 //! - [`joint`]: several of these, weighted, as one.
 //!
 //! Every objective is a plain `Sync` struct holding the measured data; the simulator
@@ -21,6 +23,7 @@ pub mod peak_amplitude;
 pub mod peak_search;
 pub mod resonance;
 pub mod torque_curve;
+pub mod unbalance_step;
 
 use crate::model::{ParamError, Params};
 use crate::sim::SimError;

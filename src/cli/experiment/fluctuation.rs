@@ -59,6 +59,14 @@ pub struct RunArgs {
     /// Recording interval, seconds.
     #[arg(long, value_name = "SECONDS", default_value_t = 4e-3)]
     pub sample_period_s: f64,
+    /// Measurement noise on the table angle reading: Gaussian, this standard
+    /// deviation in arc-seconds (the motor angle, which enters the deviation divided
+    /// by the ratio, stays as the encoder read it).
+    #[arg(long, value_name = "ARCSEC", default_value_t = 0.0)]
+    pub noise_arcsec: f64,
+    /// Seed of the measurement noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
 }
 
 /// A positive finite flag value.
@@ -94,18 +102,44 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
     a.common.create_out()?;
     let test = a.run.test(a.speed_deg_per_min)?;
-    run_test(&a.common, &p, &test)
+    run_test(&a.common, &p, &test, &a.run)
 }
 
-/// Runs `test`, writes its experiment file and reports it (fluctuation and unbalance).
-pub fn run_test(common: &Common, p: &Params, test: &FluctuationTest) -> anyhow::Result<()> {
+/// Runs `test`, writes its experiment file (with the measurement noise of `run`) and
+/// reports it (fluctuation and unbalance).
+pub fn run_test(
+    common: &Common,
+    p: &Params,
+    test: &FluctuationTest,
+    run: &RunArgs,
+) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        run.noise_arcsec >= 0.0 && run.noise_arcsec.is_finite(),
+        "--noise-arcsec {}: must be zero or positive",
+        run.noise_arcsec
+    );
     let name = test.kind().name();
     let bar = progress::bar(test.duration().ceil() as u64, name, common.quiet);
-    let record = fluctuation::run(p, test, |done, _| bar.set_position(done as u64))?;
+    let mut record = fluctuation::run(p, test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
+    let sigma = run.noise_arcsec / crate::experiments::iso230::ARCSEC_PER_RAD;
+    crate::experiments::measurement_noise::perturb_absolute(
+        &mut record.table_angle,
+        sigma,
+        run.seed,
+    );
+    let mut manifest = fluctuation::manifest(p, test);
+    if run.noise_arcsec > 0.0 {
+        manifest.notes = Some(format!(
+            "{}; Gaussian noise of {}″ (standard deviation) on the table angle (seed {})",
+            manifest.notes.unwrap_or_default(),
+            run.noise_arcsec,
+            run.seed
+        ));
+    }
     common.write_and_report(
         name,
-        fluctuation::manifest(p, test),
+        manifest,
         &fluctuation::to_data(&record, test.kind()),
         report,
     )

@@ -15,8 +15,11 @@ Outputs, in --out DIR: unbalance.json/.csv, unbalance.svg (deviation θt − θm
 table angle per direction) and unbalance-spectrum.svg. Printed: as for fluctuation, plus \
 the step: the largest change of the deviation across 0.5° of table angle and where it \
 happens. Where the unbalance moment overcomes the drive's friction the table crosses the \
-backlash: a worm gear shows a step of about its lost motion (≈ 33″); a preloaded roller \
-gear cam shows none.
+backlash: a worm gear shows a step of about its lost motion (≈ 33″) twice per revolution \
+and direction; a preloaded roller gear cam shows none. Every step of at least half the \
+largest is listed, located to a fraction of a degree (where an ideal step with the same \
+area under the curve would stand, in a ±5° window): `rtid identify` fits the table friction \
+ft to these angles. --noise-arcsec adds Gaussian noise to the table angle readings.
 
 Example:
   rtid experiment unbalance --preset worm-gear --out runs/worm
@@ -62,5 +65,5 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         )),
         ..a.run.test(a.speed_deg_per_min)?
     };
-    run_test(&a.common, &p, &test)
+    run_test(&a.common, &p, &test, &a.run)
 }
