@@ -343,8 +343,9 @@ fn the_torque_curve_cannot_separate_motor_from_shaft_friction_but_coulomb_from_v
     // must fire. fm and Cm (Coulomb against viscous) it separates: no warning. The
     // Jacobian step is ±0.1 in ln p: the quantised encoders make the simulated motor
     // torque jitter, and at smaller steps that jitter, not the friction, fills the
-    // columns (at identify's 2e-3 every correlation of the six friction parameters
-    // comes out under 0.2; docs/identification.md).
+    // columns (at 2e-3, identify's step for such fits until then, every correlation
+    // of the six friction parameters comes out under 0.2; identify now uses 0.1;
+    // docs/identification.md).
     let u = torque_curve_uncertainty(&["fm", "fw"], 0.1);
     eprintln!("fm–fw: {:+.4}", u.correlation[0][1]);
     assert!(
