@@ -169,6 +169,12 @@ fn motor_friction_and_viscous_damping_from_the_torque_curve_within_5_percent() {
         c.settings.max_iters = 60;
         let r = run(&c);
         assert_within(&r, &[("fm", 0.14), ("Cm", 8.0e-3)], 0.05);
+        // The standard errors of such a fit are lower bounds, and the result says so.
+        assert!(
+            r.result.warnings.iter().any(|w| w.contains("lower bounds")),
+            "{:?}",
+            r.result.warnings
+        );
     }
 }
 

@@ -53,7 +53,9 @@ the heights tell them apart. Resonances are peaks of the damped response, never 
 biases Kw by ~6 %).
 
 Search: positive parameters in log space inside --bound (default 0.1×..10× the start); \
---starts N starts (the preset's values, then a Latin hypercube in the bounds) in parallel; \
+--starts N starts (the preset's values, then a Latin hypercube in the bounds) in parallel \
+(default 4; 1 with a torque curve or an unbalance test, whose every evaluation is a closed-loop \
+simulation); \
 --method lsq (Gauss–Newton with line search; default), nelder-mead (default with a torque \
 curve or an unbalance test, whose quantised encoders make finite differences rough) or pso. Ctrl-C ends the \
 search and still writes the best result; with --checkpoint FILE, --resume continues.
@@ -100,9 +102,10 @@ pub struct Args {
     /// Frequency-response model of the objectives.
     #[arg(long = "model", value_enum, default_value = "auto")]
     pub fidelity: FidelityChoice,
-    /// Number of starts.
-    #[arg(long, default_value_t = 4)]
-    pub starts: usize,
+    /// Number of starts [default: 4; 1 when a torque curve or an unbalance test is
+    /// fitted: each of its evaluations is seconds of closed-loop simulation].
+    #[arg(long)]
+    pub starts: Option<usize>,
     /// Seed of the Latin hypercube and of the particle swarm.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -140,13 +143,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     for b in &a.bounds {
         bounds.push(parse_bound(b).map_err(anyhow::Error::msg)?);
     }
-    anyhow::ensure!(a.starts >= 1, "--starts must be at least 1");
-    // Objectives on a time simulation with quantised encoders: rough on the scale of
-    // finite differences.
+    // Objectives on a closed-loop time simulation with quantised encoders: rough on
+    // the scale of finite differences, and seconds per evaluation.
     let has_torque = experiments.iter().any(|(_, e): &(String, Experiment)| {
         use crate::io::experiment_file::Kind;
         matches!(e.manifest.kind, Kind::TorqueCurve | Kind::Unbalance)
     });
+    let starts = a.starts.unwrap_or(if has_torque { 1 } else { 4 });
+    anyhow::ensure!(starts >= 1, "--starts must be at least 1");
     let config = Config {
         experiments,
         base,
@@ -166,7 +170,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             } else {
                 Method::Lsq
             }),
-            starts: a.starts,
+            starts,
             seed: a.seed,
             max_iters: a.max_iters,
             ..Settings::default()
