@@ -16,7 +16,7 @@ use super::setup::{
     build, build_with, default_fit, has_frequency_response, ObjectiveKind, SetupError,
 };
 use super::space::{Bound, ParamSpace, SpaceError};
-use super::uncertainty::{at_optimum, Uncertainty};
+use super::uncertainty::{with_residuals, Uncertainty};
 use super::{search, Monitor, Settings, StartRecord};
 use crate::io::experiment_file::Experiment;
 use crate::model::Params;
@@ -316,8 +316,10 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
             "{name} ended at its {side} bound: the data pull it further — widen --bound {name}=LO..HI, or another parameter (fixed now) must change"
         ));
     }
+    // One evaluation at the result serves the report, the cost and the uncertainty.
     let parts = joint.part_residuals(&params)?;
-    let cost = joint.cost_of_parts(&parts);
+    let stacked = joint.stack(&parts);
+    let cost = sum_of_squares(&stacked);
     let residuals = residual_report(&joint, parts);
     for r in &residuals {
         if let Some(miss) = r
@@ -338,7 +340,7 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
         None
     } else {
         let step = uncertainty_step(simulated, last_fidelity);
-        let u = at_optimum(&space0, &joint, &best.values, step)?;
+        let u = with_residuals(&space0, &joint, &best.values, &stacked, step)?;
         warnings.extend(u.warnings.iter().cloned());
         if simulated {
             warnings.push(ROUGH_COST.into());

@@ -43,9 +43,20 @@ pub fn at_optimum(
     values: &[f64],
     step: f64,
 ) -> Result<Uncertainty, ObjectiveError> {
+    let r0 = objective.residuals(&space.params(values)?)?;
+    with_residuals(space, objective, values, &r0, step)
+}
+
+/// [`at_optimum`] when the residuals `r0` at `values` are known already.
+pub fn with_residuals(
+    space: &ParamSpace,
+    objective: &dyn Objective,
+    values: &[f64],
+    r0: &[f64],
+    step: f64,
+) -> Result<Uncertainty, ObjectiveError> {
     let n = space.dim();
     let names: Vec<String> = space.names.iter().map(|s| s.to_string()).collect();
-    let r0 = objective.residuals(&space.params(values)?)?;
     let m = r0.len();
     // Each column: ∂r/∂ln p (log parameters) or ∂r/∂p scaled by the range.
     let shifted = |j: usize, sign: f64| -> Result<Vec<f64>, ObjectiveError> {

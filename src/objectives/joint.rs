@@ -33,14 +33,17 @@ impl Joint {
         (part.weight / part.objective.len().max(1) as f64).sqrt()
     }
 
-    /// The joint cost from each part's own residuals (as [`Joint::part_residuals`]
-    /// gives them): Σ weight · mean(r²).
-    pub fn cost_of_parts(&self, parts: &[Vec<f64>]) -> f64 {
+    /// The joint residuals from each part's own: what [`Objective::residuals`] of the
+    /// joint returns, without evaluating it again.
+    pub fn stack(&self, parts: &[Vec<f64>]) -> Vec<f64> {
         self.parts
             .iter()
             .zip(parts)
-            .map(|(part, r)| Self::factor(part).powi(2) * super::sum_of_squares(r))
-            .sum()
+            .flat_map(|(part, r)| {
+                let k = Self::factor(part);
+                r.iter().map(move |x| k * x)
+            })
+            .collect()
     }
 
     /// Each part's own (unweighted) residuals, for reports.
@@ -106,7 +109,7 @@ mod tests {
         j.push("b", 0.5, Box::new(Constant(vec![4.0; 8])));
         let cost = sum_of_squares(&j.residuals(&p).unwrap());
         assert!((cost - (2.0 * 5.0 + 0.5 * 16.0)).abs() < 1e-12, "{cost}");
-        let from_parts = j.cost_of_parts(&j.part_residuals(&p).unwrap());
-        assert!((from_parts - cost).abs() < 1e-12, "{from_parts}");
+        let parts = j.part_residuals(&p).unwrap();
+        assert_eq!(j.stack(&parts), j.residuals(&p).unwrap());
     }
 }

@@ -8,7 +8,7 @@
 //! has ζ ≈ 7.5e-5 (0.025 Hz half-power width): a measurement on a 1 Hz grid
 //! under-estimates such a peak by tens of dB, so compare like with like.
 
-use super::peak_search::model_peaks;
+use super::peak_search::ModelPeaks;
 use super::{cost_function, Fidelity, Objective, ObjectiveError};
 use crate::experiments::frequency_response::{FrequencyTest, Peak};
 use crate::model::Params;
@@ -23,31 +23,25 @@ const MISSING_DB: f64 = 40.0;
 pub struct PeakAmplitude {
     /// Ascending in frequency.
     pub measured: Vec<Peak>,
-    pub fidelity: Fidelity,
-    pub test: FrequencyTest,
-    pub band: (f64, f64),
-    /// The measured frequencies, on which the nonlinear model is sampled (like for
-    /// like), when the peaks come from a measured gain curve.
-    pub grid_hz: Option<Vec<f64>>,
+    /// Where and how the model's peaks are found.
+    pub model: ModelPeaks,
 }
 
 impl PeakAmplitude {
     pub fn new(mut measured: Vec<Peak>, fidelity: Fidelity, test: FrequencyTest) -> Self {
         measured.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-        let lo = measured.first().map_or(10.0, |p| p.frequency_hz) / 3.0;
-        let hi = measured.last().map_or(600.0, |p| p.frequency_hz) * 3.0;
-        PeakAmplitude {
-            measured,
+        let model = ModelPeaks::new(
+            measured.first().map_or(10.0, |p| p.frequency_hz),
+            measured.last().map_or(600.0, |p| p.frequency_hz),
             fidelity,
             test,
-            band: (lo, hi),
-            grid_hz: None,
-        }
+        );
+        PeakAmplitude { measured, model }
     }
 
     /// Locate the nonlinear model's peaks on the measured frequencies `grid_hz`.
     pub fn on_grid(mut self, grid_hz: Vec<f64>) -> Self {
-        self.grid_hz = Some(grid_hz);
+        self.model.grid_hz = Some(grid_hz);
         self
     }
 }
@@ -58,14 +52,7 @@ impl Objective for PeakAmplitude {
     }
 
     fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
-        let peaks = model_peaks(
-            p,
-            self.fidelity,
-            &self.test,
-            self.band,
-            self.measured.len(),
-            self.grid_hz.as_deref(),
-        )?;
+        let peaks = self.model.locate(p, self.measured.len())?;
         Ok(self
             .measured
             .iter()

@@ -197,31 +197,56 @@ pub fn nonlinear_peak_on_grid(
     ))
 }
 
-/// The model's `n` resonances in the band: the highest linear peaks, each located in
-/// the nonlinear virtual test when `fidelity` asks for it (peaks in parallel) — on
-/// the measured frequencies `grid_hz` when they are given
-/// ([`nonlinear_peak_on_grid`]).
-pub fn model_peaks(
-    p: &Params,
-    fidelity: super::Fidelity,
-    test: &FrequencyTest,
-    band: (f64, f64),
-    n: usize,
-    grid_hz: Option<&[f64]>,
-) -> Result<Vec<Peak>, super::ObjectiveError> {
-    let guesses = linear_peaks(p, band.0, band.1, n)?;
-    match fidelity {
-        super::Fidelity::Linear => Ok(guesses),
-        super::Fidelity::Nonlinear => guesses
-            .par_iter()
-            .map(|g| {
-                match grid_hz {
-                    Some(grid) => nonlinear_peak_on_grid(p, test, grid, g.frequency_hz),
-                    None => nonlinear_peak(p, test, g.frequency_hz),
-                }
-                .map_err(Into::into)
-            })
-            .collect(),
+/// How the objectives that compare peaks ([`super::resonance`],
+/// [`super::peak_amplitude`]) find the model's: at which fidelity, in which band,
+/// under which test conditions, and on which measured frequencies.
+#[derive(Clone, Debug)]
+pub struct ModelPeaks {
+    pub fidelity: super::Fidelity,
+    /// Conditions of the nonlinear virtual test.
+    pub test: FrequencyTest,
+    /// Band in which the model's peaks are sought, Hz.
+    pub band: (f64, f64),
+    /// The measured frequencies, when the peaks come from a measured gain curve: the
+    /// nonlinear model is then sampled on them (like for like).
+    pub grid_hz: Option<Vec<f64>>,
+}
+
+impl ModelPeaks {
+    /// For measured peaks from `lowest_hz` to `highest_hz`: the band is a third of the
+    /// lowest to three times the highest.
+    pub fn new(
+        lowest_hz: f64,
+        highest_hz: f64,
+        fidelity: super::Fidelity,
+        test: FrequencyTest,
+    ) -> Self {
+        ModelPeaks {
+            fidelity,
+            test,
+            band: (lowest_hz / 3.0, highest_hz * 3.0),
+            grid_hz: None,
+        }
+    }
+
+    /// The model's `n` resonances in the band: the highest linear peaks, each located
+    /// in the nonlinear virtual test when the fidelity asks for it (peaks in parallel)
+    /// — on the measured frequencies when they are given ([`nonlinear_peak_on_grid`]).
+    pub fn locate(&self, p: &Params, n: usize) -> Result<Vec<Peak>, super::ObjectiveError> {
+        let guesses = linear_peaks(p, self.band.0, self.band.1, n)?;
+        match self.fidelity {
+            super::Fidelity::Linear => Ok(guesses),
+            super::Fidelity::Nonlinear => guesses
+                .par_iter()
+                .map(|g| {
+                    match &self.grid_hz {
+                        Some(grid) => nonlinear_peak_on_grid(p, &self.test, grid, g.frequency_hz),
+                        None => nonlinear_peak(p, &self.test, g.frequency_hz),
+                    }
+                    .map_err(Into::into)
+                })
+                .collect(),
+        }
     }
 }
 

@@ -12,7 +12,7 @@
 //! ascending frequency, against the measured ones in ascending frequency. A measured
 //! peak the model does not have costs a residual of 100 % of its frequency.
 
-use super::peak_search::model_peaks;
+use super::peak_search::ModelPeaks;
 use super::{cost_function, Fidelity, Objective, ObjectiveError};
 use crate::experiments::frequency_response::FrequencyTest;
 use crate::model::Params;
@@ -25,47 +25,31 @@ pub const SCALE: f64 = 1e-3;
 pub struct ResonanceMatch {
     /// Hz, ascending.
     pub measured_hz: Vec<f64>,
-    pub fidelity: Fidelity,
-    /// Conditions of the nonlinear virtual test.
-    pub test: FrequencyTest,
-    /// Band in which the model's peaks are sought, Hz.
-    pub band: (f64, f64),
-    /// The measured frequencies, when the resonances come from a measured gain curve:
-    /// the nonlinear model is then sampled on them (like for like).
-    pub grid_hz: Option<Vec<f64>>,
+    /// Where and how the model's resonances are found.
+    pub model: ModelPeaks,
 }
 
 impl ResonanceMatch {
-    /// The band is a third of the lowest to three times the highest measured peak.
     pub fn new(mut measured_hz: Vec<f64>, fidelity: Fidelity, test: FrequencyTest) -> Self {
         measured_hz.sort_by(f64::total_cmp);
-        let lo = measured_hz.first().copied().unwrap_or(10.0) / 3.0;
-        let hi = measured_hz.last().copied().unwrap_or(600.0) * 3.0;
-        ResonanceMatch {
-            measured_hz,
+        let model = ModelPeaks::new(
+            measured_hz.first().copied().unwrap_or(10.0),
+            measured_hz.last().copied().unwrap_or(600.0),
             fidelity,
             test,
-            band: (lo, hi),
-            grid_hz: None,
-        }
+        );
+        ResonanceMatch { measured_hz, model }
     }
 
     /// Locate the nonlinear model's peaks on the measured frequencies `grid_hz`.
     pub fn on_grid(mut self, grid_hz: Vec<f64>) -> Self {
-        self.grid_hz = Some(grid_hz);
+        self.model.grid_hz = Some(grid_hz);
         self
     }
 
     /// The model's resonances paired with the measured ones (`None`: missing).
     pub fn model_hz(&self, p: &Params) -> Result<Vec<Option<f64>>, ObjectiveError> {
-        let peaks = model_peaks(
-            p,
-            self.fidelity,
-            &self.test,
-            self.band,
-            self.measured_hz.len(),
-            self.grid_hz.as_deref(),
-        )?;
+        let peaks = self.model.locate(p, self.measured_hz.len())?;
         Ok((0..self.measured_hz.len())
             .map(|k| peaks.get(k).map(|pk| pk.frequency_hz))
             .collect())
