@@ -5,14 +5,15 @@
 //! results → report.
 #![forbid(unsafe_code)]
 
-pub mod cli;
 pub mod controller;
 pub mod experiments;
 pub mod identify;
 pub mod input;
 pub mod io;
 pub mod model;
+pub mod names;
 pub mod objectives;
+pub mod peaks;
 pub mod recorder;
 pub mod report;
 pub mod sim;

@@ -1,7 +1,8 @@
 //! The virtual frequency-response test (MODEL.md §5.1).
 
-use rtid::experiments::frequency_response::{linear, peaks, sweep, FrequencyTest};
+use rtid::experiments::frequency_response::{linear, sweep, FrequencyTest};
 use rtid::model::{presets, Params};
+use rtid::peaks::maxima as peaks;
 
 /// The preset made linear: no backlash, no Coulomb friction, no fluctuation.
 fn linear_limit(name: &str) -> Params {

@@ -1,7 +1,7 @@
 //! The frequency response estimated from raw time series (MODEL.md §5.1, recorded as a
 //! `frequency_response_time` file) against the exact linear response.
 
-use rtid::experiments::frequency_response::{linear, peaks};
+use rtid::experiments::frequency_response::linear;
 use rtid::experiments::frequency_response_estimate::{
     evaluate_experiment, EstimateOptions, Evaluation,
 };
@@ -10,6 +10,7 @@ use rtid::experiments::frequency_response_record::{
 };
 use rtid::io::experiment_file::{self, Experiment};
 use rtid::model::{presets, Params};
+use rtid::peaks::maxima as peaks;
 
 /// The preset made linear: no backlash, no Coulomb friction, no fluctuation.
 fn linear_limit(name: &str) -> Params {

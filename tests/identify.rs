@@ -7,7 +7,7 @@ use rtid::identify::setup::ObjectiveKind;
 use rtid::identify::{identify, Bound, Config, FidelityChoice, Identified, Method, Monitor};
 use rtid::io::experiment_file::{self, Data, Experiment, Kind, Manifest};
 use rtid::model::{presets, Params};
-use rtid::objectives::peak_search::linear_peaks;
+use rtid::peaks::of_linear_response as linear_peaks;
 
 fn fixture(path: &str) -> (String, Experiment) {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))

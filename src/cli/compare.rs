@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
-use crate::experiments::compare::{self, Summary, THRESHOLD_ARCSEC};
+use rtid::experiments::compare::{self, Summary, THRESHOLD_ARCSEC};
 
 pub const LONG_ABOUT: &str = "\
 Compares two rotary tables as the paper's Table 3 (§5, \"Comparison between driving \

@@ -7,7 +7,7 @@ use anyhow::bail;
 use super::experiment::{
     fluctuation, frequency_response, frequency_response_time, positioning, torque_curve,
 };
-use crate::io::experiment_file::{self, Kind};
+use rtid::io::experiment_file::{self, Kind};
 
 pub const LONG_ABOUT: &str = "\
 Evaluates an experiment file (a JSON manifest with its CSV, docs/experiment-files.md), \

@@ -9,14 +9,13 @@ use anyhow::Context;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use super::ModelArgs;
-use crate::identify::setup::ObjectiveKind;
-use crate::identify::space::parse_bound;
-use crate::identify::{identify, Config, FidelityChoice, Identified, Method, Monitor, Settings};
-use crate::io::experiment_file::{self, Data, Experiment};
-use crate::io::params_file;
-use crate::model::Params;
-use crate::objectives::peak_search::LinearGain;
-use crate::report::plot::{self, Chart, Series, Style};
+use rtid::identify::comparison;
+use rtid::identify::setup::ObjectiveKind;
+use rtid::identify::space::parse_bound;
+use rtid::identify::{identify, Config, FidelityChoice, Identified, Method, Monitor, Settings};
+use rtid::io::experiment_file::{self, Experiment};
+use rtid::io::params_file;
+use rtid::model::Params;
 
 pub const LONG_ABOUT: &str = "\
 Identifies physical parameters of the drive — torsional stiffnesses Kw, Kg, Kb, internal \
@@ -92,16 +91,16 @@ pub struct Args {
     pub bounds: Vec<String>,
     /// Objectives to use (default: by experiment kind, see above).
     #[arg(long, value_delimiter = ',', value_enum)]
-    pub objective: Option<Vec<ObjectiveKind>>,
+    pub objective: Option<Vec<ObjectiveArg>>,
     /// Weight of each experiment in the joint cost, in the order given (default 1 each).
     #[arg(long = "weight", value_delimiter = ',', allow_negative_numbers = true)]
     pub weights: Vec<f64>,
     /// Solver (default: lsq; nelder-mead when a torque curve is fitted).
     #[arg(long, value_enum)]
-    pub method: Option<Method>,
+    pub method: Option<MethodArg>,
     /// Frequency-response model of the objectives.
     #[arg(long = "model", value_enum, default_value = "auto")]
-    pub fidelity: FidelityChoice,
+    pub fidelity: FidelityArg,
     /// Number of starts [default: 4; 1 when a torque curve or an unbalance test is
     /// fitted: each of its evaluations is seconds of closed-loop simulation].
     #[arg(long)]
@@ -132,6 +131,80 @@ pub struct Args {
     pub quiet: bool,
 }
 
+/// The solver (`--method`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// Gauss–Newton with line search, finite-difference Jacobian in parallel.
+    Lsq,
+    /// Nelder–Mead simplex.
+    NelderMead,
+    /// Particle swarm in the bounds.
+    Pso,
+}
+
+impl From<MethodArg> for Method {
+    fn from(m: MethodArg) -> Method {
+        match m {
+            MethodArg::Lsq => Method::Lsq,
+            MethodArg::NelderMead => Method::NelderMead,
+            MethodArg::Pso => Method::Pso,
+        }
+    }
+}
+
+/// The frequency-response model (`--model`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FidelityArg {
+    /// The linear response for the search, then the nonlinear virtual test at the
+    /// result as a check of the linearisation (a warning if it moves the peaks).
+    Auto,
+    /// The linear response only.
+    Linear,
+    /// The linear response for every start, then corrections of that fit by the
+    /// nonlinear virtual test.
+    Nonlinear,
+}
+
+impl From<FidelityArg> for FidelityChoice {
+    fn from(f: FidelityArg) -> FidelityChoice {
+        match f {
+            FidelityArg::Auto => FidelityChoice::Auto,
+            FidelityArg::Linear => FidelityChoice::Linear,
+            FidelityArg::Nonlinear => FidelityChoice::Nonlinear,
+        }
+    }
+}
+
+/// An objective (`--objective`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ObjectiveArg {
+    /// Relative error of the resonance frequencies.
+    Resonance,
+    /// dB error of the resonance peak heights.
+    PeakAmplitude,
+    /// dB error of the gain at every measured frequency.
+    GainCurve,
+    /// dB error of the gain within ±3 % of each resonance.
+    GainNearPeaks,
+    /// Error of the motor torque of the torque test.
+    TorqueCurve,
+    /// Error of the table angles where the unbalance test's deviation steps.
+    UnbalanceStep,
+}
+
+impl From<ObjectiveArg> for ObjectiveKind {
+    fn from(o: ObjectiveArg) -> ObjectiveKind {
+        match o {
+            ObjectiveArg::Resonance => ObjectiveKind::Resonance,
+            ObjectiveArg::PeakAmplitude => ObjectiveKind::PeakAmplitude,
+            ObjectiveArg::GainCurve => ObjectiveKind::GainCurve,
+            ObjectiveArg::GainNearPeaks => ObjectiveKind::GainNearPeaks,
+            ObjectiveArg::TorqueCurve => ObjectiveKind::TorqueCurve,
+            ObjectiveArg::UnbalanceStep => ObjectiveKind::UnbalanceStep,
+        }
+    }
+}
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     let base = a.model.load()?;
     let mut experiments = Vec::new();
@@ -146,7 +219,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // Objectives on a closed-loop time simulation with quantised encoders: rough on
     // the scale of finite differences, and seconds per evaluation.
     let has_torque = experiments.iter().any(|(_, e): &(String, Experiment)| {
-        use crate::io::experiment_file::Kind;
+        use rtid::io::experiment_file::Kind;
         matches!(e.manifest.kind, Kind::TorqueCurve | Kind::Unbalance)
     });
     let starts = a.starts.unwrap_or(if has_torque { 1 } else { 4 });
@@ -161,11 +234,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             .filter(|s| !s.is_empty())
             .collect(),
         bounds,
-        objectives: a.objective.clone(),
+        objectives: a
+            .objective
+            .as_ref()
+            .map(|v| v.iter().map(|&o| o.into()).collect()),
         weights: a.weights.clone(),
-        fidelity: a.fidelity,
+        fidelity: a.fidelity.into(),
         settings: Settings {
-            method: a.method.unwrap_or(if has_torque {
+            method: a.method.map(Method::from).unwrap_or(if has_torque {
                 Method::NelderMead
             } else {
                 Method::Lsq
@@ -256,7 +332,7 @@ fn spinner(monitor: &Arc<Monitor>, quiet: bool) -> Option<Spinner> {
     Some((bar, done, handle))
 }
 
-fn print_summary(r: &crate::identify::result::IdentifyResult) {
+fn print_summary(r: &rtid::identify::result::IdentifyResult) {
     let mut t = Table::new();
     t.load_preset(UTF8_FULL_CONDENSED);
     t.set_header([
@@ -378,123 +454,10 @@ fn write_plots(
 ) -> anyhow::Result<()> {
     let stem = out.with_extension("");
     for (k, (file, exp)) in experiments.iter().enumerate() {
-        let path = PathBuf::from(format!("{}-{}.svg", stem.display(), k + 1));
-        let title = format!("identification: {file}");
-        match &exp.data {
-            Data::FrequencyResponse {
-                frequency_hz,
-                gain_db,
-                ..
-            } => {
-                let curve = |p: &Params| -> Vec<(f64, f64)> {
-                    let Ok(lin) = LinearGain::new(p) else {
-                        return Vec::new();
-                    };
-                    let (lo, hi) = (frequency_hz[0], frequency_hz[frequency_hz.len() - 1]);
-                    (0..=600)
-                        .map(|i| lo + (hi - lo) * i as f64 / 600.0)
-                        .map(|f| (f, lin.gain_db(f)))
-                        .collect()
-                };
-                let measured: Vec<(f64, f64)> = frequency_hz
-                    .iter()
-                    .copied()
-                    .zip(gain_db.iter().copied())
-                    .collect();
-                plot::write(
-                    &path,
-                    &Chart {
-                        title: &title,
-                        x_label: "frequency, Hz",
-                        y_label: "gain θt/(θm·Rg·Rw), dB",
-                    },
-                    &[
-                        Series::new("measured", measured, Style::Markers),
-                        Series::new("linear model, start", curve(start), Style::Dashed),
-                        Series::new("linear model, identified", curve(fitted), Style::Line),
-                    ],
-                )?;
-            }
-            Data::TorqueCurve {
-                time_s,
-                motor_torque_nm,
-                ..
-            } => {
-                let test = crate::experiments::torque_curve::TorqueTest::from_conditions(
-                    &exp.manifest.conditions,
-                );
-                let model =
-                    crate::experiments::torque_curve::simulate_torque(fitted, &test, time_s)?;
-                plot::write(
-                    &path,
-                    &Chart {
-                        title: &title,
-                        x_label: "time, s",
-                        y_label: "motor torque, N·m",
-                    },
-                    &[
-                        Series::new(
-                            "measured",
-                            time_s
-                                .iter()
-                                .copied()
-                                .zip(motor_torque_nm.iter().copied())
-                                .collect(),
-                            Style::Line,
-                        ),
-                        Series::new(
-                            "identified model",
-                            time_s.iter().copied().zip(model).collect(),
-                            Style::Dashed,
-                        ),
-                    ],
-                )?;
-            }
-            Data::Unbalance { .. } => plot_unbalance(&path, &title, exp, fitted)?,
-            _ => {}
+        if let Some(c) = comparison::compare(file, exp, start, fitted)? {
+            let path = PathBuf::from(format!("{}-{}.svg", stem.display(), k + 1));
+            rtid::report::identify::comparison(&c).write(&path)?;
         }
     }
-    Ok(())
-}
-
-/// The measured deviation over table angle and the identified model's (a full run
-/// of the test at the file's conditions), one curve per direction each.
-fn plot_unbalance(
-    path: &Path,
-    title: &str,
-    exp: &Experiment,
-    fitted: &Params,
-) -> anyhow::Result<()> {
-    use crate::experiments::fluctuation::{self, FluctuationTest};
-    let measured = fluctuation::evaluate_experiment(exp)?;
-    let test = FluctuationTest::from_conditions(exp)?;
-    let record = fluctuation::run(fitted, &test, |_, _| {})?;
-    let model = fluctuation::evaluate(&record, fitted.ratio())?;
-    let mut series = Vec::new();
-    for (who, e, style) in [
-        ("measured", &measured, Style::Line),
-        ("identified model", &model, Style::Dashed),
-    ] {
-        for p in &e.passes {
-            let every = p.angle_deg.len().div_ceil(3000).max(1);
-            let pts: Vec<(f64, f64)> = p
-                .angle_deg
-                .iter()
-                .copied()
-                .zip(p.deviation_arcsec.iter().copied())
-                .step_by(every)
-                .collect();
-            series.push(Series::new(format!("{who}, {}", p.direction), pts, style));
-        }
-    }
-    plot::write(
-        path,
-        &Chart {
-            title,
-            x_label: "table angle, deg",
-            y_label: "θt − θm·Rg·Rw, arc-sec",
-        },
-        &series,
-    )?;
     Ok(())
 }

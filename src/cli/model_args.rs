@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use anyhow::{bail, Context};
 use clap::Args;
 
-use crate::io::params_file;
-use crate::model::{presets, Params};
+use rtid::io::params_file;
+use rtid::model::{presets, Params};
 
 /// Which parameter set to use, and overrides.
 #[derive(Debug, Clone, Args)]

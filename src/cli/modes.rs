@@ -3,7 +3,7 @@
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use super::ModelArgs;
-use crate::model::modes;
+use rtid::model::modes;
 
 pub const LONG_ABOUT: &str = "\
 Natural frequencies and mode shapes of the linearised drive: meshes without backlash, \

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use super::ModelArgs;
-use crate::io::params_file;
-use crate::model::params::PARAMS;
+use rtid::io::params_file;
+use rtid::model::params::PARAMS;
 
 pub const LONG_ABOUT: &str = "\
 Lists every parameter of a mechanism with its value, SI unit and meaning, and the notes on \

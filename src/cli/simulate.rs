@@ -9,11 +9,11 @@ use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use super::ModelArgs;
-use crate::input::{Move, NoTorque, Samples, Sine, Step};
-use crate::io::{atomic, torque_file};
-use crate::model::{idx::*, LoopMode, NSTATE};
-use crate::recorder::Recorder;
-use crate::sim::{Simulation, STATE_NAMES};
+use rtid::input::{Move, NoTorque, Samples, Sine, Step};
+use rtid::io::{atomic, torque_file};
+use rtid::model::{idx::*, LoopMode, NSTATE};
+use rtid::recorder::Recorder;
+use rtid::sim::{Simulation, STATE_NAMES};
 
 pub const LONG_ABOUT: &str = "\
 Integrates the nonlinear model (backlash, stick-slip friction, gear fluctuation, servo) \
@@ -122,7 +122,11 @@ impl FromStr for InputSpec {
             "move" => InputSpec::Move {
                 target_deg: fields.number("target_deg")?,
                 speed_deg_per_min: fields.optional("speed_deg_per_min")?,
-                loop_mode: fields.take("loop").map(|v| v.parse()).transpose()?,
+                loop_mode: fields
+                    .take("loop")
+                    .map(|v| v.parse())
+                    .transpose()
+                    .map_err(|e: rtid::names::UnknownName| e.to_string())?,
             },
             "none" => InputSpec::None,
             other => {
@@ -206,7 +210,7 @@ impl<W: Write> Recorder for CsvRecorder<W> {
         row.push(format!("{motor_torque:.9e}"));
         row.extend(y.iter().map(|v| format!("{v:.12e}")));
         if let Some((m, _)) = &self.reference {
-            use crate::input::Trajectory;
+            use rtid::input::Trajectory;
             row.push(format!("{:.12e}", m.angle(t)));
         }
         if let Err(e) = self.out.write_record(&row) {
@@ -336,7 +340,7 @@ fn write_csv(
     closed: bool,
     simulate: impl FnOnce(
         &mut CsvRecorder<&mut std::io::BufWriter<&std::fs::File>>,
-    ) -> Result<(), crate::sim::SimError>,
+    ) -> Result<(), rtid::sim::SimError>,
     every: u64,
 ) -> anyhow::Result<()> {
     let result: anyhow::Result<()> = atomic::write_with(path, |w| {

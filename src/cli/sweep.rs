@@ -1,12 +1,13 @@
 //! `rtid sweep` and `rtid sweep merge`: sensitivity sweeps from the command line.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use super::{progress, ModelArgs};
-use crate::sweep::{self, analysis::Indices, Method, Output, RunOptions, Shard, Sweep, TestLength};
+use rtid::report::sweep as figures;
+use rtid::sweep::{self, analysis::Indices, Method, Output, RunOptions, Shard, Sweep, TestLength};
 
 pub const LONG_ABOUT: &str = "\
 What-if studies: how the resonances, the reversal value, the fluctuation or the torque \
@@ -179,7 +180,7 @@ impl RunArgs {
         }
         let mut outputs = Vec::new();
         for o in &self.outputs {
-            let o: Output = o.parse().map_err(anyhow::Error::msg)?;
+            let o: Output = o.parse().context("--outputs")?;
             if !outputs.contains(&o) {
                 outputs.push(o);
             }
@@ -268,15 +269,49 @@ fn run_sweep(a: RunArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     let (_, rows) = sweep::load_complete(std::slice::from_ref(&out))?;
-    let (indices, files) = sweep::write_report(&sweep, &rows, &out)?;
+    let (indices, files) = write_report(&sweep, &rows, &out)?;
     print(&sweep, &out, Some(report), &indices, &files, a.json)
 }
 
 fn merge(m: MergeArgs) -> anyhow::Result<()> {
     let (sweep, rows) = sweep::load_complete(&m.shards)?;
     sweep::write_final(&sweep, &rows, &m.out)?;
-    let (indices, files) = sweep::write_report(&sweep, &rows, &m.out)?;
+    let (indices, files) = write_report(&sweep, &rows, &m.out)?;
     print(&sweep, &m.out, None, &indices, &files, m.json)
+}
+
+/// The indices file (not for a grid) and the plots beside `out`: tornado charts, or
+/// for a grid of one or two factors line plots or heat maps. Returns the indices and
+/// the files written.
+fn write_report(
+    sweep: &Sweep,
+    rows: &std::collections::BTreeMap<usize, Vec<String>>,
+    out: &Path,
+) -> anyhow::Result<(Indices, Vec<PathBuf>)> {
+    let (indices, file) = sweep::write_indices(sweep, rows, out)?;
+    let charts = if sweep.method == Method::Grid {
+        let design = sweep.design()?;
+        let y = sweep::output_columns(sweep, rows);
+        figures::grid_plots(&sweep.factors, &design.values, &sweep.output_columns(), &y)?
+    } else {
+        figures::tornadoes(&indices)?
+    };
+    let mut files: Vec<PathBuf> = file.into_iter().collect();
+    for (name, svg) in charts {
+        let path = beside(out, &name);
+        rtid::io::atomic::write(&path, svg.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+        files.push(path);
+    }
+    Ok((indices, files))
+}
+
+/// `dir/stem.csv` → `dir/stem-NAME.svg`.
+fn beside(out: &Path, name: &str) -> PathBuf {
+    let stem = out
+        .file_stem()
+        .map_or("sweep".into(), |s| s.to_string_lossy());
+    out.with_file_name(format!("{stem}-{name}.svg"))
 }
 
 fn print(

@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::iso230;
-use super::{fluctuation, frequency_response, positioning, torque_curve};
+use super::{fluctuation, positioning, torque_curve};
 use crate::io::experiment_file::{self, Data, Experiment, ExperimentFileError};
 
 /// Two table-encoder counts of the paper's tables (2 × 0.0001°), arc-sec: the smallest
@@ -172,7 +172,7 @@ fn add(s: &mut Summary, exp: &Experiment) -> Result<(), String> {
                 .copied()
                 .zip(gain_db.iter().copied())
                 .collect();
-            let peaks = frequency_response::peaks(&curve, RESONANCES);
+            let peaks = crate::peaks::maxima(&curve, RESONANCES);
             s.resonances_hz = Some(peaks.iter().map(|p| p.frequency_hz).collect());
         }
         Data::Resonance { peaks_hz, .. } if s.resonances_hz.is_none() => {

@@ -37,6 +37,7 @@ use crate::model::drive::{idx::*, Drive, NSTATE};
 use crate::model::lanes::Lanes;
 use crate::model::modes::LinearModel;
 use crate::model::Params;
+use crate::peaks::Peak;
 use crate::sim::{default_step, LaneSimulation, SimError};
 
 /// Frequencies advanced together by one worker (two AVX2 registers per state).
@@ -101,13 +102,6 @@ pub struct Point {
     pub below_resolution: bool,
     /// Simulated time, s.
     pub simulated_s: f64,
-}
-
-/// A resonance: a local maximum of the gain, located by parabolic interpolation.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct Peak {
-    pub frequency_hz: f64,
-    pub gain_db: f64,
 }
 
 /// Samples of one window: time, motor angle, table angle, and contact counts.
@@ -590,7 +584,7 @@ pub fn sweep(
 pub fn refinement(points: &[Point], test: &FrequencyTest) -> Vec<f64> {
     let gains: Vec<(f64, f64)> = points.iter().map(|p| (p.frequency_hz, p.gain_db)).collect();
     let mut extra: Vec<f64> = Vec::new();
-    for i in local_maxima(&gains) {
+    for i in crate::peaks::local_maxima(&gains) {
         let centre = gains[i].0;
         let n = (test.refine_half_width_hz / test.refine_step_hz).floor() as i64;
         for k in -n..=n {
@@ -607,53 +601,37 @@ pub fn refinement(points: &[Point], test: &FrequencyTest) -> Vec<f64> {
     extra
 }
 
-/// Indices of interior local maxima of a curve sorted by x.
-fn local_maxima(curve: &[(f64, f64)]) -> Vec<usize> {
-    (1..curve.len().saturating_sub(1))
-        .filter(|&i| curve[i].1 > curve[i - 1].1 && curve[i].1 >= curve[i + 1].1)
-        .collect()
+/// Resonances reported by the evaluation of a gain curve (the highest local maxima).
+pub const RESONANCES: usize = 4;
+
+/// What the evaluation of a frequency-response file finds: its resonances.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Evaluation {
+    /// The highest [`RESONANCES`] local maxima of the gain, each located by the
+    /// parabola through it and its neighbours, ascending in frequency.
+    pub peaks: Vec<Peak>,
+    /// Points of the curve.
+    pub points: usize,
 }
 
-/// Resonances of a gain curve sorted by frequency: local maxima located by the
-/// parabola through each maximum and its neighbours, the highest `max_peaks` first
-/// in importance, returned ascending in frequency.
-pub fn peaks(curve: &[(f64, f64)], max_peaks: usize) -> Vec<Peak> {
-    let mut found: Vec<Peak> = local_maxima(curve)
-        .into_iter()
-        .map(|i| {
-            let ((x0, y0), (x1, y1), (x2, y2)) = (curve[i - 1], curve[i], curve[i + 1]);
-            // Vertex of the parabola through three points.
-            let d = (x0 - x1) * (x0 - x2) * (x1 - x2);
-            let a = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / d;
-            let b = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / d;
-            let c = y1 - a * x1 * x1 - b * x1;
-            if a < 0.0 {
-                let xv = (-b / (2.0 * a)).clamp(x0, x2);
-                Peak {
-                    frequency_hz: xv,
-                    gain_db: a * xv * xv + b * xv + c,
-                }
-            } else {
-                Peak {
-                    frequency_hz: x1,
-                    gain_db: y1,
-                }
-            }
-        })
+/// Evaluates a gain curve (frequencies ascending).
+pub fn evaluate(frequency_hz: &[f64], gain_db: &[f64]) -> Evaluation {
+    let curve: Vec<(f64, f64)> = frequency_hz
+        .iter()
+        .copied()
+        .zip(gain_db.iter().copied())
         .collect();
-    found.sort_by(|a, b| b.gain_db.total_cmp(&a.gain_db));
-    found.truncate(max_peaks);
-    found.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-    found
+    Evaluation {
+        peaks: crate::peaks::maxima(&curve, RESONANCES),
+        points: curve.len(),
+    }
 }
 
 /// The gain (dB) and phase (deg) of the linearised model at `freqs_hz`, solved in the
 /// frequency domain (no backlash, no friction).
 pub fn linear(p: &Params, freqs_hz: &[f64]) -> Result<Vec<(f64, f64)>, crate::model::ParamError> {
-    Ok(crate::model::modes::frequency_response(p, freqs_hz)?
-        .into_iter()
-        .map(|h| (20.0 * h.norm().log10(), h.arg().to_degrees()))
-        .collect())
+    use crate::model::linear_response::{Channel, LinearResponse};
+    Ok(LinearResponse::new(p, Channel::TableOverMotor)?.gain_phase(freqs_hz))
 }
 
 #[cfg(test)]
@@ -698,18 +676,5 @@ mod tests {
                 assert_eq!([m[0][l], m[1][l], m[2][l]], expected, "lane {l}, step {k}");
             }
         }
-    }
-
-    #[test]
-    fn parabolic_peaks_find_the_vertex() {
-        let curve: Vec<(f64, f64)> = (0..20)
-            .map(|i| {
-                let f = 180.0 + i as f64;
-                (f, 40.0 - 0.3 * (f - 186.4) * (f - 186.4))
-            })
-            .collect();
-        let p = peaks(&curve, 5);
-        assert_eq!(p.len(), 1);
-        assert!((p[0].frequency_hz - 186.4).abs() < 1e-9 && (p[0].gain_db - 40.0).abs() < 1e-9);
     }
 }

@@ -7,7 +7,7 @@
 //! also gives the compliance table angle / motor torque. Bins whose coherence is below
 //! `min_coherence` are kept in the result but flagged and left out of the peak search
 //! and the plotted curve; peaks are local maxima of the kept gain, located by
-//! [`frequency_response::peaks`]' parabola, whose prominence — the height above the
+//! [`crate::peaks::vertex`], whose prominence — the height above the
 //! lowest gain between them and the nearest higher point on either side — is at least
 //! `min_prominence_db` plus twice the random errors (one standard deviation each) of
 //! the peak bin and of that lowest bin: the noise ripple of an estimate, largest where
@@ -18,10 +18,10 @@
 use serde::Serialize;
 
 use super::fluctuation::{self, FluctuationError};
-use super::frequency_response::{self, Peak};
 use super::stepped_sine::{self, SinePoint, SteppedSineError, SteppedSineOptions};
 use super::welch::{self, WelchError, WelchOptions};
 use crate::io::experiment_file::{sample_period, Data, Excitation, Experiment, Kind};
+use crate::peaks::{self, Peak};
 
 /// Default Welch segment length, s: 0.5 Hz resolution, several bins across the
 /// half-power width of the worm preset's 187 Hz mode (≈ 4.5 Hz).
@@ -175,7 +175,7 @@ pub fn evaluate_experiment(
         let mut curve: Vec<(f64, f64)> =
             points.iter().map(|q| (q.frequency_hz, q.gain_db)).collect();
         curve.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let peaks = frequency_response::peaks(&curve, opts.max_peaks);
+        let peaks = peaks::maxima(&curve, opts.max_peaks);
         return Ok(Evaluation::SteppedSine {
             ratio,
             settle_fraction: opts.settle_fraction,
@@ -269,74 +269,19 @@ fn kept_peaks(bins: &[Bin], opts: &EstimateOptions) -> Vec<Peak> {
         let run = &bins[start..end];
         let curve: Vec<(f64, f64)> = run.iter().map(|b| (b.frequency_hz, b.gain_db)).collect();
         let sigma: Vec<f64> = run.iter().map(|b| b.gain_sigma_db).collect();
-        found.extend(prominent_peaks(&curve, &sigma, opts.min_prominence_db));
+        found.extend(peaks::prominent(
+            &curve,
+            Some(&sigma),
+            opts.min_prominence_db,
+        ));
         start = end;
     }
-    found.sort_by(|a, b| b.gain_db.total_cmp(&a.gain_db));
-    found.truncate(opts.max_peaks);
-    found.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-    found
-}
-
-/// Interior local maxima of `curve` whose prominence (the height above the lowest
-/// point between them and the nearest higher point on each side, or the curve's end)
-/// is at least `min_prominence` + 2·(`sigma` at the peak + `sigma` at that lowest
-/// point), each located by the parabola of [`frequency_response::peaks`]. `sigma`:
-/// one standard deviation of each point (all zeros for an exact curve).
-pub fn prominent_peaks(curve: &[(f64, f64)], sigma: &[f64], min_prominence: f64) -> Vec<Peak> {
-    let y: Vec<f64> = curve.iter().map(|c| c.1).collect();
-    let mut out = Vec::new();
-    for i in 1..y.len().saturating_sub(1) {
-        if !(y[i] > y[i - 1] && y[i] >= y[i + 1]) {
-            continue;
-        }
-        // The lowest point on one side before a higher one: (gain, index).
-        let base = |range: &mut dyn Iterator<Item = usize>| {
-            let mut low = (y[i], i);
-            for j in range {
-                if y[j] > y[i] {
-                    break;
-                }
-                if y[j] < low.0 {
-                    low = (y[j], j);
-                }
-            }
-            low
-        };
-        let left = base(&mut (0..i).rev());
-        let right = base(&mut (i + 1..y.len()));
-        let (low, at) = if left.0 > right.0 { left } else { right };
-        let s = |k: usize| sigma.get(k).copied().unwrap_or(0.0);
-        if y[i] - low >= min_prominence + 2.0 * (s(i) + s(at)) {
-            out.extend(frequency_response::peaks(&curve[i - 1..=i + 1], 1));
-        }
-    }
-    out
+    peaks::highest(found, opts.max_peaks)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn ripple_is_not_a_peak_but_a_resonance_is() {
-        // A resonance at 50 with ripple of ±0.5 dB every other point.
-        let curve: Vec<(f64, f64)> = (0..100)
-            .map(|i| {
-                let f = i as f64;
-                let ripple = if i % 2 == 0 { 0.5 } else { -0.5 };
-                (f, 20.0 / (1.0 + ((f - 50.0) / 3.0).powi(2)) + ripple)
-            })
-            .collect();
-        let exact = vec![0.0; curve.len()];
-        let p = prominent_peaks(&curve, &exact, 3.0);
-        assert_eq!(p.len(), 1, "{p:?}");
-        assert!((p[0].frequency_hz - 50.0).abs() < 1.0, "{p:?}");
-        assert!(prominent_peaks(&curve, &exact, 0.5).len() > 10);
-        // The ripple as the random error it is: 1 dB of prominence suffices.
-        let sigma = vec![0.5; curve.len()];
-        assert_eq!(prominent_peaks(&curve, &sigma, 1.0).len(), 1);
-    }
 
     #[test]
     fn kept_runs_split_at_flagged_bins() {

@@ -11,7 +11,7 @@
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
-use super::iso230::{Direction, Iso230Report, Measurement, ARCSEC_PER_RAD};
+use super::iso230::{Direction, Measurement, ARCSEC_PER_RAD};
 use crate::controller::quantise;
 use crate::input::Move;
 use crate::io::experiment_file::{Data, Kind, Manifest};
@@ -201,112 +201,4 @@ pub fn manifest(params: &Params, test: &PositioningTest) -> Manifest {
         }
     ));
     m
-}
-
-/// A readable ISO 230-2 summary in arc-seconds.
-pub fn table(report: &Iso230Report) -> String {
-    use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
-    let mut t = Table::new();
-    t.load_preset(UTF8_FULL_CONDENSED);
-    t.set_header([
-        "target °",
-        "x̄↑ ″",
-        "x̄↓ ″",
-        "s↑ ″",
-        "s↓ ″",
-        "Bi ″",
-        "R↑i ″",
-        "R↓i ″",
-        "Ri ″",
-    ]);
-    for s in &report.targets {
-        let a = s.in_arcsec();
-        t.add_row(
-            [
-                s.target.to_degrees(),
-                a.mean_up,
-                a.mean_down,
-                a.s_up,
-                a.s_down,
-                a.reversal,
-                a.repeat_up,
-                a.repeat_down,
-                a.repeat,
-            ]
-            .map(|v| format!("{v:.2}")),
-        );
-    }
-    let x = report.axis.in_arcsec();
-    let mut axis = Table::new();
-    axis.load_preset(UTF8_FULL_CONDENSED);
-    axis.set_header(["axis, arc-sec", "↑", "↓", "bidirectional"]);
-    axis.add_row([
-        "reversal B / mean B̄".to_string(),
-        "".into(),
-        "".into(),
-        format!("{:.2} / {:.2}", x.b, x.b_mean),
-    ]);
-    axis.add_row([
-        "repeatability R".to_string(),
-        format!("{:.2}", x.r_up),
-        format!("{:.2}", x.r_down),
-        format!("{:.2}", x.r),
-    ]);
-    axis.add_row([
-        "systematic deviation E".to_string(),
-        format!("{:.2}", x.e_up),
-        format!("{:.2}", x.e_down),
-        format!("{:.2}", x.e),
-    ]);
-    axis.add_row([
-        "mean deviation M".to_string(),
-        "".into(),
-        "".into(),
-        format!("{:.2}", x.m),
-    ]);
-    axis.add_row([
-        "accuracy A".to_string(),
-        format!("{:.2}", x.a_up),
-        format!("{:.2}", x.a_down),
-        format!("{:.2}", x.a),
-    ]);
-    format!("{t}\n{axis}")
-}
-
-/// The paper's Fig. 10: x̄↑, x̄↓, x̄↑ ± 2s↑, x̄↓ ± 2s↓ and x̄ over the target angle.
-pub fn plot(report: &Iso230Report, title: &str, path: &std::path::Path) -> std::io::Result<()> {
-    use crate::report::plot::{write, Chart, Series, Style};
-    let pts = |f: &dyn Fn(&super::iso230::TargetStats) -> f64| -> Vec<(f64, f64)> {
-        report
-            .targets
-            .iter()
-            .map(|s| (s.target.to_degrees(), f(s) * ARCSEC_PER_RAD))
-            .collect()
-    };
-    let series = [
-        Series::new("x̄↑", pts(&|s| s.mean_up), Style::Line),
-        Series::new(
-            "x̄↑ ± 2s↑",
-            pts(&|s| s.mean_up + 2.0 * s.s_up),
-            Style::Dashed,
-        ),
-        Series::new("", pts(&|s| s.mean_up - 2.0 * s.s_up), Style::Dashed),
-        Series::new("x̄↓", pts(&|s| s.mean_down), Style::Line),
-        Series::new(
-            "x̄↓ ± 2s↓",
-            pts(&|s| s.mean_down + 2.0 * s.s_down),
-            Style::Dashed,
-        ),
-        Series::new("", pts(&|s| s.mean_down - 2.0 * s.s_down), Style::Dashed),
-        Series::new("x̄", pts(&|s| s.mean_bidirectional), Style::Markers),
-    ];
-    write(
-        path,
-        &Chart {
-            title,
-            x_label: "target angle, deg",
-            y_label: "positional deviation, arc-sec",
-        },
-        &series,
-    )
 }

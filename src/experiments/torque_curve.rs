@@ -211,6 +211,13 @@ pub fn simulate_torque(
         .collect())
 }
 
+impl TorqueCurve {
+    /// The motor torque at `t`, linearly interpolated (held beyond the ends).
+    pub fn torque_at(&self, t: f64) -> f64 {
+        interpolate(&self.time, &self.motor_torque, t)
+    }
+}
+
 /// Linear interpolation of (x, y) at `t`, x increasing; clamped at the ends.
 fn interpolate(x: &[f64], y: &[f64], t: f64) -> f64 {
     if t.is_nan() {
@@ -430,110 +437,4 @@ fn line_at(curve: &TorqueCurve, a: f64, b: f64, t: f64) -> Option<f64> {
         return None;
     }
     Some(my + sxy / sxx * (t - mx))
-}
-
-/// A readable summary.
-pub fn table(report: &TorqueReport) -> String {
-    use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
-    let mut t = Table::new();
-    t.load_preset(UTF8_FULL_CONDENSED);
-    t.set_header(["torque curve", "value"]);
-    t.add_row(["samples".to_string(), report.samples.to_string()]);
-    t.add_row([
-        "duration, s".to_string(),
-        format!("{:.3}", report.duration_s),
-    ]);
-    t.add_row([
-        "RMS torque, N·m".to_string(),
-        format!("{:.4}", report.rms_nm),
-    ]);
-    t.add_row([
-        "peak torque, N·m".to_string(),
-        format!("{:.4}", report.peak_nm),
-    ]);
-    t.add_row([
-        "Coulomb friction at the motor, N·m".to_string(),
-        report
-            .friction_nm
-            .map_or("– (no usable reversal)".into(), |f| format!("{f:.4}")),
-    ]);
-    let mut r = Table::new();
-    r.load_preset(UTF8_FULL_CONDENSED);
-    r.set_header([
-        format!("reversal (from {})", report.reversals_from),
-        "moving before".into(),
-        "jump N·m".into(),
-        "friction N·m".into(),
-    ]);
-    for v in &report.reversals {
-        r.add_row([
-            format!("t = {:.4} s", v.time_s),
-            if v.direction_before > 0.0 { "+" } else { "−" }.into(),
-            format!("{:.4}", v.jump_nm),
-            format!("{:.4}", v.friction_nm),
-        ]);
-    }
-    format!("{t}\n{r}")
-}
-
-/// The paper's Fig. 9: motor torque over time, the reversals marked.
-pub fn plot(
-    curve: &TorqueCurve,
-    report: &TorqueReport,
-    title: &str,
-    path: &std::path::Path,
-) -> std::io::Result<()> {
-    use crate::report::plot::{write, Chart, Series, Style};
-    let torque: Vec<(f64, f64)> = curve
-        .time
-        .iter()
-        .copied()
-        .zip(curve.motor_torque.iter().copied())
-        .collect();
-    let marks: Vec<(f64, f64)> = report
-        .reversals
-        .iter()
-        .map(|r| {
-            (
-                r.time_s,
-                interpolate(&curve.time, &curve.motor_torque, r.time_s),
-            )
-        })
-        .collect();
-    write(
-        path,
-        &Chart {
-            title,
-            x_label: "time, s",
-            y_label: "motor torque, N·m",
-        },
-        &[
-            Series::new("motor torque", torque, Style::Line),
-            Series::new("velocity reversals", marks, Style::Markers),
-        ],
-    )
-}
-
-/// Motor torque over table angle (a friction loop); the curve must have the angle.
-pub fn plot_vs_angle(
-    curve: &TorqueCurve,
-    title: &str,
-    path: &std::path::Path,
-) -> std::io::Result<()> {
-    use crate::report::plot::{write, Chart, Series, Style};
-    let points: Vec<(f64, f64)> = curve
-        .table_angle
-        .iter()
-        .map(|a| a.to_degrees())
-        .zip(curve.motor_torque.iter().copied())
-        .collect();
-    write(
-        path,
-        &Chart {
-            title,
-            x_label: "table angle, deg",
-            y_label: "motor torque, N·m",
-        },
-        &[Series::new("motor torque", points, Style::Line)],
-    )
 }

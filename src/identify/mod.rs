@@ -8,6 +8,7 @@
 //! parallel too — rayon's work stealing nests them, so two cores stay busy with one
 //! start or with eight.
 
+pub mod comparison;
 pub mod correction;
 pub mod problem;
 pub mod result;

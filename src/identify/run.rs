@@ -23,7 +23,7 @@ use crate::model::Params;
 use crate::objectives::{sum_of_squares, Fidelity, Joint, Objective, ObjectiveError};
 
 /// Which frequency-response model the objectives use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FidelityChoice {
     /// The linear response for the search, then the nonlinear virtual test at the
     /// result as a check of the linearisation (a warning if it moves the peaks).
@@ -513,11 +513,11 @@ fn residual_report(joint: &Joint, parts: Vec<Vec<f64>>) -> Vec<ExperimentResidua
 /// identified parameters, per frequency-response experiment — like for like: the
 /// test is simulated at the measured frequencies near each measured peak and its peak
 /// located as the measurement's was
-/// ([`crate::objectives::peak_search::nonlinear_peak_on_grid`]), so that at the true
+/// ([`crate::objectives::model_peaks::nonlinear_peak_on_grid`]), so that at the true
 /// parameters it reproduces the measurement exactly and a difference is the
 /// linearisation's bias.
 fn nonlinear_check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, IdentifyError> {
-    use crate::objectives::peak_search::nonlinear_peak_on_grid;
+    use crate::objectives::model_peaks::nonlinear_peak_on_grid;
     let mut out = Vec::new();
     for (file, exp) in &config.experiments {
         let Some(grid) = super::setup::measured_grid(exp) else {

@@ -2,18 +2,19 @@
 //! feeds by default, which parameters a user who names none wants fitted, and the
 //! test conditions each simulation must reproduce.
 
-use crate::experiments::frequency_response::{FrequencyTest, Peak};
+use crate::experiments::frequency_response::FrequencyTest;
 use crate::experiments::torque_curve::TorqueTest;
 use crate::io::experiment_file::{Data, Experiment, Kind};
 use crate::model::{ParamError, Params, Topology};
-use crate::objectives::peak_search::GRID_BAND;
+use crate::objectives::model_peaks::GRID_BAND;
 use crate::objectives::{
     gain_curve::GainCurve, peak_amplitude::PeakAmplitude, resonance::ResonanceMatch,
     torque_curve::TorqueResidual, unbalance_step::UnbalanceStep, Fidelity, Joint, Objective,
 };
+use crate::peaks::{self, Peak};
 
 /// An objective by name (`--objective`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ObjectiveKind {
     /// Relative error of the resonance frequencies.
@@ -140,7 +141,7 @@ pub fn measured_peaks(file: &str, exp: &Experiment) -> Result<Vec<Peak>, SetupEr
             .collect()),
         Data::FrequencyResponse { .. } => {
             let curve: Vec<(f64, f64)> = valid_points(exp).collect();
-            let found = prominent_peaks(&curve, PROMINENCE_DB);
+            let found = peaks::prominent(&curve, None, PROMINENCE_DB);
             if found.is_empty() {
                 return Err(SetupError::NoPeaks { file: file.into() });
             }
@@ -158,39 +159,6 @@ pub fn measured_peaks(file: &str, exp: &Experiment) -> Result<Vec<Peak>, SetupEr
 /// end) on each side — its topographic prominence. Measurement noise makes many
 /// small maxima; a friction-damped worm resonance may stand only ~1.6 dB out.
 pub const PROMINENCE_DB: f64 = 1.0;
-
-/// The peaks of `curve` (sorted by frequency) with at least `min_db` prominence,
-/// located by parabolic interpolation, ascending in frequency.
-pub fn prominent_peaks(curve: &[(f64, f64)], min_db: f64) -> Vec<Peak> {
-    let g: Vec<f64> = curve.iter().map(|c| c.1).collect();
-    let n = g.len();
-    let mut out = Vec::new();
-    for i in 1..n.saturating_sub(1) {
-        if !(g[i] > g[i - 1] && g[i] >= g[i + 1]) {
-            continue;
-        }
-        let side = |range: &mut dyn Iterator<Item = usize>| {
-            let mut low = g[i];
-            for k in range {
-                if g[k] > g[i] {
-                    break;
-                }
-                low = low.min(g[k]);
-            }
-            low
-        };
-        let left = side(&mut (0..i).rev());
-        let right = side(&mut (i + 1..n));
-        if g[i] - left.max(right) >= min_db {
-            out.push(crate::objectives::peak_search::vertex(
-                curve[i - 1],
-                curve[i],
-                curve[i + 1],
-            ));
-        }
-    }
-    out
-}
 
 /// The (frequency, gain) points of a gain curve that are measurements of the drive:
 /// points flagged `below_resolution` (the table did not move more than the encoder

@@ -20,9 +20,7 @@ use rand::{rngs::StdRng, SeedableRng};
 use super::problem::Problem;
 
 /// The solver.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// Gauss–Newton with line search, finite-difference Jacobian in parallel.

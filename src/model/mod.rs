@@ -6,6 +6,7 @@ pub mod drive;
 pub mod friction;
 pub mod kernel;
 pub mod lanes;
+pub mod linear_response;
 pub mod modes;
 pub mod params;
 pub mod presets;

@@ -45,14 +45,16 @@ pub enum LoopMode {
 }
 
 impl std::str::FromStr for LoopMode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = crate::names::UnknownName;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s.replace('-', "_").as_str() {
             "semi_closed" | "semi" => Ok(LoopMode::SemiClosed),
             "full_closed" | "full" => Ok(LoopMode::FullClosed),
-            other => Err(format!(
-                "unknown loop `{other}`: expected semi_closed or full_closed"
-            )),
+            _ => Err(crate::names::UnknownName {
+                what: "loop",
+                given: s.to_string(),
+                expected: "semi_closed or full_closed".into(),
+            }),
         }
     }
 }

@@ -7,9 +7,10 @@
 //! Points a measurement marks as meaningless (`below_resolution` = 1: the table did
 //! not move more than the encoder resolves) are left out.
 
-use super::peak_search::{nonlinear_gains, LinearGain};
+use super::model_peaks::nonlinear_gains;
 use super::{cost_function, Fidelity, Objective, ObjectiveError};
 use crate::experiments::frequency_response::FrequencyTest;
+use crate::model::linear_response::{Channel, LinearResponse};
 use crate::model::Params;
 
 /// One scaled residual is this error, dB.
@@ -29,7 +30,7 @@ impl GainCurve {
     pub fn model_db(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
         match self.fidelity {
             Fidelity::Linear => {
-                let lin = LinearGain::new(p)?;
+                let lin = LinearResponse::new(p, Channel::TableOverMotor)?;
                 Ok(self.frequency_hz.iter().map(|&f| lin.gain_db(f)).collect())
             }
             Fidelity::Nonlinear => Ok(nonlinear_gains(p, &self.test, &self.frequency_hz)?),

@@ -19,8 +19,8 @@
 
 pub mod gain_curve;
 pub mod joint;
+pub mod model_peaks;
 pub mod peak_amplitude;
-pub mod peak_search;
 pub mod resonance;
 pub mod torque_curve;
 pub mod unbalance_step;

@@ -8,10 +8,11 @@
 //! has ζ ≈ 7.5e-5 (0.025 Hz half-power width): a measurement on a 1 Hz grid
 //! under-estimates such a peak by tens of dB, so compare like with like.
 
-use super::peak_search::ModelPeaks;
+use super::model_peaks::ModelPeaks;
 use super::{cost_function, Fidelity, Objective, ObjectiveError};
-use crate::experiments::frequency_response::{FrequencyTest, Peak};
+use crate::experiments::frequency_response::FrequencyTest;
 use crate::model::Params;
+use crate::peaks::Peak;
 
 /// One scaled residual is this error, dB.
 pub const SCALE_DB: f64 = 0.1;

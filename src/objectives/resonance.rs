@@ -5,14 +5,14 @@
 //! motor-held modes — never the undamped eigenvalues (fitting those to measured peaks
 //! biases Kw by ~6 %, MODEL.md §6). With [`Fidelity::Linear`] they come from the exact
 //! linear response with damping; with [`Fidelity::Nonlinear`] from the nonlinear
-//! virtual test at the experiment's conditions ([`super::peak_search`]), sampled on
+//! virtual test at the experiment's conditions ([`super::model_peaks`]), sampled on
 //! the measured frequencies when there is a measured gain curve.
 //!
 //! Pairing: the model's `n` highest peaks in the band (n = measured peaks), in
 //! ascending frequency, against the measured ones in ascending frequency. A measured
 //! peak the model does not have costs a residual of 100 % of its frequency.
 
-use super::peak_search::ModelPeaks;
+use super::model_peaks::ModelPeaks;
 use super::{cost_function, Fidelity, Objective, ObjectiveError};
 use crate::experiments::frequency_response::FrequencyTest;
 use crate::model::Params;
@@ -111,7 +111,7 @@ mod tests {
     #[test]
     fn the_linear_resonances_of_the_model_itself_match_exactly() {
         let p = presets::load("worm-gear").unwrap();
-        let peaks = crate::objectives::peak_search::linear_peaks(&p, 10.0, 600.0, 2).unwrap();
+        let peaks = crate::peaks::of_linear_response(&p, 10.0, 600.0, 2).unwrap();
         let hz: Vec<f64> = peaks.iter().map(|pk| pk.frequency_hz).collect();
         let obj = ResonanceMatch::new(hz, Fidelity::Linear, FrequencyTest::default());
         let r = obj.residuals(&p).unwrap();

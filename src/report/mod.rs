@@ -1,3 +1,11 @@
-//! Reports: SVG charts.
+//! Presentation: figures (SVG charts) of the tests, identifications and sweeps. The
+//! domain modules compute; this module only draws what they computed.
 
-pub mod plot;
+pub mod figure;
+pub mod fluctuation;
+pub mod frequency_response;
+pub mod frequency_response_time;
+pub mod identify;
+pub mod positioning;
+pub mod sweep;
+pub mod torque_curve;

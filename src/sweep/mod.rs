@@ -9,7 +9,7 @@
 //! task) and streams each finished row to the CSV file ([`stream`]), so an
 //! interrupted sweep resumes where it stopped and a large one splits into shards for
 //! a job array. [`analysis`] turns the finished rows into local sensitivities,
-//! Morris μ*/σ or Sobol S1/ST with bootstrap intervals, and [`plot`] draws them.
+//! Morris μ*/σ or Sobol S1/ST with bootstrap intervals (drawn by `report::sweep`).
 //!
 //! Rows are deterministic functions of (design, seed, index): the final file of a
 //! straight run, of a resumed one and of merged shards are the same bytes.
@@ -19,7 +19,6 @@ pub mod designs;
 pub mod local;
 pub mod morris;
 pub mod outputs;
-pub mod plot;
 pub mod sobol;
 pub mod spec;
 pub mod stream;
@@ -358,40 +357,36 @@ pub fn indices_path(out: &Path) -> std::path::PathBuf {
     out.with_file_name(format!("{stem}-indices.csv"))
 }
 
-/// Analyses complete rows and writes the indices file (not for a grid) and the plots
-/// beside `out`: tornado charts, or for a grid of one or two factors line plots or
-/// heat maps. Returns the indices and the files written.
-pub fn write_report(
+/// Analyses complete rows and, except for a grid, writes the indices file beside
+/// `out` ([`indices_path`]). Returns the indices and the file written.
+pub fn write_indices(
     sweep: &Sweep,
     rows: &BTreeMap<usize, Vec<String>>,
     out: &Path,
-) -> Result<(analysis::Indices, Vec<std::path::PathBuf>), SweepError> {
+) -> Result<(analysis::Indices, Option<std::path::PathBuf>), SweepError> {
     let indices = analysis::analyse(sweep, rows)?;
-    let io = |e: std::io::Error, p: &Path| {
-        SweepError::Stream(StreamError::Io {
-            path: p.to_path_buf(),
-            source: e,
-        })
-    };
-    let mut written = Vec::new();
     if sweep.method == Method::Grid {
-        let design = sweep.design()?;
-        let k = sweep.factors.len();
-        let names = sweep.output_columns();
-        let y: Vec<Vec<f64>> = (0..names.len())
-            .map(|j| {
-                rows.values()
-                    .map(|r| r[1 + k + j].parse().unwrap_or(f64::NAN))
-                    .collect()
-            })
-            .collect();
-        written = plot::grid_plots(&sweep.factors, &design.values, &names, &y, out)
-            .map_err(|e| io(e, out))?;
-    } else {
-        let path = indices_path(out);
-        analysis::write(&path, &indices).map_err(|e| io(e, &path))?;
-        written.push(path);
-        written.extend(plot::tornadoes(&indices, out).map_err(|e| io(e, out))?);
+        return Ok((indices, None));
     }
-    Ok((indices, written))
+    let path = indices_path(out);
+    analysis::write(&path, &indices).map_err(|source| {
+        SweepError::Stream(StreamError::Io {
+            path: path.clone(),
+            source,
+        })
+    })?;
+    Ok((indices, Some(path)))
+}
+
+/// The output columns of complete rows as numbers: `y[c][i]` is output column `c` of
+/// the row of design point `i` (NaN where it is empty).
+pub fn output_columns(sweep: &Sweep, rows: &BTreeMap<usize, Vec<String>>) -> Vec<Vec<f64>> {
+    let k = sweep.factors.len();
+    (0..sweep.output_columns().len())
+        .map(|j| {
+            rows.values()
+                .map(|r| r[1 + k + j].parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect()
 }

@@ -16,11 +16,11 @@
 //! default of `rtid sweep`) shortens them to what a sweep can afford; the physics is
 //! the same (module docs of [`TestLength`]).
 //!
-//! **Resonances.** The linear gain (table over motor amplitude × Rg·Rw, MODEL.md §5.1)
-//! of [`frequency_response::linear`] is evaluated on a logarithmic grid of
-//! [`POINTS_PER_DECADE`] from half the lowest to twice the highest motor-held natural
-//! frequency; around each local maximum a grid 50 times finer is evaluated and the
-//! peak located by a parabola ([`frequency_response::peaks`]). The number of columns is
+//! **Resonances.** The peaks of the exact linear gain (table over motor amplitude ×
+//! Rg·Rw, docs/model.md) from half the lowest to twice the highest motor-held natural
+//! frequency, found by [`crate::peaks::of_linear_response`] — the same function the
+//! identification's resonance objective uses, so both report the same resonance for
+//! the same parameters. The number of columns is
 //! the number of motor-held modes of the base topology (worm 3, roller 2); column i is
 //! the i-th peak in ascending frequency, empty when the gain has fewer peaks (a mode
 //! that the motor torque hardly excites, or two that merged).
@@ -30,16 +30,14 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 
 use crate::experiments::fluctuation::{self, FluctuationError, FluctuationTest};
-use crate::experiments::frequency_response::{self, Peak};
 use crate::experiments::iso230::{self, Iso230Error};
 use crate::experiments::positioning::{self, PositioningTest};
 use crate::experiments::torque_curve::{self, TorqueEvalError, TorqueTest};
 use crate::model::modes;
 use crate::model::{ParamError, Params, Topology};
+use crate::names::UnknownName;
+use crate::peaks::{self, Peak};
 use crate::sim::SimError;
-
-/// Coarse grid density of the resonance search.
-pub const POINTS_PER_DECADE: f64 = 100.0;
 
 /// One requested output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -112,15 +110,14 @@ impl Output {
 }
 
 impl FromStr for Output {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownName;
+    fn from_str(s: &str) -> Result<Self, UnknownName> {
         ALL.into_iter()
             .find(|o| o.name() == s.trim())
-            .ok_or_else(|| {
-                format!(
-                    "unknown output `{s}`: the outputs are {}",
-                    ALL.map(Output::name).join(", ")
-                )
+            .ok_or_else(|| UnknownName {
+                what: "output",
+                given: s.to_string(),
+                expected: ALL.map(Output::name).join(", "),
             })
     }
 }
@@ -146,12 +143,16 @@ pub enum TestLength {
 }
 
 impl FromStr for TestLength {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownName;
+    fn from_str(s: &str) -> Result<Self, UnknownName> {
         match s {
             "short" => Ok(TestLength::Short),
             "full" => Ok(TestLength::Full),
-            other => Err(format!("unknown test length `{other}`: short or full")),
+            other => Err(UnknownName {
+                what: "test length",
+                given: other.to_string(),
+                expected: "short or full".into(),
+            }),
         }
     }
 }
@@ -341,38 +342,7 @@ pub fn gain_peaks(p: &Params, max: usize) -> Result<Vec<Peak>, ParamError> {
     if hi <= 0.0 {
         return Ok(Vec::new());
     }
-    let (lo, hi) = (0.5 * lo, 2.0 * hi);
-    let n = ((hi / lo).log10() * POINTS_PER_DECADE).ceil() as usize + 1;
-    let ratio = (hi / lo).powf(1.0 / (n - 1) as f64);
-    let freqs: Vec<f64> = (0..n).map(|i| lo * ratio.powi(i as i32)).collect();
-    let coarse = curve(p, &freqs)?;
-    let mut out = Vec::new();
-    for guess in frequency_response::peaks(&coarse, usize::MAX) {
-        // A grid 50× finer over two coarse spacings either side.
-        let (a, b) = (
-            guess.frequency_hz / ratio.powi(2),
-            guess.frequency_hz * ratio.powi(2),
-        );
-        let fine: Vec<f64> = (0..=200).map(|i| a + (b - a) * i as f64 / 200.0).collect();
-        let refined = frequency_response::peaks(&curve(p, &fine)?, 1);
-        out.extend(refined.into_iter().next().or(Some(guess)));
-    }
-    out.sort_by(|x, y| y.gain_db.total_cmp(&x.gain_db));
-    out.truncate(max);
-    out.sort_by(|x, y| x.frequency_hz.total_cmp(&y.frequency_hz));
-    // Two coarse guesses may refine to one peak.
-    out.dedup_by(|x, y| (x.frequency_hz - y.frequency_hz).abs() < 1e-9 * y.frequency_hz);
-    Ok(out)
-}
-
-/// (frequency, gain dB) of the linear model, non-finite points dropped.
-fn curve(p: &Params, freqs: &[f64]) -> Result<Vec<(f64, f64)>, ParamError> {
-    Ok(freqs
-        .iter()
-        .zip(frequency_response::linear(p, freqs)?)
-        .map(|(&f, (g, _))| (f, g))
-        .filter(|(_, g)| g.is_finite())
-        .collect())
+    peaks::of_linear_response(p, 0.5 * lo, 2.0 * hi, max)
 }
 
 #[cfg(test)]
@@ -413,6 +383,6 @@ mod tests {
             assert_eq!(o.name().parse::<Output>().unwrap(), o);
         }
         let err = "torque".parse::<Output>().unwrap_err();
-        assert!(err.contains("torque_rms"), "{err}");
+        assert!(err.to_string().contains("torque_rms"), "{err}");
     }
 }

@@ -37,10 +37,13 @@ impl Shard {
 }
 
 impl std::str::FromStr for Shard {
-    type Err = String;
+    type Err = crate::names::BadForm;
     /// `I/N` with 0 ≤ I < N (Slurm: `$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`).
-    fn from_str(s: &str) -> Result<Self, String> {
-        let bad = || format!("--shard {s}: expected I/N with 0 ≤ I < N, e.g. 3/16");
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let bad = || crate::names::BadForm {
+            given: s.to_string(),
+            expected: "I/N with 0 ≤ I < N, e.g. 3/16",
+        };
         let (i, n) = s.split_once('/').ok_or_else(bad)?;
         let (index, count): (usize, usize) = (
             i.trim().parse().map_err(|_| bad())?,
@@ -146,7 +149,10 @@ pub fn read(path: &Path) -> Result<(SweepFile, bool), StreamError> {
     let mut shard = None;
     let rest: Vec<&str> = lines.collect();
     if let Some(s) = rest.first().and_then(|l| l.strip_prefix("# shard ")) {
-        shard = Some(s.parse().map_err(|e: String| bad(3, e))?);
+        shard = Some(
+            s.parse()
+                .map_err(|e: crate::names::BadForm| bad(3, e.to_string()))?,
+        );
         skip += 1;
     }
     let body = rest[skip - 2..].join("\n");

@@ -6,9 +6,12 @@ use anyhow::bail;
 
 use super::Common;
 use crate::cli::progress;
-use crate::experiments::fluctuation::{self, Evaluation, FluctuationTest};
-use crate::io::experiment_file::{Experiment, Kind};
-use crate::model::{LoopMode, Params};
+use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+use rtid::experiments::fluctuation::{self, Evaluation, FluctuationTest};
+use rtid::experiments::spectrum::Peak;
+use rtid::io::experiment_file::{Experiment, Kind};
+use rtid::model::{LoopMode, Params};
+use rtid::report;
 
 pub const LONG_ABOUT: &str = "\
 Rotational fluctuation (paper §4.4, Figs. 11 and 12): the servo, in semi-closed loop by \
@@ -122,8 +125,8 @@ pub fn run_test(
     let bar = progress::bar(test.duration().ceil() as u64, name, common.quiet);
     let mut record = fluctuation::run(p, test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
-    let sigma = run.noise_arcsec / crate::experiments::iso230::ARCSEC_PER_RAD;
-    crate::experiments::measurement_noise::perturb_absolute(
+    let sigma = run.noise_arcsec / rtid::experiments::iso230::ARCSEC_PER_RAD;
+    rtid::experiments::measurement_noise::perturb_absolute(
         &mut record.table_angle,
         sigma,
         run.seed,
@@ -167,16 +170,13 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
     } else {
         "rotational fluctuation"
     };
-    fluctuation::plot_deviation(&e, &format!("{mechanism}: {what}"), plot)
-        .map_err(|err| anyhow::anyhow!("writing {}: {err}", plot.display()))?;
-    let spectrum = spectrum_path(plot);
-    fluctuation::plot_spectrum(
+    report::fluctuation::deviation(&e, &format!("{mechanism}: {what}")).write(plot)?;
+    report::fluctuation::spectrum(
         &e,
         &format!("{mechanism}: power spectrum of the {what}"),
         200.0,
-        &spectrum,
     )
-    .map_err(|err| anyhow::anyhow!("writing {}: {err}", spectrum.display()))?;
+    .write(&spectrum_path(plot))?;
     print(&e, kind, json, &exp.path)
 }
 
@@ -189,7 +189,62 @@ fn print(e: &Evaluation, kind: Kind, json: bool, source: &Path) -> anyhow::Resul
         println!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         println!("{}: {kind} evaluation, arc-seconds", source.display());
-        println!("{}", fluctuation::table(e, kind));
+        println!("{}", table(e, kind));
     }
     Ok(())
+}
+
+/// A readable summary in arc-seconds.
+fn table(e: &Evaluation, kind: Kind) -> String {
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header([
+        "direction",
+        "revolutions",
+        "mean ″",
+        "peak-to-peak ″",
+        "dominant orders (cycles/rev: amplitude ″)",
+        "largest step ″ at °",
+    ]);
+    for p in &e.passes {
+        t.add_row([
+            p.direction.to_string(),
+            p.revolutions.to_string(),
+            format!("{:.2}", p.mean_arcsec),
+            format!("{:.2}", p.pp_arcsec),
+            orders(&p.dominant),
+            format!("{:.2} at {:.1}", p.step.size_arcsec, p.step.angle_deg),
+        ]);
+    }
+    let mut s = format!(
+        "{t}\nratio {:.6e}; peak-to-peak {:.2}″",
+        e.ratio, e.pp_arcsec
+    );
+    if let Some(g) = e.gap_arcsec {
+        s += &format!("; gap between the directions (lost motion) {g:.2}″");
+    }
+    s += &format!("\ndominant orders (mean spectrum): {}", orders(&e.dominant));
+    if kind == Kind::Unbalance {
+        s += &format!(
+            "\nstep: {:.2}″ at table angle {:.1}°",
+            e.step.size_arcsec, e.step.angle_deg
+        );
+        for p in &e.passes {
+            let list: Vec<String> = p
+                .steps
+                .iter()
+                .map(|st| format!("{:.2}″ at {:.3}°", st.size_arcsec, st.angle_deg))
+                .collect();
+            s += &format!("\nsteps {} (located): {}", p.direction, list.join(", "));
+        }
+    }
+    s
+}
+
+fn orders(peaks: &[Peak]) -> String {
+    peaks
+        .iter()
+        .map(|p| format!("{:.0}: {:.2}", p.order, p.amplitude))
+        .collect::<Vec<_>>()
+        .join(", ")
 }

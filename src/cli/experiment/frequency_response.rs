@@ -6,9 +6,8 @@ use anyhow::bail;
 
 use super::Common;
 use crate::cli::progress;
-use crate::experiments::frequency_response::{self as fr, FrequencyTest, Point};
-use crate::io::experiment_file::{self, Data, Experiment, Kind, Manifest};
-use crate::report::plot::{write, Chart, Series, Style};
+use rtid::experiments::frequency_response::{self as fr, FrequencyTest, Point};
+use rtid::io::experiment_file::{self, Data, Experiment, Kind, Manifest};
 
 pub const LONG_ABOUT: &str = "\
 Frequency response (paper §4.1): open loop, the motor driven by a sinusoidal torque \
@@ -174,7 +173,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.noise_percent
     );
     let mut gain_db: Vec<f64> = points.iter().map(|q| q.gain_db).collect();
-    crate::experiments::measurement_noise::perturb_gain_db(&mut gain_db, a.noise_percent, a.seed);
+    rtid::experiments::measurement_noise::perturb_gain_db(&mut gain_db, a.noise_percent, a.seed);
     let data = Data::FrequencyResponse {
         frequency_hz: freqs,
         gain_db,
@@ -257,44 +256,14 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
             exp.path.display()
         );
     };
-    let curve: Vec<(f64, f64)> = frequency_hz
-        .iter()
-        .copied()
-        .zip(gain_db.iter().copied())
-        .collect();
-    let peaks = fr::peaks(&curve, 4);
-    let mut series = vec![Series::new(
-        "gain (simulated or measured)",
-        curve,
-        Style::Line,
-    )];
-    if let Some(lin) = extra.get("linear_gain_db") {
-        let pts = frequency_hz
-            .iter()
-            .copied()
-            .zip(lin.iter().copied())
-            .collect();
-        series.push(Series::new("linear model", pts, Style::Dashed));
-    }
-    series.push(Series::new(
-        "resonances",
-        peaks.iter().map(|p| (p.frequency_hz, p.gain_db)).collect(),
-        Style::Markers,
-    ));
+    let peaks = fr::evaluate(frequency_hz, gain_db).peaks;
     let title = format!(
         "{}: frequency response (table / motor × ratio)",
         exp.manifest.mechanism.as_deref().unwrap_or("table")
     );
-    write(
-        plot,
-        &Chart {
-            title: &title,
-            x_label: "frequency, Hz",
-            y_label: "gain, dB",
-        },
-        &series,
-    )
-    .map_err(|e| anyhow::anyhow!("writing {}: {e}", plot.display()))?;
+    let linear = extra.get("linear_gain_db").map(Vec::as_slice);
+    rtid::report::frequency_response::gain(frequency_hz, gain_db, linear, &peaks, &title)
+        .write(plot)?;
     if json {
         let value = serde_json::json!({
             "kind": "frequency_response",

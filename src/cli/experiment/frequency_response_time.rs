@@ -8,12 +8,12 @@ use anyhow::bail;
 use super::fluctuation::positive;
 use super::Common;
 use crate::cli::progress;
-use crate::experiments::frequency_response_estimate::{
+use rtid::experiments::frequency_response_estimate::{
     self as estimate, EstimateOptions, Evaluation,
 };
-use crate::experiments::frequency_response_record::{self as record, Excitation, RecordTest};
-use crate::io::experiment_file::{self, Experiment};
-use crate::report::plot::{write, Chart, Series, Style};
+use rtid::experiments::frequency_response_record::{self as record, Excitation, RecordTest};
+use rtid::io::experiment_file::{self, Experiment};
+use std::fmt::Write as _;
 
 pub const LONG_ABOUT: &str = "\
 The frequency-response test (paper §4.1) recorded as raw time series, the way a DAQ on a \
@@ -220,192 +220,23 @@ pub fn report_with(
 }
 
 fn plot_evaluation(e: &Evaluation, mechanism: &str, plot: &Path) -> anyhow::Result<()> {
-    let chart = |title: &str, y: &'static str| (format!("{mechanism}: {title}"), y);
-    let markers = Series::new(
-        "resonances",
-        e.peaks()
-            .iter()
-            .map(|p| (p.frequency_hz, p.gain_db))
-            .collect(),
-        Style::Markers,
-    );
-    let write_chart = |path: &Path, (title, y): (String, &str), series: &[Series]| {
-        write(
-            path,
-            &Chart {
-                title: &title,
-                x_label: "frequency, Hz",
-                y_label: y,
-            },
-            series,
-        )
-        .map_err(|err| anyhow::anyhow!("writing {}: {err}", path.display()))
-    };
-    match e {
-        Evaluation::SteppedSine { points, .. } => {
-            let mut curve: Vec<(f64, f64)> =
-                points.iter().map(|q| (q.frequency_hz, q.gain_db)).collect();
-            curve.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let series = [
-                Series::new("gain (stepped sine)", curve, Style::Line),
-                markers,
-            ];
-            write_chart(
-                plot,
-                chart("frequency response (stepped sine)", "gain, dB"),
-                &series,
-            )
-        }
-        Evaluation::H1 {
-            bins,
-            min_coherence,
-            ..
-        } => {
-            // Up to a little beyond the highest kept bin: above it is noise.
-            let top = bins
-                .iter()
-                .filter(|b| b.kept)
-                .map(|b| b.frequency_hz)
-                .fold(0.0, f64::max);
-            let top = if top > 0.0 { 1.2 * top } else { f64::INFINITY };
-            let shown = |f: f64| f <= top;
-            let mut series: Vec<Series> = estimate::kept_runs(bins)
-                .into_iter()
-                .enumerate()
-                .map(|(i, run)| {
-                    let name = if i == 0 {
-                        format!("H1 gain where γ² ≥ {min_coherence}")
-                    } else {
-                        String::new()
-                    };
-                    Series::new(name, run, Style::Line)
-                })
-                .collect();
-            series.push(markers);
-            write_chart(
-                plot,
-                chart("frequency response (H1, Welch)", "gain, dB"),
-                &series,
-            )?;
-            let coherence: Vec<(f64, f64)> = bins
-                .iter()
-                .filter(|b| shown(b.frequency_hz))
-                .map(|b| (b.frequency_hz, b.coherence))
-                .collect();
-            let x1 = coherence.last().map_or(1.0, |c| c.0);
-            let series = [
-                Series::new("coherence γ²", coherence, Style::Line),
-                Series::new(
-                    "threshold",
-                    vec![(0.0, *min_coherence), (x1, *min_coherence)],
-                    Style::Dashed,
-                ),
-            ];
-            let path = coherence_path(plot);
-            write_chart(
-                &path,
-                chart("coherence, motor angle → table angle", "γ²"),
-                &series,
-            )
-        }
+    let (gain, coherence) = rtid::report::frequency_response_time::figures(e, mechanism);
+    gain.write(plot)?;
+    if let Some(c) = coherence {
+        c.write(&coherence_path(plot))?;
     }
+    Ok(())
 }
 
 /// The printed evaluation.
 fn summary(e: &Evaluation, source: &Path) -> String {
-    use std::fmt::Write as _;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "{}: frequency response from time series",
+    let mut s = format!(
+        "{}: frequency response from time series\n",
         source.display()
     );
     match e {
-        Evaluation::SteppedSine {
-            ratio,
-            settle_fraction,
-            points,
-            ..
-        } => {
-            let _ = writeln!(
-                s,
-                "stepped sine, {} frequencies, first {:.0} % of each dwell discarded; ratio {ratio:.6e}",
-                points.len(),
-                100.0 * settle_fraction
-            );
-            let _ = writeln!(
-                s,
-                "  freq Hz   gain dB  phase deg  table amp ″  cycles  residual"
-            );
-            for q in points {
-                let flag = if q.table_residual > 0.5 {
-                    "  not a clean sine"
-                } else {
-                    ""
-                };
-                let _ = writeln!(
-                    s,
-                    "{:9.2} {:9.3} {:10.2} {:12.3} {:7} {:9.3}{flag}",
-                    q.frequency_hz,
-                    q.gain_db,
-                    q.phase_deg,
-                    q.table_amplitude_rad.to_degrees() * 3600.0,
-                    q.cycles,
-                    q.table_residual
-                );
-            }
-        }
-        Evaluation::H1 {
-            ratio,
-            sample_rate_hz,
-            segment_len,
-            segments,
-            resolution_hz,
-            min_coherence,
-            kept,
-            bins,
-            ..
-        } => {
-            let _ = writeln!(
-                s,
-                "H1 with Welch averaging: {sample_rate_hz:.1} Hz sampling, segments of {segment_len} \
-                 samples (resolution {resolution_hz:.3} Hz), {segments} averaged, Hann, 50 % overlap; \
-                 ratio {ratio:.6e}"
-            );
-            let _ = writeln!(
-                s,
-                "{kept} of {} bins with γ² ≥ {min_coherence} (the others are left out)",
-                bins.len()
-            );
-            let _ = writeln!(s, "  band Hz      kept   mean γ²   gain dB (kept)");
-            let nyquist = sample_rate_hz / 2.0;
-            let mut lo = 0.0;
-            while lo < nyquist.min(1000.0) {
-                let hi = lo + 100.0;
-                let band: Vec<_> = bins
-                    .iter()
-                    .filter(|b| b.frequency_hz >= lo && b.frequency_hz < hi)
-                    .collect();
-                if !band.is_empty() {
-                    let k: Vec<f64> = band.iter().filter(|b| b.kept).map(|b| b.gain_db).collect();
-                    let mean = band.iter().map(|b| b.coherence).sum::<f64>() / band.len() as f64;
-                    let range = if k.is_empty() {
-                        "—".to_string()
-                    } else {
-                        let (a, b) = k
-                            .iter()
-                            .fold((f64::MAX, f64::MIN), |(a, b), &g| (a.min(g), b.max(g)));
-                        format!("{a:.1} … {b:.1}")
-                    };
-                    let _ = writeln!(
-                        s,
-                        "  {lo:4.0}–{hi:<4.0} {:5.0} %  {mean:8.3}   {range}",
-                        100.0 * k.len() as f64 / band.len() as f64
-                    );
-                }
-                lo = hi;
-            }
-        }
+        Evaluation::SteppedSine { .. } => stepped_sine_summary(e, &mut s),
+        Evaluation::H1 { .. } => h1_summary(e, &mut s),
     }
     let _ = writeln!(
         s,
@@ -418,4 +249,102 @@ fn summary(e: &Evaluation, source: &Path) -> String {
         let _ = writeln!(s, "  none found");
     }
     s.trim_end().to_string()
+}
+
+/// The demodulated points of a stepped sine, one line each.
+fn stepped_sine_summary(e: &Evaluation, s: &mut String) {
+    let Evaluation::SteppedSine {
+        ratio,
+        settle_fraction,
+        points,
+        ..
+    } = e
+    else {
+        return;
+    };
+    let _ = writeln!(
+        s,
+        "stepped sine, {} frequencies, first {:.0} % of each dwell discarded; ratio {ratio:.6e}",
+        points.len(),
+        100.0 * settle_fraction
+    );
+    let _ = writeln!(
+        s,
+        "  freq Hz   gain dB  phase deg  table amp ″  cycles  residual"
+    );
+    for q in points {
+        let flag = if q.table_residual > 0.5 {
+            "  not a clean sine"
+        } else {
+            ""
+        };
+        let _ = writeln!(
+            s,
+            "{:9.2} {:9.3} {:10.2} {:12.3} {:7} {:9.3}{flag}",
+            q.frequency_hz,
+            q.gain_db,
+            q.phase_deg,
+            q.table_amplitude_rad.to_degrees() * 3600.0,
+            q.cycles,
+            q.table_residual
+        );
+    }
+}
+
+/// The H1 settings, and per 100 Hz band the share of kept bins, the mean coherence and
+/// the range of the kept gains.
+fn h1_summary(e: &Evaluation, s: &mut String) {
+    let Evaluation::H1 {
+        ratio,
+        sample_rate_hz,
+        segment_len,
+        segments,
+        resolution_hz,
+        min_coherence,
+        kept,
+        bins,
+        ..
+    } = e
+    else {
+        return;
+    };
+    let _ = writeln!(
+        s,
+        "H1 with Welch averaging: {sample_rate_hz:.1} Hz sampling, segments of {segment_len} \
+         samples (resolution {resolution_hz:.3} Hz), {segments} averaged, Hann, 50 % overlap; \
+         ratio {ratio:.6e}"
+    );
+    let _ = writeln!(
+        s,
+        "{kept} of {} bins with γ² ≥ {min_coherence} (the others are left out)",
+        bins.len()
+    );
+    let _ = writeln!(s, "  band Hz      kept   mean γ²   gain dB (kept)");
+    let top = (sample_rate_hz / 2.0).min(1000.0);
+    let mut lo = 0.0;
+    while lo < top {
+        let hi = lo + 100.0;
+        let band: Vec<_> = bins
+            .iter()
+            .filter(|b| b.frequency_hz >= lo && b.frequency_hz < hi)
+            .collect();
+        if !band.is_empty() {
+            let k: Vec<f64> = band.iter().filter(|b| b.kept).map(|b| b.gain_db).collect();
+            let mean = band.iter().map(|b| b.coherence).sum::<f64>() / band.len() as f64;
+            let range = if k.is_empty() {
+                "—".to_string()
+            } else {
+                let (a, b) = k
+                    .iter()
+                    .fold((f64::MAX, f64::MIN), |(a, b), &g| (a.min(g), b.max(g)));
+                format!("{a:.1} … {b:.1}")
+            };
+            let _ = writeln!(
+                s,
+                "  {lo:4.0}–{hi:<4.0} {:5.0} %  {mean:8.3}   {range}",
+                100.0 * k.len() as f64 / band.len() as f64
+            );
+        }
+        lo = hi;
+    }
 }

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 
 use super::ModelArgs;
-use crate::io::experiment_file::{self, Data, Experiment, Manifest};
+use rtid::io::experiment_file::{self, Data, Experiment, Manifest};
 
 pub const LONG_ABOUT: &str = "\
 Runs one of the paper's tests on the model and writes it as an experiment file — a JSON \

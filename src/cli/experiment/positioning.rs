@@ -4,11 +4,13 @@ use std::path::Path;
 
 use anyhow::bail;
 
+use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+
 use super::Common;
 use crate::cli::progress;
-use crate::experiments::{iso230, positioning};
-use crate::io::experiment_file::Experiment;
-use crate::model::{LoopMode, Params};
+use rtid::experiments::{iso230, positioning};
+use rtid::io::experiment_file::Experiment;
+use rtid::model::{LoopMode, Params};
 
 pub const LONG_ABOUT: &str = "\
 ISO 230-2 positioning accuracy and repeatability (paper §4.3): the servo, in semi-closed \
@@ -114,8 +116,7 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
         "{}: ISO 230-2 positioning",
         exp.manifest.mechanism.as_deref().unwrap_or("table")
     );
-    positioning::plot(&report, &title, plot)
-        .map_err(|e| anyhow::anyhow!("writing {}: {e}", plot.display()))?;
+    rtid::report::positioning::deviations(&report, &title).write(plot)?;
     print_positioning(&report, json, &exp.path)
 }
 
@@ -140,7 +141,76 @@ fn print_positioning(
         println!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         println!("{}: ISO 230-2 evaluation, arc-seconds", source.display());
-        println!("{}", positioning::table(report));
+        println!("{}", table(report));
     }
     Ok(())
+}
+
+/// A readable ISO 230-2 summary in arc-seconds.
+fn table(report: &iso230::Iso230Report) -> String {
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header([
+        "target °",
+        "x̄↑ ″",
+        "x̄↓ ″",
+        "s↑ ″",
+        "s↓ ″",
+        "Bi ″",
+        "R↑i ″",
+        "R↓i ″",
+        "Ri ″",
+    ]);
+    for s in &report.targets {
+        let a = s.in_arcsec();
+        t.add_row(
+            [
+                s.target.to_degrees(),
+                a.mean_up,
+                a.mean_down,
+                a.s_up,
+                a.s_down,
+                a.reversal,
+                a.repeat_up,
+                a.repeat_down,
+                a.repeat,
+            ]
+            .map(|v| format!("{v:.2}")),
+        );
+    }
+    let x = report.axis.in_arcsec();
+    let mut axis = Table::new();
+    axis.load_preset(UTF8_FULL_CONDENSED);
+    axis.set_header(["axis, arc-sec", "↑", "↓", "bidirectional"]);
+    axis.add_row([
+        "reversal B / mean B̄".to_string(),
+        "".into(),
+        "".into(),
+        format!("{:.2} / {:.2}", x.b, x.b_mean),
+    ]);
+    axis.add_row([
+        "repeatability R".to_string(),
+        format!("{:.2}", x.r_up),
+        format!("{:.2}", x.r_down),
+        format!("{:.2}", x.r),
+    ]);
+    axis.add_row([
+        "systematic deviation E".to_string(),
+        format!("{:.2}", x.e_up),
+        format!("{:.2}", x.e_down),
+        format!("{:.2}", x.e),
+    ]);
+    axis.add_row([
+        "mean deviation M".to_string(),
+        "".into(),
+        "".into(),
+        format!("{:.2}", x.m),
+    ]);
+    axis.add_row([
+        "accuracy A".to_string(),
+        format!("{:.2}", x.a_up),
+        format!("{:.2}", x.a_down),
+        format!("{:.2}", x.a),
+    ]);
+    format!("{t}\n{axis}")
 }

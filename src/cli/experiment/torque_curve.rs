@@ -4,11 +4,15 @@ use std::path::Path;
 
 use anyhow::bail;
 
+use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+use rtid::experiments::torque_curve::TorqueReport;
+use rtid::report::torque_curve as figures;
+
 use super::Common;
 use crate::cli::progress;
-use crate::experiments::torque_curve::{self, TorqueTest};
-use crate::io::experiment_file::Experiment;
-use crate::model::{LoopMode, Params};
+use rtid::experiments::torque_curve::{self, TorqueTest};
+use rtid::io::experiment_file::Experiment;
+use rtid::model::{LoopMode, Params};
 
 pub const LONG_ABOUT: &str = "\
 Friction torque curve (paper §4.2, Fig. 9): the servo, in full-closed loop by default, \
@@ -94,7 +98,7 @@ fn run_torque_curve(a: &Args, p: &Params) -> anyhow::Result<()> {
         "--noise-percent {}: must be zero or positive",
         a.noise_percent
     );
-    crate::experiments::measurement_noise::perturb_by_rms(
+    rtid::experiments::measurement_noise::perturb_by_rms(
         &mut curve.motor_torque,
         a.noise_percent,
         a.seed,
@@ -126,13 +130,10 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("{}: {e}", exp.path.display()))?;
     let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
     let title = format!("{mechanism}: motor torque");
-    torque_curve::plot(&curve, &report, &title, plot)
-        .map_err(|e| anyhow::anyhow!("writing {}: {e}", plot.display()))?;
-    if !curve.table_angle.is_empty() {
+    figures::over_time(&curve, &report, &title).write(plot)?;
+    if let Some(figure) = figures::over_angle(&curve, &title) {
         let stem = plot.file_stem().unwrap_or_default().to_string_lossy();
-        let angle_plot = plot.with_file_name(format!("{stem}-vs-angle.svg"));
-        torque_curve::plot_vs_angle(&curve, &title, &angle_plot)
-            .map_err(|e| anyhow::anyhow!("writing {}: {e}", angle_plot.display()))?;
+        figure.write(&plot.with_file_name(format!("{stem}-vs-angle.svg")))?;
     }
     if json {
         let mut value = serde_json::to_value(&report)?;
@@ -146,9 +147,52 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
             test.amplitude.to_degrees(),
             test.period
         );
-        println!("{}", torque_curve::table(&report));
+        println!("{}", table(&report));
     }
     Ok(())
+}
+
+/// A readable summary.
+fn table(report: &TorqueReport) -> String {
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header(["torque curve", "value"]);
+    t.add_row(["samples".to_string(), report.samples.to_string()]);
+    t.add_row([
+        "duration, s".to_string(),
+        format!("{:.3}", report.duration_s),
+    ]);
+    t.add_row([
+        "RMS torque, N·m".to_string(),
+        format!("{:.4}", report.rms_nm),
+    ]);
+    t.add_row([
+        "peak torque, N·m".to_string(),
+        format!("{:.4}", report.peak_nm),
+    ]);
+    t.add_row([
+        "Coulomb friction at the motor, N·m".to_string(),
+        report
+            .friction_nm
+            .map_or("– (no usable reversal)".into(), |f| format!("{f:.4}")),
+    ]);
+    let mut r = Table::new();
+    r.load_preset(UTF8_FULL_CONDENSED);
+    r.set_header([
+        format!("reversal (from {})", report.reversals_from),
+        "moving before".into(),
+        "jump N·m".into(),
+        "friction N·m".into(),
+    ]);
+    for v in &report.reversals {
+        r.add_row([
+            format!("t = {:.4} s", v.time_s),
+            if v.direction_before > 0.0 { "+" } else { "−" }.into(),
+            format!("{:.4}", v.jump_nm),
+            format!("{:.4}", v.friction_nm),
+        ]);
+    }
+    format!("{t}\n{r}")
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 
 use super::fluctuation::{positive, run_test, RunArgs};
 use super::Common;
-use crate::experiments::fluctuation::{FluctuationTest, DEFAULT_UNBALANCE};
+use rtid::experiments::fluctuation::{FluctuationTest, DEFAULT_UNBALANCE};
 
 pub const LONG_ABOUT: &str = "\
 Influence of an unbalance mass (paper §4.5, Fig. 14): the table is mounted vertically \

@@ -1,21 +1,24 @@
-//! Sweep figures (SVG, plotters, written atomically): a tornado chart of each
-//! output's sensitivities, and for a grid the output over one factor (lines, via
-//! [`crate::report::plot`]) or over two (a heat map).
+//! Sweep figures (SVG, plotters): a tornado chart of each output's sensitivities, and
+//! for a grid the output over one factor (a line [`Figure`]) or over two (a heat map).
+//! Each is returned as (output column, SVG document); the caller decides where it goes.
 
 use std::collections::BTreeMap;
-use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::analysis::Indices;
-use super::spec::{Factor, Scale};
-use crate::report::plot::{self as lines, Chart, Series, Style};
+use super::figure::{Figure, FigureError, Series, Style};
+use crate::sweep::analysis::Indices;
+use crate::sweep::spec::{Factor, Scale};
 
 const BAR: RGBColor = RGBColor(31, 119, 180);
 const SECOND: RGBColor = RGBColor(255, 127, 14);
 
-fn text<E: std::fmt::Display>(e: E) -> std::io::Error {
-    std::io::Error::other(e.to_string())
+/// A drawing error of the chart titled `title`.
+fn drawing(title: &str) -> impl Fn(&dyn std::fmt::Display) -> FigureError + '_ {
+    move |e| FigureError::Draw {
+        title: title.to_string(),
+        message: e.to_string(),
+    }
 }
 
 /// One bar of a tornado chart: a label, the main value, an optional second value
@@ -34,12 +37,13 @@ pub fn tornado_svg(
     x_label: &str,
     legend: (&str, Option<&str>),
     bars: &[Bar],
-) -> std::io::Result<String> {
+) -> Result<String, FigureError> {
+    let text = drawing(title);
     let mut bars: Vec<&Bar> = bars.iter().filter(|b| b.value.is_finite()).collect();
     if bars.is_empty() {
-        return Err(std::io::Error::other(
-            "nothing to plot: no finite sensitivity",
-        ));
+        return Err(FigureError::Empty {
+            title: title.to_string(),
+        });
     }
     bars.sort_by(|a, b| a.value.abs().total_cmp(&b.value.abs()));
     let n = bars.len();
@@ -61,7 +65,7 @@ pub fn tornado_svg(
     {
         let height = 140 + 44 * n as u32;
         let root = SVGBackend::with_string(&mut svg, (900, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(text)?;
+        root.fill(&WHITE).map_err(|e| text(&e))?;
         let labels: Vec<String> = bars.iter().map(|b| b.label.clone()).collect();
         let mut c = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 22))
@@ -69,7 +73,7 @@ pub fn tornado_svg(
             .x_label_area_size(44)
             .y_label_area_size(120)
             .build_cartesian_2d((lo - pad)..(hi + pad), -0.5..(n as f64 - 0.5))
-            .map_err(text)?;
+            .map_err(|e| text(&e))?;
         c.configure_mesh()
             .x_desc(x_label)
             .y_labels(n)
@@ -84,7 +88,7 @@ pub fn tornado_svg(
             .disable_y_mesh()
             .light_line_style(RGBColor(235, 235, 235))
             .draw()
-            .map_err(text)?;
+            .map_err(|e| text(&e))?;
         let has_second = bars.iter().any(|b| b.second.is_some());
         let (h_main, h_second) = if has_second { (0.38, 0.2) } else { (0.35, 0.0) };
         c.draw_series(bars.iter().enumerate().map(|(i, b)| {
@@ -94,7 +98,7 @@ pub fn tornado_svg(
                 BAR.mix(0.8).filled(),
             )
         }))
-        .map_err(text)?
+        .map_err(|e| text(&e))?
         .label(legend.0)
         .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 18, y + 5)], BAR.filled()));
         if has_second {
@@ -104,7 +108,7 @@ pub fn tornado_svg(
                     Rectangle::new([(0.0, y - h_second), (s, y + h_second)], SECOND.filled())
                 })
             }))
-            .map_err(text)?
+            .map_err(|e| text(&e))?
             .label(legend.1.unwrap_or(""))
             .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 18, y + 5)], SECOND.filled()));
         }
@@ -113,25 +117,24 @@ pub fn tornado_svg(
             b.interval
                 .map(|(l, h)| PathElement::new(vec![(l, y), (h, y)], BLACK.stroke_width(2)))
         }))
-        .map_err(text)?;
+        .map_err(|e| text(&e))?;
         c.draw_series(std::iter::once(PathElement::new(
             vec![(0.0, -0.5), (0.0, n as f64 - 0.5)],
             BLACK.stroke_width(1),
         )))
-        .map_err(text)?;
+        .map_err(|e| text(&e))?;
         c.configure_series_labels()
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()
-            .map_err(text)?;
-        root.present().map_err(text)?;
+            .map_err(|e| text(&e))?;
+        root.present().map_err(|e| text(&e))?;
     }
     Ok(svg)
 }
 
-/// Tornado charts of every output column of `indices`, written as `stem-COLUMN.svg`
-/// beside `out`. Returns the files written.
-pub fn tornadoes(indices: &Indices, out: &Path) -> std::io::Result<Vec<std::path::PathBuf>> {
+/// Tornado charts of every output column of `indices`: (column, SVG).
+pub fn tornadoes(indices: &Indices) -> Result<Vec<(String, String)>, FigureError> {
     let Some(main) = indices.main_column() else {
         return Ok(Vec::new());
     };
@@ -169,27 +172,19 @@ pub fn tornadoes(indices: &Indices, out: &Path) -> std::io::Result<Vec<std::path
             ("ST", Some("S1")),
         ),
     };
-    let mut written = Vec::new();
+    let mut charts = Vec::new();
     for output in order {
         let bars = &by_output[output];
         if bars.iter().all(|b| !b.value.is_finite()) {
             continue;
         }
-        let path = beside(out, output);
         let title = format!("{output}: {} sensitivities", indices.method);
-        let svg = tornado_svg(&title, x_label, legend, bars)?;
-        crate::io::atomic::write(&path, svg.as_bytes())?;
-        written.push(path);
+        charts.push((
+            output.to_string(),
+            tornado_svg(&title, x_label, legend, bars)?,
+        ));
     }
-    Ok(written)
-}
-
-/// `dir/stem.csv` → `dir/stem-NAME.svg`.
-pub fn beside(out: &Path, name: &str) -> std::path::PathBuf {
-    let stem = out
-        .file_stem()
-        .map_or("sweep".into(), |s| s.to_string_lossy());
-    out.with_file_name(format!("{stem}-{name}.svg"))
+    Ok(charts)
 }
 
 /// A factor's axis coordinate and label: the value, or its log10 for a log range.
@@ -209,49 +204,37 @@ fn axis_label(f: &Factor) -> String {
 }
 
 /// Plots of a grid: each output column over the factor (one factor: a line per
-/// output column) or over the two factors (a heat map per column). `values[i]` are
-/// the factor values of row i, `y[c][i]` output column c (NaN: missing).
+/// output column) or over the two factors (a heat map per column); none for more
+/// factors. `values[i]` are the factor values of row i, `y[c][i]` output column c
+/// (NaN: missing). Returns (column, SVG).
 pub fn grid_plots(
     factors: &[Factor],
     values: &[Vec<f64>],
     names: &[String],
     y: &[Vec<f64>],
-    out: &Path,
-) -> std::io::Result<Vec<std::path::PathBuf>> {
-    let mut written = Vec::new();
+) -> Result<Vec<(String, String)>, FigureError> {
+    let mut charts = Vec::new();
     for (name, col) in names.iter().zip(y) {
         if col.iter().all(|v| !v.is_finite()) {
             continue;
         }
-        let path = beside(out, name);
-        match factors.len() {
+        let svg = match factors.len() {
             1 => {
                 let pts = values
                     .iter()
                     .zip(col)
                     .map(|(v, &c)| (axis(&factors[0], v[0]), c))
                     .collect();
-                let xl = axis_label(&factors[0]);
-                let chart = Chart {
-                    title: name,
-                    x_label: &xl,
-                    y_label: name,
-                };
-                lines::write(
-                    &path,
-                    &chart,
-                    &[Series::new(name.clone(), pts, Style::Line)],
-                )?;
+                Figure::new(name.as_str(), &axis_label(&factors[0]), name)
+                    .with(Series::new(name.clone(), pts, Style::Line))
+                    .render()?
             }
-            2 => {
-                let svg = heat_map(name, factors, values, col)?;
-                crate::io::atomic::write(&path, svg.as_bytes())?;
-            }
-            _ => return Ok(written),
-        }
-        written.push(path);
+            2 => heat_map(name, factors, values, col)?,
+            _ => break,
+        };
+        charts.push((name.clone(), svg));
     }
-    Ok(written)
+    Ok(charts)
 }
 
 /// A colour from blue (0) through green to yellow (1), after viridis.
@@ -277,7 +260,8 @@ fn heat_map(
     factors: &[Factor],
     values: &[Vec<f64>],
     col: &[f64],
-) -> std::io::Result<String> {
+) -> Result<String, FigureError> {
+    let text = drawing(name);
     let (fx, fy) = (&factors[0], &factors[1]);
     let cell = |f: &Factor| {
         let (a, b) = (axis(f, f.low), axis(f, f.high));
@@ -292,7 +276,7 @@ fn heat_map(
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (900, 640)).into_drawing_area();
-        root.fill(&WHITE).map_err(text)?;
+        root.fill(&WHITE).map_err(|e| text(&e))?;
         let (main, bar) = root.split_horizontally(780);
         let mut c = ChartBuilder::on(&main)
             .caption(name, ("sans-serif", 22))
@@ -300,13 +284,13 @@ fn heat_map(
             .x_label_area_size(44)
             .y_label_area_size(80)
             .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(text)?;
+            .map_err(|e| text(&e))?;
         c.configure_mesh()
             .x_desc(axis_label(fx))
             .y_desc(axis_label(fy))
             .disable_mesh()
             .draw()
-            .map_err(text)?;
+            .map_err(|e| text(&e))?;
         c.draw_series(values.iter().zip(col).map(|(v, &z)| {
             let (x, y) = (axis(fx, v[0]), axis(fy, v[1]));
             let fill = if z.is_finite() {
@@ -319,14 +303,14 @@ fn heat_map(
                 fill,
             )
         }))
-        .map_err(text)?;
+        .map_err(|e| text(&e))?;
         let mut b = ChartBuilder::on(&bar)
             .margin_top(60)
             .margin_bottom(60)
             .margin_right(10)
             .y_label_area_size(70)
             .build_cartesian_2d(0.0..1.0, lo..(lo + span))
-            .map_err(text)?;
+            .map_err(|e| text(&e))?;
         // Enough decimals to tell the colour bar's ticks apart.
         let decimals = (2.0 - span.log10().floor()).clamp(0.0, 12.0) as usize;
         b.configure_mesh()
@@ -336,7 +320,7 @@ fn heat_map(
             .y_label_style(("sans-serif", 14))
             .y_label_formatter(&|v: &f64| format!("{v:.decimals$}"))
             .draw()
-            .map_err(text)?;
+            .map_err(|e| text(&e))?;
         b.draw_series((0..100).map(|i| {
             let (t0, t1) = (i as f64 / 100.0, (i + 1) as f64 / 100.0);
             Rectangle::new(
@@ -344,8 +328,8 @@ fn heat_map(
                 colour(t0 + 0.005).filled(),
             )
         }))
-        .map_err(text)?;
-        root.present().map_err(text)?;
+        .map_err(|e| text(&e))?;
+        root.present().map_err(|e| text(&e))?;
     }
     Ok(svg)
 }

@@ -1,102 +1,17 @@
-//! Where the model's resonances are: peaks of its gain curve, either of the exact
-//! linear response (grid scan + golden-section refinement on the smooth curve) or of
-//! the nonlinear virtual test (a short scan of time simulations around the linear
-//! prediction + two parabolic refinements).
+//! Where the model's resonances are, for the objectives that compare peaks: those of
+//! its exact linear response ([`crate::peaks::of_linear_response`]), or of the
+//! nonlinear virtual test (a short scan of time simulations around the linear
+//! prediction + two parabolic refinements, or like for like on a measured grid).
 //!
 //! The nonlinear search costs 9 simulations per peak (more if the peak lies outside
 //! the first scan); the linear one a few hundred 4×4 complex solves.
 
-use nalgebra::{Complex, DVector};
 use rayon::prelude::*;
 
-use crate::experiments::frequency_response::{simulate_point, FrequencyTest, Peak};
-use crate::model::modes::LinearModel;
-use crate::model::{ParamError, Params};
+use crate::experiments::frequency_response::{simulate_point, FrequencyTest};
+use crate::model::Params;
+use crate::peaks::{of_linear_response, vertex, Peak};
 use crate::sim::SimError;
-
-/// The exact linear gain |θt/(θm·Rg·Rw)| of one parameter set, in dB.
-pub struct LinearGain {
-    model: LinearModel,
-    force: DVector<Complex<f64>>,
-    motor: usize,
-    table: usize,
-    ratio: f64,
-}
-
-impl LinearGain {
-    pub fn new(p: &Params) -> Result<Self, ParamError> {
-        let model = LinearModel::new(p)?;
-        let motor = model.index("theta_m").expect("every topology has theta_m");
-        let table = model.index("theta_t").expect("every topology has theta_t");
-        let mut force = DVector::from_element(model.n_dof(), Complex::new(0.0, 0.0));
-        force[motor] = Complex::new(1.0, 0.0);
-        Ok(LinearGain {
-            model,
-            force,
-            motor,
-            table,
-            ratio: p.ratio(),
-        })
-    }
-
-    /// Gain at `hz`, dB (−∞ where the system is singular).
-    pub fn gain_db(&self, hz: f64) -> f64 {
-        match self.model.response(std::f64::consts::TAU * hz, &self.force) {
-            Some(x) => {
-                20.0 * (x[self.table] / (x[self.motor] * self.ratio))
-                    .norm()
-                    .log10()
-            }
-            None => f64::NEG_INFINITY,
-        }
-    }
-
-    /// Every local maximum of the gain in [lo_hz, hi_hz], located to 1e-7 relative.
-    pub fn peaks(&self, lo_hz: f64, hi_hz: f64) -> Vec<Peak> {
-        const GRID: usize = 600;
-        let ratio = (hi_hz / lo_hz).powf(1.0 / (GRID - 1) as f64);
-        let f: Vec<f64> = (0..GRID).map(|i| lo_hz * ratio.powi(i as i32)).collect();
-        let g: Vec<f64> = f.iter().map(|&hz| self.gain_db(hz)).collect();
-        (1..GRID - 1)
-            .filter(|&i| g[i] > g[i - 1] && g[i] >= g[i + 1])
-            .map(|i| self.golden_max(f[i - 1], f[i + 1]))
-            .collect()
-    }
-
-    /// The maximum of the gain in [a, b] (unimodal there) by golden-section search.
-    fn golden_max(&self, mut a: f64, mut b: f64) -> Peak {
-        let r = 0.5 * (5f64.sqrt() - 1.0);
-        let mut c = b - r * (b - a);
-        let mut d = a + r * (b - a);
-        let (mut gc, mut gd) = (self.gain_db(c), self.gain_db(d));
-        while b - a > 1e-7 * b {
-            if gc > gd {
-                (b, d, gd) = (d, c, gc);
-                c = b - r * (b - a);
-                gc = self.gain_db(c);
-            } else {
-                (a, c, gc) = (c, d, gd);
-                d = a + r * (b - a);
-                gd = self.gain_db(d);
-            }
-        }
-        let f = 0.5 * (a + b);
-        Peak {
-            frequency_hz: f,
-            gain_db: self.gain_db(f),
-        }
-    }
-}
-
-/// The `n` highest local maxima of the linear gain in [lo_hz, hi_hz], ascending in
-/// frequency (fewer if the curve has fewer).
-pub fn linear_peaks(p: &Params, lo_hz: f64, hi_hz: f64, n: usize) -> Result<Vec<Peak>, ParamError> {
-    let mut peaks = LinearGain::new(p)?.peaks(lo_hz, hi_hz);
-    peaks.sort_by(|a, b| b.gain_db.total_cmp(&a.gain_db));
-    peaks.truncate(n);
-    peaks.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-    Ok(peaks)
-}
 
 /// Relative offsets of the first nonlinear scan around the linear prediction: backlash
 /// and friction soften the drive, so the scan reaches further down than up.
@@ -233,7 +148,7 @@ impl ModelPeaks {
     /// in the nonlinear virtual test when the fidelity asks for it (peaks in parallel)
     /// — on the measured frequencies when they are given ([`nonlinear_peak_on_grid`]).
     pub fn locate(&self, p: &Params, n: usize) -> Result<Vec<Peak>, super::ObjectiveError> {
-        let guesses = linear_peaks(p, self.band.0, self.band.1, n)?;
+        let guesses = of_linear_response(p, self.band.0, self.band.1, n)?;
         match self.fidelity {
             super::Fidelity::Linear => Ok(guesses),
             super::Fidelity::Nonlinear => guesses
@@ -255,58 +170,4 @@ fn argmax(v: &[f64]) -> usize {
         .enumerate()
         .max_by(|a, b| a.1.total_cmp(b.1))
         .map_or(0, |(i, _)| i)
-}
-
-/// The vertex of the parabola through three points (x ascending), clamped to
-/// [x0, x2]; the middle point if the parabola is not concave.
-pub fn vertex((x0, y0): (f64, f64), (x1, y1): (f64, f64), (x2, y2): (f64, f64)) -> Peak {
-    let d = (x0 - x1) * (x0 - x2) * (x1 - x2);
-    let a = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / d;
-    let b = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / d;
-    if a >= 0.0 || !a.is_finite() || !b.is_finite() {
-        let best = [(x0, y0), (x1, y1), (x2, y2)]
-            .into_iter()
-            .max_by(|p, q| p.1.total_cmp(&q.1))
-            .unwrap_or((x1, y1));
-        return Peak {
-            frequency_hz: best.0,
-            gain_db: best.1,
-        };
-    }
-    let xv = (-b / (2.0 * a)).clamp(x0, x2);
-    // Evaluate in centred form for accuracy.
-    let c = y1 - a * x1 * x1 - b * x1;
-    Peak {
-        frequency_hz: xv,
-        gain_db: a * xv * xv + b * xv + c,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::model::presets;
-
-    #[test]
-    fn linear_peaks_are_the_maxima_of_the_linear_gain() {
-        let p = presets::load("worm-gear").unwrap();
-        let lin = LinearGain::new(&p).unwrap();
-        let peaks = linear_peaks(&p, 10.0, 600.0, 2).unwrap();
-        assert_eq!(peaks.len(), 2, "{peaks:?}");
-        for pk in &peaks {
-            for d in [-0.01, 0.01] {
-                assert!(lin.gain_db(pk.frequency_hz + d) < pk.gain_db, "{pk:?}");
-            }
-        }
-        // Near the damped motor-held modes (186.5 and 236.9 Hz undamped).
-        assert!((peaks[0].frequency_hz - 186.9).abs() < 0.5, "{peaks:?}");
-        assert!((peaks[1].frequency_hz - 234.1).abs() < 1.0, "{peaks:?}");
-    }
-
-    #[test]
-    fn the_vertex_of_a_parabola_is_exact() {
-        let y = |x: f64| 3.0 - 0.5 * (x - 1.3) * (x - 1.3);
-        let pk = vertex((1.0, y(1.0)), (1.5, y(1.5)), (2.0, y(2.0)));
-        assert!((pk.frequency_hz - 1.3).abs() < 1e-12 && (pk.gain_db - 3.0).abs() < 1e-12);
-    }
 }

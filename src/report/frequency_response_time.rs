@@ -1,0 +1,81 @@
+//! Figures of a frequency response estimated from raw time series: the gain (stepped
+//! sine or H1) with its resonances, and the coherence of an H1 estimate.
+
+use super::figure::{Figure, Series, Style};
+use crate::experiments::frequency_response_estimate::{kept_runs, Bin, Evaluation};
+
+/// The gain with the resonances marked, and for H1 the coherence figure too.
+pub fn figures(e: &Evaluation, mechanism: &str) -> (Figure, Option<Figure>) {
+    let markers = Series::new(
+        "resonances",
+        e.peaks()
+            .iter()
+            .map(|p| (p.frequency_hz, p.gain_db))
+            .collect(),
+        Style::Markers,
+    );
+    match e {
+        Evaluation::SteppedSine { points, .. } => {
+            let mut curve: Vec<(f64, f64)> =
+                points.iter().map(|q| (q.frequency_hz, q.gain_db)).collect();
+            curve.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let gain = Figure::new(
+                format!("{mechanism}: frequency response (stepped sine)"),
+                "frequency, Hz",
+                "gain, dB",
+            )
+            .with(Series::new("gain (stepped sine)", curve, Style::Line))
+            .with(markers);
+            (gain, None)
+        }
+        Evaluation::H1 {
+            bins,
+            min_coherence,
+            ..
+        } => {
+            let mut gain = Figure::new(
+                format!("{mechanism}: frequency response (H1, Welch)"),
+                "frequency, Hz",
+                "gain, dB",
+            );
+            for (i, run) in kept_runs(bins).into_iter().enumerate() {
+                let name = if i == 0 {
+                    format!("H1 gain where γ² ≥ {min_coherence}")
+                } else {
+                    String::new()
+                };
+                gain = gain.with(Series::new(name, run, Style::Line));
+            }
+            let coherence = coherence(bins, *min_coherence, mechanism);
+            (gain.with(markers), Some(coherence))
+        }
+    }
+}
+
+/// The coherence up to a little beyond the highest kept bin (above it is noise), with
+/// the threshold.
+fn coherence(bins: &[Bin], min_coherence: f64, mechanism: &str) -> Figure {
+    let top = bins
+        .iter()
+        .filter(|b| b.kept)
+        .map(|b| b.frequency_hz)
+        .fold(0.0, f64::max);
+    let top = if top > 0.0 { 1.2 * top } else { f64::INFINITY };
+    let points: Vec<(f64, f64)> = bins
+        .iter()
+        .filter(|b| b.frequency_hz <= top)
+        .map(|b| (b.frequency_hz, b.coherence))
+        .collect();
+    let x1 = points.last().map_or(1.0, |c| c.0);
+    Figure::new(
+        format!("{mechanism}: coherence, motor angle → table angle"),
+        "frequency, Hz",
+        "γ²",
+    )
+    .with(Series::new("coherence γ²", points, Style::Line))
+    .with(Series::new(
+        "threshold",
+        vec![(0.0, min_coherence), (x1, min_coherence)],
+        Style::Dashed,
+    ))
+}
