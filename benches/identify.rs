@@ -8,55 +8,39 @@
 //! check). `identify/fit/worm-gear-nonlinear`: the same with `--model nonlinear`
 //! (issue 4's goal: < 3 s on 2 cores).
 
-use std::path::Path;
+#[path = "../tests/support/mod.rs"]
+mod support;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use rtid::identify::setup::{frequency_test, measured_grid};
 use rtid::identify::{identify, Config, FidelityChoice, Monitor};
-use rtid::io::experiment_file;
-use rtid::model::presets;
-use rtid::objectives::{resonance::ResonanceMatch, Fidelity, Objective};
+use rtid::objectives::{Fidelity, ObjectiveKind, Source};
 
 fn bench(c: &mut Criterion) {
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/worm-gear/frequency_response.json");
-    let exp = experiment_file::read(&path).unwrap();
-    let p = presets::load("worm-gear").unwrap();
-    let peaks: Vec<f64> = rtid::identify::setup::measured_peaks("fixture", &exp)
-        .unwrap()
-        .iter()
-        .map(|k| k.frequency_hz)
-        .collect();
+    let support::Fixture { spec, truth } = support::worm_frequency_response();
+    let source = Source {
+        file: &spec.source,
+        experiment: &spec.experiment,
+    };
+    let resonance = ObjectiveKind::named("resonance").unwrap();
     let mut group = c.benchmark_group("identify");
     group.sample_size(10);
     group.throughput(Throughput::Elements(1));
     for fidelity in [Fidelity::Linear, Fidelity::Nonlinear] {
-        let obj = ResonanceMatch::new(peaks.clone(), fidelity, frequency_test(&exp))
-            .on_grid(measured_grid(&exp).expect("a gain curve"));
+        let obj = resonance.build(&source, fidelity).unwrap();
         group.bench_function(format!("cost/{}", fidelity.name()), |b| {
-            b.iter(|| obj.residuals(&p).unwrap())
+            b.iter(|| obj.residuals(&truth).unwrap())
         });
     }
-    let mut start = p.clone();
-    start.kw *= 1.4;
-    start.kg = start.kg.map(|k| k * 1.4);
+    let start = support::off(&truth, &[("Kw", 1.4), ("Kg", 1.4)]);
     group.bench_function("fit/worm-gear", |b| {
         b.iter(|| {
-            let config = Config::new(
-                vec![("fixture".into(), exp.clone())],
-                start.clone(),
-                &["Kw", "Kg"],
-            );
+            let config = Config::new(vec![spec.clone()], start.clone(), &["Kw", "Kg"]);
             identify(&config, &Monitor::default()).unwrap()
         })
     });
     group.bench_function("fit/worm-gear-nonlinear", |b| {
         b.iter(|| {
-            let mut config = Config::new(
-                vec![("fixture".into(), exp.clone())],
-                start.clone(),
-                &["Kw", "Kg"],
-            );
+            let mut config = Config::new(vec![spec.clone()], start.clone(), &["Kw", "Kg"]);
             config.fidelity = FidelityChoice::Nonlinear;
             identify(&config, &Monitor::default()).unwrap()
         })

@@ -1,35 +1,33 @@
 //! Identification (issue 4): parameters recovered from rtid's own virtual
 //! experiments (fixtures/), multi-start, identifiability warnings, the interrupt path.
+//! The true values come from the fixtures (`support`), the presets that made them.
 
-use std::path::Path;
+mod support;
 
-use rtid::identify::setup::ObjectiveKind;
-use rtid::identify::{identify, Bound, Config, FidelityChoice, Identified, Method, Monitor};
-use rtid::io::experiment_file::{self, Data, Experiment, Kind, Manifest};
+use rtid::identify::{
+    identify, Bound, Config, ExperimentSpec, FidelityChoice, Identified, Method, Monitor, Warning,
+};
+use rtid::io::experiment_file::{Data, Experiment, Kind, Manifest};
 use rtid::model::{presets, Params};
+use rtid::objectives::ObjectiveKind;
 use rtid::peaks::of_linear_response as linear_peaks;
+use support::{off, values, Fixture};
 
-fn fixture(path: &str) -> (String, Experiment) {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("fixtures")
-        .join(path);
-    (path.to_string(), experiment_file::read(&p).unwrap())
-}
-
-fn preset_with(name: &str, set: &[(&str, f64)]) -> Params {
-    let mut p = presets::load(name).unwrap();
-    for (k, v) in set {
-        p.set(k, *v).unwrap();
-    }
-    p
-}
-
-fn config(experiments: Vec<(String, Experiment)>, base: Params, fit: &[&str]) -> Config {
+fn config(experiments: Vec<ExperimentSpec>, base: Params, fit: &[&str]) -> Config {
     Config::new(experiments, base, fit)
 }
 
 fn run(c: &Config) -> Identified {
     identify(c, &Monitor::default()).unwrap()
+}
+
+fn objective(name: &str) -> ObjectiveKind {
+    ObjectiveKind::named(name).unwrap()
+}
+
+/// Whether a warning of the result matches.
+fn warns(r: &Identified, matches: impl Fn(&Warning) -> bool) -> bool {
+    r.result.warnings.iter().any(|w| matches(&w.0))
 }
 
 fn assert_within(r: &Identified, truth: &[(&str, f64)], tol: f64) {
@@ -46,14 +44,11 @@ fn assert_within(r: &Identified, truth: &[(&str, f64)], tol: f64) {
 
 #[test]
 fn kw_and_kg_from_the_worm_frequency_response_within_1_percent_from_50_percent_off() {
+    let Fixture { spec, truth } = support::worm_frequency_response();
     for (kw, kg) in [(1.5, 0.5), (0.5, 1.5), (1.5, 1.5)] {
-        let base = preset_with("worm-gear", &[("Kw", 3.1e5 * kw), ("Kg", 850.0 * kg)]);
-        let r = run(&config(
-            vec![fixture("worm-gear/frequency_response.json")],
-            base,
-            &["Kw", "Kg"],
-        ));
-        assert_within(&r, &[("Kw", 3.1e5), ("Kg", 850.0)], 0.01);
+        let base = off(&truth, &[("Kw", kw), ("Kg", kg)]);
+        let r = run(&config(vec![spec.clone()], base, &["Kw", "Kg"]));
+        assert_within(&r, &values(&truth, &["Kw", "Kg"]), 0.01);
         assert!(!r.result.interrupted);
     }
 }
@@ -64,18 +59,15 @@ fn kw_and_kg_from_nonlinear_simulations_within_0_2_percent_from_40_percent_off()
     // −0.36 % / −0.18 % on this nonlinear data (the bias of backlash and friction), so
     // 0.2 % needs the nonlinear stage; it must converge in a few evaluations of the
     // nonlinear test (docs/identification.md, `--model nonlinear`).
-    let base = preset_with("worm-gear", &[("Kw", 3.1e5 * 1.4), ("Kg", 850.0 * 1.4)]);
-    let mut c = config(
-        vec![fixture("worm-gear/frequency_response.json")],
-        base,
-        &["Kw", "Kg"],
-    );
+    let Fixture { spec, truth } = support::worm_frequency_response();
+    let base = off(&truth, &[("Kw", 1.4), ("Kg", 1.4)]);
+    let mut c = config(vec![spec], base, &["Kw", "Kg"]);
     c.fidelity = FidelityChoice::Nonlinear;
     let r = run(&c);
-    assert_within(&r, &[("Kw", 3.1e5), ("Kg", 850.0)], 0.002);
+    assert_within(&r, &values(&truth, &["Kw", "Kg"]), 0.002);
     let stage = &r.result.starts[0];
     assert!(
-        stage.termination.starts_with("converged") && stage.iterations <= 6,
+        stage.termination.converged() && stage.iterations <= 6,
         "{stage:?}"
     );
     assert_eq!(r.result.residuals[0].objective, "gain_curve");
@@ -83,18 +75,12 @@ fn kw_and_kg_from_nonlinear_simulations_within_0_2_percent_from_40_percent_off()
 
 #[test]
 fn kw_and_kb_of_the_roller_from_two_resonances() {
-    let base = preset_with(
-        "roller-gear-cam",
-        &[("Kw", 1.11e6 * 0.5), ("Kb", 9.0e6 * 1.5)],
-    );
-    let r = run(&config(
-        vec![fixture("roller-gear-cam/frequency_response.json")],
-        base,
-        &["Kw", "Kb"],
-    ));
-    assert_within(&r, &[("Kw", 1.11e6), ("Kb", 9.0e6)], 0.01);
+    let Fixture { spec, truth } = support::roller_frequency_response();
+    let base = off(&truth, &[("Kw", 0.5), ("Kb", 1.5)]);
+    let r = run(&config(vec![spec], base, &["Kw", "Kb"]));
+    assert_within(&r, &values(&truth, &["Kw", "Kb"]), 0.01);
     assert!(
-        !r.result.warnings.iter().any(|w| w.contains("correlated")),
+        !warns(&r, |w| matches!(w, Warning::Correlated { .. })),
         "Kw and Kb of the roller move its two modes differently: {:?}",
         r.result.warnings
     );
@@ -102,18 +88,15 @@ fn kw_and_kb_of_the_roller_from_two_resonances() {
 
 #[test]
 fn with_1_percent_noise_kw_and_kg_within_5_percent() {
-    let base = preset_with("worm-gear", &[("Kw", 3.1e5 * 1.5), ("Kg", 850.0 * 0.5)]);
-    let r = run(&config(
-        vec![fixture("worm-gear-noisy/frequency_response.json")],
-        base,
-        &["Kw", "Kg"],
-    ));
-    assert_within(&r, &[("Kw", 3.1e5), ("Kg", 850.0)], 0.05);
+    let Fixture { spec, truth } = support::worm_frequency_response_noisy();
+    let base = off(&truth, &[("Kw", 1.5), ("Kg", 0.5)]);
+    let r = run(&config(vec![spec], base, &["Kw", "Kg"]));
+    assert_within(&r, &values(&truth, &["Kw", "Kg"]), 0.05);
 }
 
 /// A resonance experiment made from the exact linear peaks of the preset (frequency
 /// and height), as a measurement in the linear limit would give them.
-fn linear_resonance_experiment(p: &Params) -> (String, Experiment) {
+fn linear_resonance_experiment(p: &Params) -> ExperimentSpec {
     let peaks = linear_peaks(p, 10.0, 600.0, 2).unwrap();
     let mut m = Manifest::new(Kind::Resonance);
     m.peaks_hz = Some(peaks.iter().map(|k| k.frequency_hz).collect());
@@ -122,8 +105,8 @@ fn linear_resonance_experiment(p: &Params) -> (String, Experiment) {
         peaks_hz: m.peaks_hz.clone().unwrap(),
         peak_gain_db: m.peak_gain_db.clone(),
     };
-    (
-        "linear-peaks".into(),
+    ExperimentSpec::new(
+        "linear-peaks",
         Experiment {
             manifest: m,
             data,
@@ -138,14 +121,11 @@ fn ciw_and_cig_from_the_peak_amplitudes_within_5_percent() {
     let truth = presets::load("worm-gear").unwrap();
     let exp = linear_resonance_experiment(&truth);
     for (a, b) in [(1.5, 0.5), (0.5, 1.5)] {
-        let base = preset_with(
-            "worm-gear",
-            &[("Ciw", truth.ciw * a), ("Cig", truth.cig.unwrap() * b)],
-        );
-        let mut c = config(vec![exp.clone()], base, &["Ciw", "Cig"]);
-        c.objectives = Some(vec![ObjectiveKind::PeakAmplitude]);
+        let base = off(&truth, &[("Ciw", a), ("Cig", b)]);
+        let c = config(vec![exp.clone()], base, &["Ciw", "Cig"])
+            .with_objectives(&[objective("peak_amplitude")]);
         let r = run(&c);
-        assert_within(&r, &[("Ciw", truth.ciw), ("Cig", truth.cig.unwrap())], 0.05);
+        assert_within(&r, &values(&truth, &["Ciw", "Cig"]), 0.05);
     }
 }
 
@@ -155,23 +135,21 @@ fn motor_friction_and_viscous_damping_from_the_torque_curve_within_5_percent() {
     // Rg·Rw = 1/90 at the motor and hardly show; see docs/validation.md), started
     // 50 % off, clean and with 1 % noise. Nelder–Mead: the quantised encoders make the
     // torque residual rough on the scale of finite differences.
-    for (set, start) in [
-        ("worm-gear/torque_curve.json", (1.5, 0.5)),
-        ("worm-gear-noisy/torque_curve.json", (0.5, 1.5)),
+    for (fixture, start) in [
+        (support::worm_torque_curve(), (1.5, 0.5)),
+        (support::worm_torque_curve_noisy(), (0.5, 1.5)),
     ] {
-        let base = preset_with(
-            "worm-gear",
-            &[("fm", 0.14 * start.0), ("Cm", 8.0e-3 * start.1)],
-        );
-        let mut c = config(vec![fixture(set)], base, &["fm", "Cm"]);
-        c.settings.starts = 1;
-        c.settings.method = Method::NelderMead;
-        c.settings.max_iters = 60;
+        let Fixture { spec, truth } = fixture;
+        let base = off(&truth, &[("fm", start.0), ("Cm", start.1)]);
+        let mut c = config(vec![spec], base, &["fm", "Cm"]);
+        c.search.starts = Some(1);
+        c.search.method = Some(Method::NelderMead);
+        c.search.max_iters = 60;
         let r = run(&c);
-        assert_within(&r, &[("fm", 0.14), ("Cm", 8.0e-3)], 0.05);
+        assert_within(&r, &values(&truth, &["fm", "Cm"]), 0.05);
         // The standard errors of such a fit are lower bounds, and the result says so.
         assert!(
-            r.result.warnings.iter().any(|w| w.contains("lower bounds")),
+            warns(&r, |w| *w == Warning::RoughCost),
             "{:?}",
             r.result.warnings
         );
@@ -216,23 +194,23 @@ fn the_table_friction_hardly_shows_in_the_motor_torque() {
 
 #[test]
 fn the_kw_kb_pair_of_the_worm_is_flagged_and_kw_kg_is_not() {
-    let base = presets::load("worm-gear").unwrap();
-    let exp = fixture("worm-gear/frequency_response.json");
-    let r = run(&config(vec![exp.clone()], base.clone(), &["Kw", "Kb"]));
+    let Fixture { spec, truth } = support::worm_frequency_response();
+    let r = run(&config(vec![spec.clone()], truth.clone(), &["Kw", "Kb"]));
     assert!(
-        r.result
-            .warnings
-            .iter()
-            .any(|w| w.contains("Kw and Kb") || w.contains("singular")),
+        warns(&r, |w| match w {
+            Warning::Correlated { a, b, .. } => a == "Kw" && b == "Kb",
+            Warning::Singular { .. } => true,
+            _ => false,
+        }),
         "Kb·r² acts in series with Kw: {:?}",
         r.result.warnings
     );
-    let r = run(&config(vec![exp], base, &["Kw", "Kg"]));
+    let r = run(&config(vec![spec], truth, &["Kw", "Kg"]));
     assert!(
-        !r.result
-            .warnings
-            .iter()
-            .any(|w| w.contains("correlated") || w.contains("singular")),
+        !warns(&r, |w| matches!(
+            w,
+            Warning::Correlated { .. } | Warning::Singular { .. }
+        )),
         "{:?}",
         r.result.warnings
     );
@@ -243,41 +221,35 @@ fn multistart_escapes_the_local_minimum_a_single_start_falls_into() {
     // The whole linear gain curve against Kw alone over two decades: started 3.4×
     // too soft (Kw = 9e4), the model's resonances sit below the measured ones and the
     // gain-curve residual has a local minimum there.
-    let base = preset_with("worm-gear", &[("Kw", 9e4)]);
-    let mut c = config(
-        vec![fixture("worm-gear/frequency_response.json")],
-        base,
-        &["Kw"],
-    );
-    c.objectives = Some(vec![ObjectiveKind::GainCurve]);
+    let Fixture { spec, truth } = support::worm_frequency_response();
+    let kw_true = truth.kw;
+    let mut base = truth.clone();
+    base.kw = 9e4;
+    let mut c = config(vec![spec], base, &["Kw"]).with_objectives(&[objective("gain_curve")]);
     c.fidelity = FidelityChoice::Linear;
     c.bounds = vec![("Kw".into(), Bound { lo: 3e4, hi: 3e6 })];
-    c.settings.starts = 1;
+    c.search.starts = Some(1);
     let single = run(&c);
     let kw = single.result.parameters["Kw"];
     assert!(
-        ((kw - 3.1e5) / 3.1e5).abs() > 0.2,
+        ((kw - kw_true) / kw_true).abs() > 0.2,
         "one start from 9e4 should stall in the local minimum, got Kw = {kw:.4e}"
     );
-    c.settings.starts = 8;
+    c.search.starts = Some(8);
     let multi = run(&c);
-    assert_within(&multi, &[("Kw", 3.1e5)], 0.02);
+    assert_within(&multi, &values(&truth, &["Kw"]), 0.02);
     assert!(multi.result.cost < single.result.cost);
 }
 
 #[test]
 fn an_interrupted_search_still_writes_a_valid_result() {
-    let base = preset_with("worm-gear", &[("fm", 0.2)]);
-    let mut c = config(
-        vec![fixture("worm-gear/torque_curve.json")],
-        base,
-        &["fm", "Cm"],
-    );
-    c.settings.max_evaluations = Some(5);
-    c.settings.starts = 2;
+    let Fixture { spec, truth } = support::worm_torque_curve();
+    let mut c = config(vec![spec], off(&truth, &[("fm", 1.4)]), &["fm", "Cm"]);
+    c.search.max_evaluations = Some(5);
+    c.search.starts = Some(2);
     let r = run(&c);
     assert!(r.result.interrupted);
-    assert!(r.result.warnings.iter().any(|w| w.contains("stopped")));
+    assert!(warns(&r, |w| matches!(w, Warning::Interrupted { .. })));
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("result.json");
     r.result.write(&path).unwrap();
@@ -289,21 +261,15 @@ fn an_interrupted_search_still_writes_a_valid_result() {
         assert!(x.is_finite() && x >= b[0].as_f64().unwrap() && x <= b[1].as_f64().unwrap());
     }
     assert!(v["cost"].as_f64().unwrap().is_finite());
-    assert_eq!(v["termination"], "interrupted");
+    assert_eq!(v["termination"]["code"], "interrupted");
 }
 
 #[test]
 fn the_paper_worm_resonances_are_out_of_reach_of_kw_and_kg() {
-    let r = run(&config(
-        vec![fixture("paper/worm-gear.json")],
-        presets::load("worm-gear").unwrap(),
-        &["Kw", "Kg"],
-    ));
+    let Fixture { spec, truth } = support::paper_worm();
+    let r = run(&config(vec![spec], truth, &["Kw", "Kg"]));
     assert!(
-        r.result
-            .warnings
-            .iter()
-            .any(|w| w.contains("misses the measured resonances")),
+        warns(&r, |w| matches!(w, Warning::ResonanceMiss { .. })),
         "{:?}",
         r.result.warnings
     );
@@ -311,29 +277,25 @@ fn the_paper_worm_resonances_are_out_of_reach_of_kw_and_kg() {
 
 #[test]
 fn methods_agree_on_an_easy_problem() {
+    let Fixture { spec, truth } = support::worm_frequency_response();
     for method in [Method::NelderMead, Method::Pso] {
-        let base = preset_with("worm-gear", &[("Kw", 3.1e5 * 1.3), ("Kg", 850.0 * 0.8)]);
-        let mut c = config(
-            vec![fixture("worm-gear/frequency_response.json")],
-            base,
-            &["Kw", "Kg"],
-        );
-        c.settings.method = method;
-        c.settings.starts = 4;
-        c.settings.max_iters = if method == Method::Pso { 60 } else { 300 };
+        let base = off(&truth, &[("Kw", 1.3), ("Kg", 0.8)]);
+        let mut c = config(vec![spec.clone()], base, &["Kw", "Kg"]);
+        c.search.method = Some(method);
+        c.search.starts = Some(4);
+        c.search.max_iters = if method == Method::Pso { 60 } else { 300 };
         let r = run(&c);
-        assert_within(&r, &[("Kw", 3.1e5), ("Kg", 850.0)], 0.02);
+        assert_within(&r, &values(&truth, &["Kw", "Kg"]), 0.02);
     }
 }
 
 /// The torque-curve objective of the worm fixture and the uncertainty at the truth
 /// for `names` (standard machinery: the Jacobian step of a simulated objective).
-fn torque_curve_uncertainty(names: &[&str], step: f64) -> rtid::identify::uncertainty::Uncertainty {
+fn torque_curve_uncertainty(names: &[&str], step: f64) -> rtid::identify::uncertainty::Assessed {
     use rtid::identify::{setup, uncertainty::at_optimum, ParamSpace};
-    use rtid::objectives::Fidelity;
-    let truth = presets::load("worm-gear").unwrap();
-    let exp = vec![fixture("worm-gear/torque_curve.json")];
-    let joint = setup::build(&exp, None, &[], Fidelity::Linear).unwrap();
+    use rtid::objectives::{Fidelity, Stage};
+    let Fixture { spec, truth } = support::worm_torque_curve();
+    let joint = setup::build(&[spec], Stage::Search, Fidelity::Linear).unwrap();
     let names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
     let space = ParamSpace::new(truth.clone(), &names, &[]).unwrap();
     let values: Vec<f64> = names
@@ -353,20 +315,22 @@ fn the_torque_curve_cannot_separate_motor_from_shaft_friction_but_coulomb_from_v
     // of the six friction parameters comes out under 0.2; identify now uses 0.1;
     // docs/identification.md).
     let u = torque_curve_uncertainty(&["fm", "fw"], 0.1);
-    eprintln!("fm–fw: {:+.4}", u.correlation[0][1]);
+    eprintln!("fm–fw: {:+.4}", u.uncertainty.correlation[0][1]);
     assert!(
-        u.warnings
-            .iter()
-            .any(|w| w.contains("fm and fw") || w.contains("singular")),
+        u.warnings.iter().any(|w| match w {
+            Warning::Correlated { a, b, .. } => a == "fm" && b == "fw",
+            Warning::Singular { .. } => true,
+            _ => false,
+        }),
         "fm and fw reach the motor as one Coulomb sum: {:?}",
         u.warnings
     );
     let u = torque_curve_uncertainty(&["fm", "Cm"], 0.1);
-    eprintln!("fm–Cm: {:+.4}", u.correlation[0][1]);
+    eprintln!("fm–Cm: {:+.4}", u.uncertainty.correlation[0][1]);
     assert!(
         !u.warnings
             .iter()
-            .any(|w| w.contains("correlated") || w.contains("singular")),
+            .any(|w| matches!(w, Warning::Correlated { .. } | Warning::Singular { .. })),
         "{:?}",
         u.warnings
     );
@@ -376,23 +340,24 @@ fn the_torque_curve_cannot_separate_motor_from_shaft_friction_but_coulomb_from_v
 #[ignore = "measurement for docs/identification.md: 13 torque-curve simulations"]
 fn measure_the_six_friction_correlations_of_the_torque_curve() {
     for step in [2e-3, 2e-2, 0.1, 0.3] {
-        let u = torque_curve_uncertainty(&["fm", "fw", "ft", "Cm", "Cw", "Ct"], step);
+        let a = torque_curve_uncertainty(&["fm", "fw", "ft", "Cm", "Cw", "Ct"], step);
+        let u = &a.uncertainty;
         eprintln!("step {step}: conditioning {:.2e}", u.conditioning);
         for (name, row) in u.names.iter().zip(&u.correlation) {
             let cells: Vec<String> = row.iter().map(|c| format!("{c:+.4}")).collect();
             eprintln!("{name}: {}", cells.join(" "));
         }
-        for w in &u.warnings {
+        for w in &a.warnings {
             eprintln!("warning: {w}");
         }
     }
 }
 
-fn unbalance_config(files: &[&str], base: Params, fit: &[&str]) -> Config {
-    let mut c = config(files.iter().map(|f| fixture(f)).collect(), base, fit);
-    c.settings.starts = 1;
-    c.settings.method = Method::NelderMead;
-    c.settings.max_iters = 20;
+fn unbalance_config(specs: Vec<ExperimentSpec>, base: Params, fit: &[&str]) -> Config {
+    let mut c = config(specs, base, fit);
+    c.search.starts = Some(1);
+    c.search.method = Some(Method::NelderMead);
+    c.search.max_iters = 20;
     c
 }
 
@@ -400,25 +365,23 @@ fn unbalance_config(files: &[&str], base: Params, fit: &[&str]) -> Config {
 fn table_friction_from_the_unbalance_step_within_5_percent_from_50_percent_off() {
     // The step of the unbalance test stands where m·g·e·sin(θt + ψ) overcomes
     // ft + Ct·ω: the table friction the torque curve cannot see.
-    for (set, start) in [
-        ("worm-gear/unbalance.json", 1.5),
-        ("worm-gear/unbalance.json", 0.5),
-    ] {
-        let base = preset_with("worm-gear", &[("ft", 0.26 * start)]);
-        let r = run(&unbalance_config(&[set], base, &["ft"]));
+    let Fixture { spec, truth } = support::worm_unbalance();
+    for start in [1.5, 0.5] {
+        let base = off(&truth, &[("ft", start)]);
+        let r = run(&unbalance_config(vec![spec.clone()], base, &["ft"]));
         eprintln!(
-            "{set} from ×{start}: ft = {:.5} ({} evaluations, {:.2} s)",
-            r.result.parameters["ft"], r.result.evaluations, r.result.wall_time_s
+            "{} from ×{start}: ft = {:.5} ({} evaluations, {:.2} s)",
+            spec.source, r.result.parameters["ft"], r.result.evaluations, r.result.wall_time_s
         );
-        assert_within(&r, &[("ft", 0.26)], 0.05);
+        assert_within(&r, &values(&truth, &["ft"]), 0.05);
     }
 }
 
 #[test]
 fn the_unbalance_experiment_fits_ft_by_default() {
-    let base = preset_with("worm-gear", &[("ft", 0.26 * 0.5)]);
-    let mut c = unbalance_config(&["worm-gear/unbalance.json"], base, &[]);
-    c.settings.max_iters = 1;
+    let Fixture { spec, truth } = support::worm_unbalance();
+    let mut c = unbalance_config(vec![spec], off(&truth, &[("ft", 0.5)]), &[]);
+    c.search.max_iters = 1;
     let r = run(&c);
     assert_eq!(
         r.result.parameters.keys().collect::<Vec<_>>(),
@@ -435,23 +398,22 @@ fn motor_and_table_friction_together_from_the_torque_curve_and_the_unbalance_ste
     // with it), ft from the unbalance step (the torque curve hardly moves with it);
     // on the noisy fixtures (1 % torque noise, 2″ table-angle noise), fm 50 % low and
     // ft 50 % high at the start.
-    let (dir, start) = ("worm-gear-noisy", (0.5, 1.5));
-    let base = preset_with(
-        "worm-gear",
-        &[("fm", 0.14 * start.0), ("ft", 0.26 * start.1)],
+    let (torque, unbalance) = (
+        support::worm_torque_curve_noisy(),
+        support::worm_unbalance_noisy(),
     );
-    let tc = format!("{dir}/torque_curve.json");
-    let ub = format!("{dir}/unbalance.json");
-    let mut c = unbalance_config(&[&tc, &ub], base, &["fm", "ft"]);
-    c.settings.max_iters = 40;
+    let truth = torque.truth;
+    let base = off(&truth, &[("fm", 0.5), ("ft", 1.5)]);
+    let mut c = unbalance_config(vec![torque.spec, unbalance.spec], base, &["fm", "ft"]);
+    c.search.max_iters = 40;
     let r = run(&c);
     eprintln!(
-        "{dir}: fm = {:.5}, ft = {:.5} ({} evaluations, {:.2} s); warnings {:?}",
+        "noisy: fm = {:.5}, ft = {:.5} ({} evaluations, {:.2} s); warnings {:?}",
         r.result.parameters["fm"],
         r.result.parameters["ft"],
         r.result.evaluations,
         r.result.wall_time_s,
         r.result.warnings
     );
-    assert_within(&r, &[("fm", 0.14), ("ft", 0.26)], 0.05);
+    assert_within(&r, &values(&truth, &["fm", "ft"]), 0.05);
 }

@@ -5,17 +5,19 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Duration;
 
-use anyhow::Context;
+use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use super::ModelArgs;
 use rtid::identify::comparison;
-use rtid::identify::setup::ObjectiveKind;
-use rtid::identify::space::parse_bound;
-use rtid::identify::{identify, Config, FidelityChoice, Identified, Method, Monitor, Settings};
-use rtid::io::experiment_file::{self, Experiment};
+use rtid::identify::{
+    identify, Bound, Config, ExperimentSpec, FidelityChoice, Identified, IdentifyResult, Method,
+    Monitor, SearchOptions, Warning,
+};
+use rtid::io::experiment_file;
 use rtid::io::params_file;
 use rtid::model::Params;
+use rtid::objectives::{Detail, ObjectiveKind};
 
 pub const LONG_ABOUT: &str = "\
 Identifies physical parameters of the drive — torsional stiffnesses Kw, Kg, Kb, internal \
@@ -89,13 +91,15 @@ pub struct Args {
     /// Bounds of a fitted parameter, SI units; repeatable: --bound Kw=1e5..1e7.
     #[arg(long = "bound", value_name = "NAME=LO..HI")]
     pub bounds: Vec<String>,
-    /// Objectives to use (default: by experiment kind, see above).
-    #[arg(long, value_delimiter = ',', value_enum)]
-    pub objective: Option<Vec<ObjectiveArg>>,
+    /// Objectives to use (default: by experiment kind, see above); each experiment
+    /// feeds those of them it can.
+    #[arg(long, value_delimiter = ',', value_parser = objective_names())]
+    pub objective: Option<Vec<String>>,
     /// Weight of each experiment in the joint cost, in the order given (default 1 each).
     #[arg(long = "weight", value_delimiter = ',', allow_negative_numbers = true)]
     pub weights: Vec<f64>,
-    /// Solver (default: lsq; nelder-mead when a torque curve is fitted).
+    /// Solver [default: lsq; nelder-mead when a torque curve or an unbalance test is
+    /// fitted].
     #[arg(long, value_enum)]
     pub method: Option<MethodArg>,
     /// Frequency-response model of the objectives.
@@ -129,6 +133,13 @@ pub struct Args {
     /// No progress display.
     #[arg(long)]
     pub quiet: bool,
+}
+
+/// The objective names `--objective` accepts (the registry's, kebab-case).
+fn objective_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(
+        ObjectiveKind::all().map(|k| clap::builder::PossibleValue::new(k.name().replace('_', "-"))),
+    )
 }
 
 /// The solver (`--method`).
@@ -175,98 +186,124 @@ impl From<FidelityArg> for FidelityChoice {
     }
 }
 
-/// An objective (`--objective`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum ObjectiveArg {
-    /// Relative error of the resonance frequencies.
-    Resonance,
-    /// dB error of the resonance peak heights.
-    PeakAmplitude,
-    /// dB error of the gain at every measured frequency.
-    GainCurve,
-    /// dB error of the gain within ±3 % of each resonance.
-    GainNearPeaks,
-    /// Error of the motor torque of the torque test.
-    TorqueCurve,
-    /// Error of the table angles where the unbalance test's deviation steps.
-    UnbalanceStep,
+/// Parses `NAME=LO..HI`.
+fn parse_bound(s: &str) -> anyhow::Result<(String, Bound)> {
+    let (name, range) = s
+        .split_once('=')
+        .with_context(|| format!("--bound {s}: expected NAME=LO..HI, e.g. Kw=1e5..1e7"))?;
+    let (lo, hi) = range
+        .split_once("..")
+        .with_context(|| format!("--bound {s}: expected LO..HI after `=`, e.g. 1e5..1e7"))?;
+    let num = |t: &str| -> anyhow::Result<f64> {
+        t.trim()
+            .parse()
+            .map_err(|_| anyhow::anyhow!("--bound {s}: `{t}` is not a number"))
+    };
+    Ok((
+        name.trim().to_string(),
+        Bound {
+            lo: num(lo)?,
+            hi: num(hi)?,
+        },
+    ))
 }
 
-impl From<ObjectiveArg> for ObjectiveKind {
-    fn from(o: ObjectiveArg) -> ObjectiveKind {
-        match o {
-            ObjectiveArg::Resonance => ObjectiveKind::Resonance,
-            ObjectiveArg::PeakAmplitude => ObjectiveKind::PeakAmplitude,
-            ObjectiveArg::GainCurve => ObjectiveKind::GainCurve,
-            ObjectiveArg::GainNearPeaks => ObjectiveKind::GainNearPeaks,
-            ObjectiveArg::TorqueCurve => ObjectiveKind::TorqueCurve,
-            ObjectiveArg::UnbalanceStep => ObjectiveKind::UnbalanceStep,
-        }
+impl Args {
+    /// The validated configuration: experiments read, bounds parsed, the chosen
+    /// objectives and weights given to each experiment, before any work starts.
+    fn config(&self) -> anyhow::Result<Config> {
+        let base = self.model.load()?;
+        let experiments = self.experiment_specs()?;
+        let bounds = self
+            .bounds
+            .iter()
+            .map(|b| parse_bound(b))
+            .collect::<anyhow::Result<_>>()?;
+        anyhow::ensure!(
+            self.starts != Some(0),
+            "--starts 0: at least one start is needed"
+        );
+        Ok(Config {
+            experiments,
+            base,
+            fit: self
+                .fit
+                .iter()
+                .map(|s| s.trim().to_string())
+                .filter(|s| !s.is_empty())
+                .collect(),
+            bounds,
+            fidelity: self.fidelity.into(),
+            search: SearchOptions {
+                method: self.method.map(Method::from),
+                starts: self.starts,
+                seed: self.seed,
+                max_iters: self.max_iters,
+                max_evaluations: None,
+            },
+            checkpoint: self.checkpoint.clone(),
+            resume: self.resume,
+        })
     }
+
+    /// Each experiment with its weight and the chosen objectives it can feed.
+    fn experiment_specs(&self) -> anyhow::Result<Vec<ExperimentSpec>> {
+        if !self.weights.is_empty() && self.weights.len() != self.experiments.len() {
+            bail!(
+                "--weight: {} weights for {} experiments: give one per experiment, in order",
+                self.weights.len(),
+                self.experiments.len()
+            );
+        }
+        let chosen: Option<Vec<ObjectiveKind>> = self
+            .objective
+            .as_ref()
+            .map(|v| v.iter().map(|o| ObjectiveKind::named(o)).collect())
+            .transpose()?;
+        let mut specs = Vec::new();
+        for (i, path) in self.experiments.iter().enumerate() {
+            let mut spec =
+                ExperimentSpec::new(path.display().to_string(), experiment_file::read(path)?);
+            if let Some(&w) = self.weights.get(i) {
+                anyhow::ensure!(
+                    w.is_finite() && w > 0.0,
+                    "--weight {w}: weights must be positive and finite"
+                );
+                spec.weight = w;
+            }
+            if let Some(all) = &chosen {
+                spec.objectives = Some(usable(all, &spec)?);
+            }
+            specs.push(spec);
+        }
+        Ok(specs)
+    }
+}
+
+/// The objectives of `all` that `spec`'s experiment can feed; an error naming the
+/// file when there is none.
+fn usable(all: &[ObjectiveKind], spec: &ExperimentSpec) -> anyhow::Result<Vec<ObjectiveKind>> {
+    let kind = spec.experiment.manifest.kind;
+    let mine: Vec<ObjectiveKind> = all.iter().copied().filter(|o| o.reads(kind)).collect();
+    if mine.is_empty() {
+        bail!(
+            "--objective {}: {} is a {kind} experiment, which none of them reads ({} needs {})",
+            all.iter()
+                .map(|o| o.name().replace('_', "-"))
+                .collect::<Vec<_>>()
+                .join(","),
+            spec.source,
+            all[0].name().replace('_', "-"),
+            all[0].definition().needs
+        );
+    }
+    Ok(mine)
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let base = a.model.load()?;
-    let mut experiments = Vec::new();
-    for path in &a.experiments {
-        let exp = experiment_file::read(path)?;
-        experiments.push((path.display().to_string(), exp));
-    }
-    let mut bounds = Vec::new();
-    for b in &a.bounds {
-        bounds.push(parse_bound(b).map_err(anyhow::Error::msg)?);
-    }
-    // Objectives on a closed-loop time simulation with quantised encoders: rough on
-    // the scale of finite differences, and seconds per evaluation.
-    let has_torque = experiments.iter().any(|(_, e): &(String, Experiment)| {
-        use rtid::io::experiment_file::Kind;
-        matches!(e.manifest.kind, Kind::TorqueCurve | Kind::Unbalance)
-    });
-    let starts = a.starts.unwrap_or(if has_torque { 1 } else { 4 });
-    anyhow::ensure!(starts >= 1, "--starts must be at least 1");
-    let config = Config {
-        experiments,
-        base,
-        fit: a
-            .fit
-            .iter()
-            .map(|s| s.trim().to_string())
-            .filter(|s| !s.is_empty())
-            .collect(),
-        bounds,
-        objectives: a
-            .objective
-            .as_ref()
-            .map(|v| v.iter().map(|&o| o.into()).collect()),
-        weights: a.weights.clone(),
-        fidelity: a.fidelity.into(),
-        settings: Settings {
-            method: a.method.map(Method::from).unwrap_or(if has_torque {
-                Method::NelderMead
-            } else {
-                Method::Lsq
-            }),
-            starts,
-            seed: a.seed,
-            max_iters: a.max_iters,
-            ..Settings::default()
-        },
-        checkpoint: a.checkpoint.clone(),
-        resume: a.resume,
-    };
+    let config = a.config()?;
     let monitor = Arc::new(Monitor::default());
-    {
-        let m = Arc::clone(&monitor);
-        // A second handler cannot be installed (tests run commands in-process): then
-        // Ctrl-C simply ends the process, as it would without rtid's handling.
-        let _ = ctrlc::set_handler(move || {
-            if m.stopped() {
-                std::process::exit(130);
-            }
-            m.stop();
-            eprintln!("\nstopping: finishing the current evaluations, then writing the best result (Ctrl-C again to quit)");
-        });
-    }
+    stop_on_ctrl_c(&monitor);
     let spinner = spinner(&monitor, a.quiet);
     let outcome = identify(&config, &monitor);
     if let Some((bar, done, handle)) = spinner {
@@ -282,18 +319,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         write_plots(path, &config.experiments, &config.base, &params)?;
     }
     if let Some(path) = &a.save_params {
-        let mut p = params.clone();
-        for name in result.parameters.keys() {
-            p.notes.insert(
-                name.clone(),
-                format!(
-                    "identified by rtid from {} ({} model)",
-                    result.experiments.join(", "),
-                    result.fidelity
-                ),
-            );
-        }
-        params_file::write(path, &p).with_context(|| format!("writing {}", path.display()))?;
+        save_params(path, &result, params)?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&result)?);
@@ -301,6 +327,35 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         print_summary(&result);
     }
     Ok(())
+}
+
+/// Ctrl-C stops the search (the best point is still written); a second one quits.
+fn stop_on_ctrl_c(monitor: &Arc<Monitor>) {
+    let m = Arc::clone(monitor);
+    // A second handler cannot be installed (a process installs one): then Ctrl-C
+    // simply ends the process, as it would without rtid's handling.
+    let _ = ctrlc::set_handler(move || {
+        if m.stopped() {
+            std::process::exit(130);
+        }
+        m.stop();
+        eprintln!("\nstopping: finishing the current evaluations, then writing the best result (Ctrl-C again to quit)");
+    });
+}
+
+/// The complete identified parameter set, each fitted value noted with its source.
+fn save_params(path: &Path, result: &IdentifyResult, mut p: Params) -> anyhow::Result<()> {
+    for name in result.parameters.keys() {
+        p.notes.insert(
+            name.clone(),
+            format!(
+                "identified by rtid from {} ({} model)",
+                result.experiments.join(", "),
+                result.fidelity
+            ),
+        );
+    }
+    params_file::write(path, &p).with_context(|| format!("writing {}", path.display()))
 }
 
 type Spinner = (
@@ -332,7 +387,32 @@ fn spinner(monitor: &Arc<Monitor>, quiet: bool) -> Option<Spinner> {
     Some((bar, done, handle))
 }
 
-fn print_summary(r: &rtid::identify::result::IdentifyResult) {
+fn print_summary(r: &IdentifyResult) {
+    println!("{}", parameter_table(r));
+    for res in &r.residuals {
+        println!(
+            "{} [{}]: RMS scaled residual {:.3} (unit: {}){}",
+            res.source,
+            res.objective,
+            res.rms,
+            res.scale,
+            res.detail.as_ref().map_or(String::new(), detail)
+        );
+    }
+    println!(
+        "cost {:.4e}, {} evaluations, {:.2} s, {} ({}, {} model)",
+        r.cost, r.evaluations, r.wall_time_s, r.termination.0, r.method, r.fidelity
+    );
+    if let Some(u) = r.uncertainty.as_ref().filter(|u| u.names.len() > 1) {
+        println!("{}", correlation_table(u));
+    }
+    for w in &r.warnings {
+        println!("warning: {}{}", w.0, hint(&w.0));
+    }
+}
+
+/// Parameter, start, identified ± standard error, bounds.
+fn parameter_table(r: &IdentifyResult) -> Table {
     let mut t = Table::new();
     t.load_preset(UTF8_FULL_CONDENSED);
     t.set_header([
@@ -360,101 +440,82 @@ fn print_summary(r: &rtid::identify::result::IdentifyResult) {
             format!("{:.3e}..{:.3e}", b[0], b[1]),
         ]);
     }
-    println!("{t}");
-    for res in &r.residuals {
-        let extra = match &res.detail {
-            Some(d) if d.get("model_hz").is_some() => format!(
-                "  measured {} Hz, model {} Hz",
-                list(&d["measured_hz"]),
-                list(&d["model_hz"])
-            ),
-            Some(d) if d.get("error_db").is_some() => {
-                format!("  errors {} dB", list(&d["error_db"]))
-            }
-            Some(d) if d.get("measured_step_deg").is_some() => {
-                let model: Vec<String> = d["model_step_deg"]
-                    .as_array()
-                    .map(|a| {
-                        a.iter()
-                            .map(|x| x.as_f64().map_or("none".into(), |v| format!("{v:.3}")))
-                            .collect()
-                    })
-                    .unwrap_or_default();
-                format!(
-                    "  step angles measured {} °, model {} °",
-                    list3(&d["measured_step_deg"]),
-                    model.join(", ")
-                )
-            }
-            Some(d) if d.get("rms_error_nm").is_some() => {
-                format!(
-                    "  RMS error {:.4} N·m",
-                    d["rms_error_nm"].as_f64().unwrap_or(f64::NAN)
-                )
-            }
-            _ => String::new(),
-        };
-        println!(
-            "{} [{}]: RMS scaled residual {:.3} (unit: {}){extra}",
-            res.source, res.objective, res.rms, res.scale
-        );
+    t
+}
+
+/// The correlation matrix.
+fn correlation_table(u: &rtid::identify::uncertainty::Uncertainty) -> Table {
+    let mut c = Table::new();
+    c.load_preset(UTF8_FULL_CONDENSED);
+    let mut header = vec!["correlation".to_string()];
+    header.extend(u.names.iter().cloned());
+    c.set_header(header);
+    for (name, row) in u.names.iter().zip(&u.correlation) {
+        let mut cells = vec![name.clone()];
+        cells.extend(row.iter().map(|x| format!("{x:+.3}")));
+        c.add_row(cells);
     }
-    println!(
-        "cost {:.4e}, {} evaluations, {:.2} s, {} ({}, {} model)",
-        r.cost, r.evaluations, r.wall_time_s, r.termination, r.method, r.fidelity
-    );
-    if let Some(u) = &r.uncertainty {
-        if u.names.len() > 1 {
-            let mut c = Table::new();
-            c.load_preset(UTF8_FULL_CONDENSED);
-            let mut header = vec!["correlation".to_string()];
-            header.extend(u.names.iter().cloned());
-            c.set_header(header);
-            for (name, row) in u.names.iter().zip(&u.correlation) {
-                let mut cells = vec![name.clone()];
-                cells.extend(row.iter().map(|x| format!("{x:+.3}")));
-                c.add_row(cells);
-            }
-            println!("{c}");
+    c
+}
+
+/// A residual detail in the measurement's units.
+fn detail(d: &Detail) -> String {
+    let list = |v: &[f64], decimals: usize| {
+        v.iter()
+            .map(|x| format!("{x:.decimals$}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match d {
+        Detail::Resonance {
+            measured_hz,
+            model_hz,
+            ..
+        } => format!(
+            "  measured {} Hz, model {} Hz",
+            list(measured_hz, 2),
+            list(model_hz, 2)
+        ),
+        Detail::PeakHeights { error_db, .. } => format!("  errors {} dB", list(error_db, 2)),
+        Detail::UnbalanceSteps {
+            measured_step_deg,
+            model_step_deg,
+            ..
+        } => {
+            let model: Vec<String> = model_step_deg
+                .iter()
+                .map(|x| x.map_or("none".into(), |v| format!("{v:.3}")))
+                .collect();
+            format!(
+                "  step angles measured {} °, model {} °",
+                list(measured_step_deg, 3),
+                model.join(", ")
+            )
         }
-    }
-    for w in &r.warnings {
-        println!("warning: {w}");
+        Detail::Torque { rms_error_nm } => format!("  RMS error {rms_error_nm:.4} N·m"),
     }
 }
 
-fn list3(v: &serde_json::Value) -> String {
-    v.as_array()
-        .map(|a| {
-            a.iter()
-                .map(|x| format!("{:.3}", x.as_f64().unwrap_or(f64::NAN)))
-                .collect::<Vec<_>>()
-                .join(", ")
-        })
-        .unwrap_or_default()
-}
-
-fn list(v: &serde_json::Value) -> String {
-    v.as_array()
-        .map(|a| {
-            a.iter()
-                .map(|x| format!("{:.2}", x.as_f64().unwrap_or(f64::NAN)))
-                .collect::<Vec<_>>()
-                .join(", ")
-        })
-        .unwrap_or_default()
+/// What to change on the command line, for the warnings that have an option.
+fn hint(w: &Warning) -> String {
+    match w {
+        Warning::AtBound { name, .. } => format!(" (--bound {name}=LO..HI)"),
+        Warning::Interrupted { .. } => " (--resume with the same --checkpoint)".into(),
+        Warning::NonlinearShift { .. } => " (--model nonlinear)".into(),
+        _ => String::new(),
+    }
 }
 
 /// One SVG per experiment beside the result: the data and the identified model.
 fn write_plots(
     out: &Path,
-    experiments: &[(String, Experiment)],
+    experiments: &[ExperimentSpec],
     start: &Params,
     fitted: &Params,
 ) -> anyhow::Result<()> {
     let stem = out.with_extension("");
-    for (k, (file, exp)) in experiments.iter().enumerate() {
-        if let Some(c) = comparison::compare(file, exp, start, fitted)? {
+    for (k, e) in experiments.iter().enumerate() {
+        if let Some(c) = comparison::compare(&e.source, &e.experiment, start, fitted)? {
             let path = PathBuf::from(format!("{}-{}.svg", stem.display(), k + 1));
             rtid::report::identify::comparison(&c).write(&path)?;
         }

@@ -26,8 +26,9 @@
 //! result at the end; the linear sub-searches have monitors of their own.
 
 use super::problem::{describe, Monitor};
+use super::search::{search, Settings, StartRecord};
 use super::space::ParamSpace;
-use super::{search, Settings, StartRecord};
+use super::termination::Termination;
 use crate::objectives::{sum_of_squares, Objective, ObjectiveError};
 
 /// Corrections at most.
@@ -103,53 +104,34 @@ pub fn polish(
     let mut corrections = 0;
     let termination = loop {
         if monitor.stopped() {
-            break "interrupted".to_string();
+            break Termination::Interrupted;
         }
         let mean: Vec<f64> = sum
             .iter()
             .map(|s| s / nonlinear_evaluations as f64)
             .collect();
-        let corrected = Corrected {
-            linear,
-            offset: mean,
-        };
-        let mut from_x = space.clone();
-        from_x.start = x.clone();
-        let inner = Monitor::default();
-        let sub = Settings {
-            starts: 1,
-            max_evaluations: None,
-            ..*settings
-        };
-        search(&from_x, &corrected, &sub, &inner, &[], &|_| {});
-        monitor.add_evaluations(inner.evaluations());
-        let Some(next) = inner.best() else {
-            break format!(
-                "the corrected linear problem could not be evaluated near {}",
-                describe(space, &x)
-            );
+        let Some(next) = corrected_fit(space, linear, mean, &x, settings, monitor) else {
+            break Termination::CorrectionFailed {
+                at: describe(space, &x),
+            };
         };
         corrections += 1;
         let step = next
-            .values
             .iter()
             .zip(&x)
             .map(|(a, b)| ((a - b) / b).abs())
             .fold(0.0, f64::max);
-        x = next.values;
+        x = next;
         let (d, c) = shift(&x)?;
         nonlinear_evaluations += 1;
         cost = c;
-        if step < STEP_TOLERANCE {
-            break format!(
-                "converged after {corrections} corrections of the linear fit ({nonlinear_evaluations} evaluations of the nonlinear test)"
-            );
-        }
-        if corrections == MAX_CORRECTIONS {
-            break format!(
-                "{MAX_CORRECTIONS} corrections of the linear fit ({nonlinear_evaluations} evaluations of the nonlinear test); the last moved the result by {:.2} %",
-                100.0 * step
-            );
+        if step < STEP_TOLERANCE || corrections == MAX_CORRECTIONS {
+            break Termination::Corrections {
+                corrections,
+                nonlinear_evaluations,
+                converged: step < STEP_TOLERANCE,
+                last_step: step,
+            };
         }
         for (s, d) in sum.iter_mut().zip(&d) {
             *s += d;
@@ -162,13 +144,37 @@ pub fn polish(
             index: 0,
             initial: from.to_vec(),
             result: Some(x),
-            cost,
+            cost: cost.is_finite().then_some(cost),
             iterations: corrections as u64,
-            termination: termination.clone(),
-            interrupted: termination == "interrupted",
+            termination,
         },
         nonlinear_evaluations,
     })
+}
+
+/// The fit of the linear residuals plus `offset` from `x` (one start, Gauss–Newton
+/// on the linear response alone, its evaluations counted in `monitor`); `None` when
+/// nothing could be evaluated.
+fn corrected_fit(
+    space: &ParamSpace,
+    linear: &dyn Objective,
+    offset: Vec<f64>,
+    x: &[f64],
+    settings: &Settings,
+    monitor: &Monitor,
+) -> Option<Vec<f64>> {
+    let corrected = Corrected { linear, offset };
+    let mut from_x = space.clone();
+    from_x.start = x.to_vec();
+    let inner = Monitor::default();
+    let sub = Settings {
+        starts: 1,
+        max_evaluations: None,
+        ..*settings
+    };
+    search(&from_x, &corrected, &sub, &inner, &[], &|_| {});
+    monitor.add_evaluations(inner.evaluations());
+    inner.best().map(|b| b.values)
 }
 
 #[cfg(test)]
@@ -226,7 +232,7 @@ mod tests {
         .unwrap();
         let kw = out.record.result.as_ref().unwrap()[0];
         assert!((kw - 2.93e5).abs() < 1.0, "{kw} {out:?}");
-        assert!(out.record.termination.starts_with("converged"), "{out:?}");
+        assert!(out.record.termination.converged(), "{out:?}");
         assert!(out.nonlinear_evaluations <= 3, "{out:?}");
         assert_eq!(monitor.best().unwrap().values, vec![kw]);
     }

@@ -17,6 +17,7 @@ use argmin::core::{CostFunction, Error, Jacobian, Operator};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
+use super::search::Settings;
 use super::space::ParamSpace;
 use crate::objectives::{sum_of_squares, Objective, ObjectiveError};
 
@@ -96,6 +97,13 @@ impl Monitor {
     }
 }
 
+/// The Jacobian's JᵀJ is singular at a point: Gauss–Newton cannot take a step there
+/// (the residuals do not depend on every parameter). Returned by the Jacobian, so the
+/// solver's error says so by type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("JᵀJ is singular at this point")]
+pub struct SingularJacobian;
+
 /// The problem of one start.
 pub struct Problem<'a> {
     pub space: &'a ParamSpace,
@@ -107,10 +115,27 @@ pub struct Problem<'a> {
     pub max_evaluations: Option<usize>,
     /// The last point evaluated and its residuals: Gauss–Newton asks for the
     /// residuals and then the Jacobian at the same point.
-    pub last: Mutex<Option<(DVector<f64>, Vec<f64>)>>,
+    last: Mutex<Option<(DVector<f64>, Vec<f64>)>>,
 }
 
-impl Problem<'_> {
+impl<'a> Problem<'a> {
+    /// The problem of one start of a search with `settings`.
+    pub fn new(
+        space: &'a ParamSpace,
+        objective: &'a dyn Objective,
+        monitor: &'a Monitor,
+        settings: &Settings,
+    ) -> Self {
+        Problem {
+            space,
+            objective,
+            monitor,
+            fd_step: settings.fd_step,
+            max_evaluations: settings.max_evaluations,
+            last: Mutex::new(None),
+        }
+    }
+
     /// Scaled residuals at solver coordinates `x`.
     pub fn residuals(&self, x: &DVector<f64>) -> Result<Vec<f64>, ObjectiveError> {
         if let Ok(last) = self.last.lock() {
@@ -212,6 +237,10 @@ impl Jacobian for Problem<'_> {
 
     fn jacobian(&self, x: &Self::Param) -> Result<Self::Jacobian, Error> {
         let r0 = self.residuals(x)?;
-        Ok(self.jacobian_at(x, &r0)?)
+        let j = self.jacobian_at(x, &r0)?;
+        if (j.transpose() * &j).try_inverse().is_none() {
+            return Err(SingularJacobian.into());
+        }
+        Ok(j)
     }
 }

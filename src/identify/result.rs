@@ -1,11 +1,17 @@
-//! The result file of `rtid identify` and its checkpoint, both JSON, written
-//! atomically.
+//! The result file of `rtid identify` (JSON, written atomically) and its assembly.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use super::assess::Assessment;
+use super::config::Config;
+use super::plan::Plan;
+use super::search::StartRecord;
+use super::space::ParamSpace;
+use super::termination::Termination;
 use super::uncertainty::Uncertainty;
-use super::{Bound, StartRecord};
+use super::warning::{Coded, Warning};
+use crate::objectives::Detail;
 
 /// One experiment's share of the fit.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
@@ -23,7 +29,16 @@ pub struct ExperimentResidual {
     pub rms: f64,
     /// The same in the measurement's units where that reads better (Hz, dB, N·m).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub detail: Option<serde_json::Value>,
+    pub detail: Option<Detail>,
+}
+
+/// The resonances of the nonlinear virtual test at the identified parameters.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct NonlinearCheck {
+    pub source: String,
+    pub measured_hz: Vec<f64>,
+    pub model_hz: Vec<f64>,
+    pub max_miss_hz: f64,
 }
 
 /// The result of `rtid identify`.
@@ -39,22 +54,23 @@ pub struct IdentifyResult {
     pub bounds: BTreeMap<String, [f64; 2]>,
     pub method: String,
     /// The frequency-response model: `linear`, `nonlinear`, or `linear, then
-    /// nonlinear` (two stages); `nonlinear time simulation` when no experiment is a
-    /// frequency response (a torque curve is always simulated).
+    /// nonlinear` (two stages); `nonlinear time simulation` when no objective depends
+    /// on it (a torque curve is always simulated).
     pub fidelity: String,
     pub cost: f64,
     pub residuals: Vec<ExperimentResidual>,
     pub evaluations: usize,
     pub wall_time_s: f64,
-    pub termination: String,
+    /// How the best start (or the corrections) ended: a code and a message.
+    pub termination: Coded<Termination>,
     pub interrupted: bool,
     pub starts: Vec<StartRecord>,
     pub uncertainty: Option<Uncertainty>,
     /// With `--model auto`: the resonances of the nonlinear virtual test at the result.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub nonlinear_check: Option<Vec<NonlinearCheck>>,
-    /// What the user should know about this fit (bounds hit, residuals left, failures).
-    pub warnings: Vec<String>,
+    /// What the user should know about this fit: a code and a message each.
+    pub warnings: Vec<Coded<Warning>>,
 }
 
 impl IdentifyResult {
@@ -62,49 +78,75 @@ impl IdentifyResult {
         let text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
         crate::io::atomic::write(path, format!("{text}\n").as_bytes())
     }
+
+    /// Whether a warning with `code` was given.
+    pub fn warns(&self, code: &str) -> bool {
+        self.warnings.iter().any(|w| w.0.code() == code)
+    }
 }
 
-/// The resonances of the nonlinear virtual test at the identified parameters.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct NonlinearCheck {
-    pub source: String,
-    pub measured_hz: Vec<f64>,
-    pub model_hz: Vec<f64>,
-    pub max_miss_hz: f64,
-}
-
-/// What `--resume` needs: the problem's identity and the starts done so far.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Checkpoint {
-    /// A fingerprint of the problem (experiments, fitted names, bounds, method,
-    /// starts, seed): a checkpoint of another problem is refused.
-    pub problem: String,
-    /// Stage (0: the only or linear stage; 1: the nonlinear polish).
-    pub stage: usize,
+/// What the run contributes to the result beside the assessment.
+pub struct Run {
+    pub values: Vec<f64>,
     pub starts: Vec<StartRecord>,
-    /// Result of the finished first stage, if any.
-    pub stage0_best: Option<Vec<f64>>,
     pub evaluations: usize,
+    pub wall_time_s: f64,
+    pub interrupted: bool,
+    pub warnings: Vec<Warning>,
 }
 
-impl Checkpoint {
-    pub fn write(&self, path: &Path) -> std::io::Result<()> {
-        let text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
-        crate::io::atomic::write(path, text.as_bytes())
+/// The result of `config` run under `plan` in `space`.
+pub fn assemble(
+    config: &Config,
+    plan: &Plan,
+    space: &ParamSpace,
+    run: Run,
+    assessment: Assessment,
+) -> IdentifyResult {
+    let named = |v: &[f64]| -> BTreeMap<String, f64> {
+        space
+            .names
+            .iter()
+            .map(|n| n.to_string())
+            .zip(v.iter().copied())
+            .collect()
+    };
+    let termination = if run.interrupted {
+        Termination::Interrupted
+    } else {
+        run.starts
+            .iter()
+            .min_by(|a, b| a.cost_or_infinity().total_cmp(&b.cost_or_infinity()))
+            .map_or(Termination::NoStart, |s| s.termination.clone())
+    };
+    let mut warnings = run.warnings;
+    warnings.extend(assessment.warnings);
+    IdentifyResult {
+        mechanism: config.base.name.clone(),
+        experiments: config
+            .experiments
+            .iter()
+            .map(|e| e.source.clone())
+            .collect(),
+        parameters: named(&run.values),
+        initial: named(&space.start),
+        bounds: space
+            .names
+            .iter()
+            .zip(&space.bounds)
+            .map(|(n, b)| (n.to_string(), [b.lo, b.hi]))
+            .collect(),
+        method: plan.stages[0].settings.method.name().into(),
+        fidelity: plan.fidelity_label(),
+        cost: assessment.cost,
+        residuals: assessment.residuals,
+        evaluations: run.evaluations,
+        wall_time_s: run.wall_time_s,
+        termination: Coded(termination),
+        interrupted: run.interrupted,
+        starts: run.starts,
+        uncertainty: assessment.uncertainty,
+        nonlinear_check: assessment.nonlinear_check,
+        warnings: warnings.into_iter().map(Coded).collect(),
     }
-
-    pub fn read(path: &Path) -> Result<Checkpoint, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        serde_json::from_str(&text)
-            .map_err(|e| format!("{}: not an rtid checkpoint: {e}", path.display()))
-    }
-}
-
-/// Bounds as `name → [lo, hi]`.
-pub fn bounds_map(names: &[&str], bounds: &[Bound]) -> BTreeMap<String, [f64; 2]> {
-    names
-        .iter()
-        .zip(bounds)
-        .map(|(n, b)| (n.to_string(), [b.lo, b.hi]))
-        .collect()
 }

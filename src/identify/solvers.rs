@@ -17,10 +17,12 @@ use argmin::solver::particleswarm::ParticleSwarm;
 use nalgebra::DVector;
 use rand::{rngs::StdRng, SeedableRng};
 
-use super::problem::Problem;
+use super::problem::{Problem, SingularJacobian};
+use super::termination::Termination;
+use crate::objectives::ObjectiveError;
 
 /// The solver.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// Gauss–Newton with line search, finite-difference Jacobian in parallel.
@@ -50,15 +52,13 @@ pub struct Limits {
 }
 
 /// How one local search ended.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Outcome {
-    /// Solver coordinates of the result.
-    #[serde(skip)]
+    /// Solver coordinates of the result (empty: no result).
     pub x: Vec<f64>,
     pub cost: f64,
     pub iterations: u64,
-    pub termination: String,
-    pub interrupted: bool,
+    pub termination: Termination,
 }
 
 /// Runs `method` from solver coordinates `x0`.
@@ -128,28 +128,30 @@ pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limit
             cost,
             iterations,
             termination,
-            interrupted: false,
         },
-        Err(e) => {
-            let interrupted = monitor.stopped();
-            Outcome {
-                x: Vec::new(),
-                cost: f64::INFINITY,
-                iterations: 0,
-                termination: if interrupted {
-                    "interrupted".into()
-                } else if e.to_string().contains("Non-invertible") {
-                    "stopped: JᵀJ singular at this start (the residuals do not depend on every parameter there)".into()
-                } else {
-                    format!("solver error: {e}")
-                },
-                interrupted,
-            }
+        Err(e) => Outcome {
+            x: Vec::new(),
+            cost: f64::INFINITY,
+            iterations: 0,
+            termination: failure(&e, monitor.stopped()),
+        },
+    }
+}
+
+/// The termination of a search that ended in an error.
+fn failure(e: &argmin::core::Error, stopped: bool) -> Termination {
+    if stopped || matches!(e.downcast_ref(), Some(ObjectiveError::Interrupted)) {
+        Termination::Interrupted
+    } else if e.downcast_ref::<SingularJacobian>().is_some() {
+        Termination::Singular
+    } else {
+        Termination::SolverError {
+            message: e.to_string(),
         }
     }
 }
 
-fn summarize<S>(s: &S) -> (Vec<f64>, f64, u64, String)
+fn summarize<S>(s: &S) -> (Vec<f64>, f64, u64, Termination)
 where
     S: State<Param = DVector<f64>, Float = f64>,
 {
@@ -163,13 +165,17 @@ where
     )
 }
 
-fn reason(t: &TerminationStatus) -> String {
+fn reason(t: &TerminationStatus) -> Termination {
     match t {
-        TerminationStatus::Terminated(TerminationReason::SolverConverged) => "converged".into(),
+        TerminationStatus::Terminated(TerminationReason::SolverConverged) => Termination::Converged,
         TerminationStatus::Terminated(TerminationReason::MaxItersReached) => {
-            "iteration limit reached".into()
+            Termination::IterationLimit
         }
-        TerminationStatus::Terminated(r) => r.text().to_string(),
-        TerminationStatus::NotTerminated => "not terminated".into(),
+        TerminationStatus::Terminated(r) => Termination::Solver {
+            reason: r.text().to_string(),
+        },
+        TerminationStatus::NotTerminated => Termination::Solver {
+            reason: "not terminated".into(),
+        },
     }
 }

@@ -10,6 +10,7 @@
 use nalgebra::DVector;
 use rand::{rngs::StdRng, seq::SliceRandom, Rng, SeedableRng};
 
+use super::warning::Side;
 use crate::model::{ParamError, Params};
 
 /// The range a parameter may take.
@@ -44,28 +45,28 @@ impl Bound {
     }
 }
 
-/// A bad `--fit` or `--bound`.
+/// Fitted parameters or bounds that cannot make a search space.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum SpaceError {
     #[error(transparent)]
     Param(#[from] ParamError),
-    #[error("--fit: nothing to fit")]
+    #[error("nothing to fit")]
     Empty,
-    #[error("--fit: {name} is named twice")]
+    #[error("{name} is fitted twice")]
     Twice { name: String },
-    #[error("--fit {name}: it does not apply to this mechanism (no spur-gear stage)")]
+    #[error("{name} does not apply to this mechanism (no spur-gear stage): it cannot be fitted")]
     NotApplicable { name: String },
-    #[error("--bound {name}={lo}..{hi}: {reason}")]
+    #[error("bounds of {name}, {lo}..{hi}: {reason}")]
     BadBound {
         name: String,
         lo: f64,
         hi: f64,
         reason: String,
     },
-    #[error("--bound {name}: {name} is not fitted (add it to --fit)")]
+    #[error("{name} has bounds but is not fitted")]
     NotFitted { name: String },
-    #[error("{name} starts at {value}, which has no default range (0.1×..10× the start needs a positive start): give --bound {name}=LO..HI")]
+    #[error("{name} starts at {value}, which has no default range (0.1×..10× the start needs a positive start): give it bounds")]
     NoDefaultBound { name: String, value: f64 },
     #[error("{name} starts at {value}, outside its bounds {lo}..{hi}")]
     StartOutside {
@@ -225,8 +226,8 @@ impl ParamSpace {
         out
     }
 
-    /// Names of parameters within 0.1 % (of the unit range) of a bound.
-    pub fn at_bounds(&self, values: &[f64]) -> Vec<(&'static str, &'static str)> {
+    /// Names of parameters within 0.1 % (of the unit range) of a bound, and which.
+    pub fn at_bounds(&self, values: &[f64]) -> Vec<(&'static str, Side)> {
         self.names
             .iter()
             .zip(&self.bounds)
@@ -234,37 +235,15 @@ impl ParamSpace {
             .filter_map(|((n, b), &v)| {
                 let u = b.unit(v);
                 if u < 1e-3 {
-                    Some((*n, "lower"))
+                    Some((*n, Side::Lower))
                 } else if u > 1.0 - 1e-3 {
-                    Some((*n, "upper"))
+                    Some((*n, Side::Upper))
                 } else {
                     None
                 }
             })
             .collect()
     }
-}
-
-/// Parses `NAME=LO..HI`.
-pub fn parse_bound(s: &str) -> Result<(String, Bound), String> {
-    let (name, range) = s
-        .split_once('=')
-        .ok_or_else(|| format!("--bound {s}: expected NAME=LO..HI, e.g. Kw=1e5..1e7"))?;
-    let (lo, hi) = range
-        .split_once("..")
-        .ok_or_else(|| format!("--bound {s}: expected LO..HI after `=`, e.g. 1e5..1e7"))?;
-    let num = |t: &str| {
-        t.trim()
-            .parse::<f64>()
-            .map_err(|_| format!("--bound {s}: `{t}` is not a number"))
-    };
-    Ok((
-        name.trim().to_string(),
-        Bound {
-            lo: num(lo)?,
-            hi: num(hi)?,
-        },
-    ))
 }
 
 #[cfg(test)]
@@ -318,25 +297,21 @@ mod tests {
     fn bad_fits_and_bounds_are_named() {
         let cases: Vec<(Result<ParamSpace, SpaceError>, &str)> = vec![
             (space(&["Kx"], &[]), "unknown parameter `Kx`"),
-            (space(&["Kw", "Kw"], &[]), "named twice"),
+            (space(&["Kw", "Kw"], &[]), "fitted twice"),
             (
                 space(&["theta_bw"], &[("theta_bw", 1.0, 0.0)]),
                 "lower bound must be below",
             ),
-            (space(&["Kw"], &[("Kg", 1.0, 2.0)]), "Kg is not fitted"),
+            (
+                space(&["Kw"], &[("Kg", 1.0, 2.0)]),
+                "Kg has bounds but is not fitted",
+            ),
             (space(&["Kw"], &[("Kw", 1.0, 2.0)]), "outside its bounds"),
-            (space(&["fluct_phase"], &[]), "--bound fluct_phase"),
+            (space(&["fluct_phase"], &[]), "give it bounds"),
         ];
         for (r, want) in cases {
             let e = r.unwrap_err().to_string();
             assert!(e.contains(want), "{e} should contain {want}");
         }
-        assert!(parse_bound("Kw=1e5..x")
-            .unwrap_err()
-            .contains("`x` is not a number"));
-        assert_eq!(
-            parse_bound("Kw = 1e5..1e7").unwrap().1,
-            Bound { lo: 1e5, hi: 1e7 }
-        );
     }
 }

@@ -12,6 +12,7 @@ use nalgebra::{DMatrix, SVD};
 use rayon::prelude::*;
 
 use super::space::ParamSpace;
+use super::warning::Warning;
 use crate::objectives::{Objective, ObjectiveError};
 
 /// Above this |correlation| two parameters are reported as not separable.
@@ -33,7 +34,13 @@ pub struct Uncertainty {
     pub residual_variance: f64,
     /// Smallest / largest singular value of the column-scaled Jacobian.
     pub conditioning: f64,
-    pub warnings: Vec<String>,
+}
+
+/// The uncertainty and what it warns of.
+#[derive(Clone, Debug)]
+pub struct Assessed {
+    pub uncertainty: Uncertainty,
+    pub warnings: Vec<Warning>,
 }
 
 /// Evaluates the uncertainty at `values`.
@@ -42,7 +49,7 @@ pub fn at_optimum(
     objective: &dyn Objective,
     values: &[f64],
     step: f64,
-) -> Result<Uncertainty, ObjectiveError> {
+) -> Result<Assessed, ObjectiveError> {
     let r0 = objective.residuals(&space.params(values)?)?;
     with_residuals(space, objective, values, &r0, step)
 }
@@ -54,21 +61,63 @@ pub fn with_residuals(
     values: &[f64],
     r0: &[f64],
     step: f64,
-) -> Result<Uncertainty, ObjectiveError> {
-    let n = space.dim();
+) -> Result<Assessed, ObjectiveError> {
     let names: Vec<String> = space.names.iter().map(|s| s.to_string()).collect();
-    let m = r0.len();
-    // Each column: ∂r/∂ln p (log parameters) or ∂r/∂p scaled by the range.
+    let jac = jacobian(space, objective, values, step)?;
+    let (m, n) = jac.shape();
+    let shape = Shape::of(&jac);
+    let mut warnings = shape.warnings(&names);
+    let sigma2 = if m > n {
+        r0.iter().map(|r| r * r).sum::<f64>() / (m - n) as f64
+    } else {
+        f64::NAN
+    };
+    let inv = (shape.conditioning >= SINGULAR_RATIO)
+        .then(|| (jac.transpose() * &jac).try_inverse())
+        .flatten();
+    let correlation = correlation(inv.as_ref(), &shape);
+    warnings.extend(correlated(&correlation, &names));
+    let standard_errors = names
+        .iter()
+        .enumerate()
+        .map(|(j, name)| {
+            (
+                name.clone(),
+                standard_error(space, values, inv.as_ref(), sigma2, j),
+            )
+        })
+        .collect();
+    Ok(Assessed {
+        uncertainty: Uncertainty {
+            standard_errors,
+            names,
+            correlation: zero_undefined(correlation),
+            residual_variance: if sigma2.is_finite() { sigma2 } else { 0.0 },
+            conditioning: shape.conditioning,
+        },
+        warnings,
+    })
+}
+
+/// Central-difference Jacobian of the residuals: each column ∂r/∂ln p (log
+/// parameters) or ∂r/∂p scaled by the range, the 2n evaluations in parallel.
+fn jacobian(
+    space: &ParamSpace,
+    objective: &dyn Objective,
+    values: &[f64],
+    step: f64,
+) -> Result<DMatrix<f64>, ObjectiveError> {
     let shifted = |j: usize, sign: f64| -> Result<Vec<f64>, ObjectiveError> {
         let mut v = values.to_vec();
-        v[j] = if space.bounds[j].log() {
+        let b = space.bounds[j];
+        v[j] = if b.log() {
             values[j] * (sign * step).exp()
         } else {
-            values[j] + sign * step * (space.bounds[j].hi - space.bounds[j].lo)
+            values[j] + sign * step * (b.hi - b.lo)
         };
         objective.residuals(&space.params(&v)?)
     };
-    let columns: Vec<Vec<f64>> = (0..n)
+    let columns: Vec<Vec<f64>> = (0..space.dim())
         .into_par_iter()
         .map(|j| {
             let (up, down) = (shifted(j, 1.0)?, shifted(j, -1.0)?);
@@ -79,126 +128,156 @@ pub fn with_residuals(
                 .collect())
         })
         .collect::<Result<_, ObjectiveError>>()?;
-    let jac = DMatrix::from_fn(m, n, |i, j| columns[j][i]);
-    let mut warnings = Vec::new();
+    let m = columns.first().map_or(0, Vec::len);
+    Ok(DMatrix::from_fn(m, space.dim(), |i, j| columns[j][i]))
+}
 
-    // Identifiability from the column-scaled Jacobian.
-    let norms: Vec<f64> = (0..n).map(|j| jac.column(j).norm()).collect();
-    for (j, &c) in norms.iter().enumerate() {
-        if c == 0.0 {
-            warnings.push(format!(
-                "{} has no effect on the residuals: the data say nothing about it",
-                names[j]
-            ));
-        }
-    }
-    let scaled = DMatrix::from_fn(m, n, |i, j| jac[(i, j)] / norms[j].max(f64::MIN_POSITIVE));
-    let sv = SVD::new(scaled.clone(), false, true);
-    let (smax, smin) = sv
-        .singular_values
-        .iter()
-        .fold((0.0f64, f64::INFINITY), |(a, b), &s| (a.max(s), b.min(s)));
-    let conditioning = if smax > 0.0 { smin / smax } else { 0.0 };
-    if m < n {
-        warnings.push(format!(
-            "{m} residuals for {n} parameters: the data cannot determine them all"
-        ));
-    }
-    if conditioning < SINGULAR_RATIO {
-        if let Some(vt) = sv.v_t.as_ref() {
-            let k = sv
-                .singular_values
-                .iter()
-                .enumerate()
-                .min_by(|a, b| a.1.total_cmp(b.1))
-                .map_or(0, |(k, _)| k);
-            let combo: Vec<String> = (0..n)
-                .filter(|&j| vt[(k, j)].abs() > 0.1)
-                .map(|j| names[j].clone())
-                .collect();
-            warnings.push(format!(
-                "JᵀJ is singular (conditioning {conditioning:.1e}): the data cannot separate {}",
-                combo.join(", ")
-            ));
+/// The Jacobian with its columns scaled to unit norm, and its singular values.
+struct Shape {
+    residuals: usize,
+    norms: Vec<f64>,
+    scaled: DMatrix<f64>,
+    svd: SVD<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    conditioning: f64,
+}
+
+impl Shape {
+    fn of(jac: &DMatrix<f64>) -> Shape {
+        let (m, n) = jac.shape();
+        let norms: Vec<f64> = (0..n).map(|j| jac.column(j).norm()).collect();
+        let scaled = DMatrix::from_fn(m, n, |i, j| jac[(i, j)] / norms[j].max(f64::MIN_POSITIVE));
+        let svd = SVD::new(scaled.clone(), false, true);
+        let (smax, smin) = svd
+            .singular_values
+            .iter()
+            .fold((0.0f64, f64::INFINITY), |(a, b), &s| (a.max(s), b.min(s)));
+        Shape {
+            residuals: m,
+            norms,
+            scaled,
+            svd,
+            conditioning: if smax > 0.0 { smin / smax } else { 0.0 },
         }
     }
 
-    // Covariance in the column coordinates (ln p or range-scaled p).
-    let sigma2 = if m > n {
-        r0.iter().map(|r| r * r).sum::<f64>() / (m - n) as f64
-    } else {
-        f64::NAN
-    };
-    let jtj = jac.transpose() * &jac;
-    let inv = if conditioning >= SINGULAR_RATIO {
-        jtj.clone().try_inverse()
-    } else {
-        None
-    };
-    let mut correlation = vec![vec![f64::NAN; n]; n];
-    let mut standard_errors = Vec::new();
-    // Correlations do not depend on σ²; take them from the pseudo-inverse of the
-    // scaled matrix when JᵀJ is singular, so a ±1 still shows.
-    let cov_shape = match &inv {
+    /// What the shape alone says: parameters without effect, too few residuals, a
+    /// singular JᵀJ and the combination it cannot separate.
+    fn warnings(&self, names: &[String]) -> Vec<Warning> {
+        let n = names.len();
+        let mut out: Vec<Warning> = self
+            .norms
+            .iter()
+            .zip(names)
+            .filter(|(c, _)| **c == 0.0)
+            .map(|(_, name)| Warning::NoEffect { name: name.clone() })
+            .collect();
+        if self.residuals < n {
+            out.push(Warning::TooFewResiduals {
+                residuals: self.residuals,
+                parameters: n,
+            });
+        }
+        if self.conditioning < SINGULAR_RATIO {
+            if let Some(vt) = self.svd.v_t.as_ref() {
+                let k = self
+                    .svd
+                    .singular_values
+                    .iter()
+                    .enumerate()
+                    .min_by(|a, b| a.1.total_cmp(b.1))
+                    .map_or(0, |(k, _)| k);
+                out.push(Warning::Singular {
+                    conditioning: self.conditioning,
+                    names: (0..n)
+                        .filter(|&j| vt[(k, j)].abs() > 0.1)
+                        .map(|j| names[j].clone())
+                        .collect(),
+                });
+            }
+        }
+        out
+    }
+}
+
+/// The correlation matrix, from (JᵀJ)⁻¹ — or, when JᵀJ is singular, from the
+/// pseudo-inverse of the scaled matrix, so that a ±1 still shows (correlations do not
+/// depend on σ²). NaN where undefined.
+fn correlation(inv: Option<&DMatrix<f64>>, shape: &Shape) -> Vec<Vec<f64>> {
+    let n = shape.norms.len();
+    let cov = match inv {
         Some(c) => c.clone(),
         None => {
-            let st = scaled.transpose() * &scaled;
+            let st = shape.scaled.transpose() * &shape.scaled;
             let pinv = st
                 .pseudo_inverse(1e-14)
                 .unwrap_or_else(|_| DMatrix::zeros(n, n));
             DMatrix::from_fn(n, n, |a, b| {
-                pinv[(a, b)] / (norms[a] * norms[b]).max(f64::MIN_POSITIVE)
+                pinv[(a, b)] / (shape.norms[a] * shape.norms[b]).max(f64::MIN_POSITIVE)
             })
         }
     };
-    for a in 0..n {
-        for b in 0..n {
-            let d = (cov_shape[(a, a)] * cov_shape[(b, b)]).sqrt();
-            correlation[a][b] = if d > 0.0 {
-                cov_shape[(a, b)] / d
-            } else {
-                f64::NAN
-            };
-        }
-    }
+    (0..n)
+        .map(|a| {
+            (0..n)
+                .map(|b| {
+                    let d = (cov[(a, a)] * cov[(b, b)]).sqrt();
+                    if d > 0.0 {
+                        cov[(a, b)] / d
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// A warning for each pair correlated beyond [`CORRELATION_LIMIT`].
+fn correlated(correlation: &[Vec<f64>], names: &[String]) -> Vec<Warning> {
+    let n = names.len();
+    let mut out = Vec::new();
     for a in 0..n {
         for b in a + 1..n {
             let c = correlation[a][b];
             if c.abs() > CORRELATION_LIMIT {
-                warnings.push(format!(
-                    "{} and {} are correlated {c:+.3}: the data cannot separate them (fix one, or add an experiment that moves them differently)",
-                    names[a], names[b]
-                ));
+                out.push(Warning::Correlated {
+                    a: names[a].clone(),
+                    b: names[b].clone(),
+                    correlation: c,
+                });
             }
         }
     }
-    for j in 0..n {
-        let se = inv.as_ref().and_then(|c| {
-            let s = (sigma2 * c[(j, j)]).sqrt();
-            s.is_finite().then(|| {
-                if space.bounds[j].log() {
-                    values[j] * s
-                } else {
-                    s * (space.bounds[j].hi - space.bounds[j].lo)
-                }
-            })
-        });
-        standard_errors.push((names[j].clone(), se));
-    }
-    let correlation = correlation
+    out
+}
+
+/// The standard error of parameter `j` in its own unit (`None` when undefined).
+fn standard_error(
+    space: &ParamSpace,
+    values: &[f64],
+    inv: Option<&DMatrix<f64>>,
+    sigma2: f64,
+    j: usize,
+) -> Option<f64> {
+    let s = (sigma2 * inv?[(j, j)]).sqrt();
+    let b = space.bounds[j];
+    s.is_finite().then(|| {
+        if b.log() {
+            values[j] * s
+        } else {
+            s * (b.hi - b.lo)
+        }
+    })
+}
+
+/// Undefined correlations written as 0 (JSON has no NaN).
+fn zero_undefined(correlation: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+    correlation
         .into_iter()
         .map(|row| {
             row.into_iter()
                 .map(|c| if c.is_finite() { c } else { 0.0 })
                 .collect()
         })
-        .collect();
-    Ok(Uncertainty {
-        standard_errors,
-        names,
-        correlation,
-        residual_variance: if sigma2.is_finite() { sigma2 } else { 0.0 },
-        conditioning,
-        warnings,
-    })
+        .collect()
 }

@@ -3,7 +3,7 @@
 //! keeps a 6000-sample torque curve from drowning two resonance frequencies; the
 //! weight (`--weight`) says how much each experiment should count.
 
-use super::{cost_function, Objective, ObjectiveError};
+use super::{Objective, ObjectiveError, ObjectiveKind, Smoothness};
 use crate::model::Params;
 
 /// One weighted part of a joint objective.
@@ -11,6 +11,8 @@ pub struct Part {
     /// Where the data came from (file name), for reports.
     pub source: String,
     pub weight: f64,
+    /// Which objective it is (its declared properties).
+    pub kind: ObjectiveKind,
     pub objective: Box<dyn Objective>,
 }
 
@@ -21,12 +23,26 @@ pub struct Joint {
 }
 
 impl Joint {
-    pub fn push(&mut self, source: impl Into<String>, weight: f64, objective: Box<dyn Objective>) {
+    pub fn push(
+        &mut self,
+        source: impl Into<String>,
+        weight: f64,
+        kind: ObjectiveKind,
+        objective: Box<dyn Objective>,
+    ) {
         self.parts.push(Part {
             source: source.into(),
             weight,
+            kind,
             objective,
         });
+    }
+
+    /// Whether any part is rough ([`Smoothness::Rough`]).
+    pub fn rough(&self) -> bool {
+        self.parts
+            .iter()
+            .any(|p| p.kind.properties().smoothness == Smoothness::Rough)
     }
 
     fn factor(part: &Part) -> f64 {
@@ -78,8 +94,6 @@ impl Objective for Joint {
     }
 }
 
-cost_function!(Joint);
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -105,8 +119,9 @@ mod tests {
     fn the_joint_cost_is_the_weighted_sum_of_mean_squares() {
         let p = crate::model::presets::load("worm-gear").unwrap();
         let mut j = Joint::default();
-        j.push("a", 2.0, Box::new(Constant(vec![1.0, 3.0])));
-        j.push("b", 0.5, Box::new(Constant(vec![4.0; 8])));
+        let kind = ObjectiveKind::named("resonance").unwrap();
+        j.push("a", 2.0, kind, Box::new(Constant(vec![1.0, 3.0])));
+        j.push("b", 0.5, kind, Box::new(Constant(vec![4.0; 8])));
         let cost = sum_of_squares(&j.residuals(&p).unwrap());
         assert!((cost - (2.0 * 5.0 + 0.5 * 16.0)).abs() < 1e-12, "{cost}");
         let parts = j.part_residuals(&p).unwrap();

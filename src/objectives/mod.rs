@@ -1,12 +1,15 @@
-//! Objective functions of the identification (MODEL.md §6): each compares the model
-//! with one measured experiment and returns a vector of **scaled residuals** —
-//! (model − measured) / (the measurement's typical error) — so that objectives of
-//! different units add up in one weighted least-squares cost (χ²-like, ~1 per point
-//! at a perfect fit to noisy data). One objective per file:
+//! Objective functions of the identification (docs/model.md, "Identification"): each
+//! compares the model with one measured experiment and returns a vector of **scaled
+//! residuals** — (model − measured) / (the measurement's typical error) — so that
+//! objectives of different units add up in one weighted least-squares cost (χ²-like,
+//! ~1 per point at a perfect fit to noisy data). One objective per file, each with its
+//! [`Definition`] (name, the experiments it reads, its properties, what it determines,
+//! how it is built), listed once in [`registry::REGISTRY`]:
 //!
 //! - [`resonance`]: relative error of the resonance frequencies;
 //! - [`peak_amplitude`]: dB error of the resonance peak heights;
-//! - [`gain_curve`]: dB error of the whole gain curve at the measured frequencies;
+//! - [`gain_curve`]: dB error of the gain at every measured frequency, or only near
+//!   the resonances (`gain-near-peaks`);
 //! - [`torque_curve`]: error of the motor torque of the closed-loop torque test;
 //! - [`unbalance_step`]: error of the table angles where the unbalance test's
 //!   deviation steps across the backlash (the table friction ft);
@@ -14,24 +17,30 @@
 //!
 //! Every objective is a plain `Sync` struct holding the measured data; the simulator
 //! is built inside [`Objective::residuals`], so rayon can evaluate it from any thread.
-//! Each also implements argmin's [`CostFunction`] over a parameter set ([`Params`]):
-//! the cost is the sum of squared scaled residuals.
+//! Adding an objective is one new file (the struct, its `Objective` impl and its
+//! `DEFINITION`) and one line in [`registry::REGISTRY`].
 
 pub mod gain_curve;
 pub mod joint;
+pub mod measured;
 pub mod model_peaks;
 pub mod peak_amplitude;
+pub mod registry;
 pub mod resonance;
 pub mod torque_curve;
 pub mod unbalance_step;
 
+use serde::{Deserialize, Serialize};
+
+use crate::io::experiment_file::Direction;
 use crate::model::{ParamError, Params};
 use crate::sim::SimError;
 
 pub use joint::Joint;
+pub use registry::{Definition, ObjectiveKind, SetupError, Source, Stage};
 
 /// What the model's frequency response is computed with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Fidelity {
     /// The exact linear response solved in the frequency domain, with damping (no
@@ -51,6 +60,28 @@ impl Fidelity {
     }
 }
 
+/// How an objective's cost varies with the parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Smoothness {
+    /// Smooth on the scale of finite differences (the exact linear response, or a
+    /// nonlinear test whose roughness the correction stage averages out).
+    Smooth,
+    /// A closed-loop time simulation read through quantised encoders: the cost is
+    /// piecewise constant on tiny scales and each evaluation costs seconds — a
+    /// derivative-free search from one start, larger difference steps, and standard
+    /// errors that are lower bounds.
+    Rough,
+}
+
+/// What an objective declares about itself; the identification's defaults follow
+/// from these, not from the experiment kinds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Properties {
+    pub smoothness: Smoothness,
+    /// Whether it depends on the frequency-response model ([`Fidelity`]).
+    pub frequency_response: bool,
+}
+
 /// Why an objective could not be evaluated.
 #[derive(Debug, Clone, thiserror::Error)]
 #[non_exhaustive]
@@ -63,6 +94,32 @@ pub enum ObjectiveError {
     Data { what: String, reason: String },
     #[error("interrupted")]
     Interrupted,
+}
+
+/// An objective's residuals in the measurement's own units, for reports.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Detail {
+    /// The resonance frequencies, measured and model, and the largest miss, Hz.
+    Resonance {
+        measured_hz: Vec<f64>,
+        model_hz: Vec<f64>,
+        max_miss_hz: f64,
+    },
+    /// The peak heights, measured, and the model's errors, dB.
+    PeakHeights {
+        measured_db: Vec<f64>,
+        error_db: Vec<f64>,
+    },
+    /// The RMS error of the motor torque, N·m.
+    Torque { rms_error_nm: f64 },
+    /// The unbalance steps: direction, measured and model table angle (deg; `None`
+    /// where the model shows no step).
+    UnbalanceSteps {
+        direction: Vec<Direction>,
+        measured_step_deg: Vec<f64>,
+        model_step_deg: Vec<Option<f64>>,
+    },
 }
 
 /// One comparison of the model with measured data.
@@ -79,9 +136,8 @@ pub trait Objective: Sync + Send {
     }
     /// What one unit of scaled residual means, for reports, e.g. `0.1 % of frequency`.
     fn scale(&self) -> String;
-    /// The residuals `r` in the measurement's own units, for reports (e.g. the
-    /// resonance misses in Hz).
-    fn detail(&self, r: &[f64]) -> Option<serde_json::Value> {
+    /// The residuals `r` in the measurement's own units, for reports.
+    fn detail(&self, r: &[f64]) -> Option<Detail> {
         let _ = r;
         None
     }
@@ -91,19 +147,3 @@ pub trait Objective: Sync + Send {
 pub fn sum_of_squares(r: &[f64]) -> f64 {
     r.iter().map(|x| x * x).sum()
 }
-
-/// Implements argmin's `CostFunction` over [`Params`] for an objective type.
-macro_rules! cost_function {
-    ($t:ty) => {
-        impl argmin::core::CostFunction for $t {
-            type Param = $crate::model::Params;
-            type Output = f64;
-            fn cost(&self, p: &Self::Param) -> Result<f64, argmin::core::Error> {
-                Ok($crate::objectives::sum_of_squares(
-                    &$crate::objectives::Objective::residuals(self, p)?,
-                ))
-            }
-        }
-    };
-}
-pub(crate) use cost_function;

@@ -1,5 +1,5 @@
 //! Peak-amplitude match: the dB error of the model's resonance peak heights against
-//! measured ones (MODEL.md §6: the internal damping Ciw, Cig from the peak heights).
+//! measured ones (paper §4.1: the internal damping Ciw, Cig from the peak heights).
 //!
 //! The model's peaks are found as in [`super::resonance`] (same pairing); the height
 //! of a lightly damped peak is very sensitive to where it is sampled, so the linear
@@ -9,10 +9,59 @@
 //! under-estimates such a peak by tens of dB, so compare like with like.
 
 use super::model_peaks::ModelPeaks;
-use super::{cost_function, Fidelity, Objective, ObjectiveError};
+use super::registry::{Definition, SetupError, Source, Stage};
+use super::{measured, Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::frequency_response::FrequencyTest;
+use crate::io::experiment_file::Kind;
 use crate::model::Params;
 use crate::peaks::Peak;
+
+/// Weight, relative to the resonance frequencies, of the peak heights that a gain curve
+/// feeds by default: resonance frequencies alone admit two (Kw, Kg) pairs for the worm
+/// (the two modes can trade their spur/drive character), and the heights tell them
+/// apart. Small, so that the heights of a nonlinear measurement (friction lowers them
+/// ~1 dB) hardly pull the frequencies.
+pub const DEFAULT_HEIGHT_WEIGHT: f64 = 0.01;
+
+/// The peak-amplitude objective: determines the internal damping of the meshes.
+pub static DEFINITION: Definition = Definition {
+    name: "peak_amplitude",
+    summary: "dB error of the resonance peak heights",
+    reads: &[Kind::FrequencyResponse, Kind::Resonance],
+    needs: "a frequency_response or resonance experiment",
+    properties: Properties {
+        smoothness: Smoothness::Smooth,
+        frequency_response: true,
+    },
+    determines: |p| {
+        if p.cig.is_some() {
+            vec!["Ciw", "Cig"]
+        } else {
+            vec!["Ciw"]
+        }
+    },
+    default_weight: |kind, stage| {
+        (kind == Kind::FrequencyResponse && stage == Stage::Search).then_some(DEFAULT_HEIGHT_WEIGHT)
+    },
+    build,
+};
+
+fn build(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, SetupError> {
+    let peaks = measured::peaks(source)?;
+    if peaks.iter().any(|p| !p.gain_db.is_finite()) {
+        return Err(SetupError::Mismatch {
+            file: source.file.into(),
+            kind: source.kind().name(),
+            objective: DEFINITION.name,
+            needs: "peak heights (`peak_gain_db` in a resonance manifest)",
+        });
+    }
+    let o = PeakAmplitude::new(peaks, fidelity, measured::frequency_test(source.experiment));
+    Ok(Box::new(match measured::grid(source.experiment) {
+        Some(grid) => o.on_grid(grid),
+        None => o,
+    }))
+}
 
 /// One scaled residual is this error, dB.
 pub const SCALE_DB: f64 = 0.1;
@@ -73,12 +122,10 @@ impl Objective for PeakAmplitude {
         format!("{SCALE_DB} dB of each peak height")
     }
 
-    fn detail(&self, r: &[f64]) -> Option<serde_json::Value> {
-        Some(serde_json::json!({
-            "measured_db": self.measured.iter().map(|p| p.gain_db).collect::<Vec<_>>(),
-            "error_db": r.iter().map(|x| x * SCALE_DB).collect::<Vec<_>>(),
-        }))
+    fn detail(&self, r: &[f64]) -> Option<Detail> {
+        Some(Detail::PeakHeights {
+            measured_db: self.measured.iter().map(|p| p.gain_db).collect(),
+            error_db: r.iter().map(|x| x * SCALE_DB).collect(),
+        })
     }
 }
-
-cost_function!(PeakAmplitude);

@@ -1,9 +1,9 @@
 //! Resonance-frequency match: the relative error of the model's resonance frequencies
-//! against measured ones (paper §4.1, MODEL.md §6).
+//! against measured ones (paper §4.1; docs/model.md).
 //!
 //! The model's resonances are the peaks of its frequency response — the damped,
 //! motor-held modes — never the undamped eigenvalues (fitting those to measured peaks
-//! biases Kw by ~6 %, MODEL.md §6). With [`Fidelity::Linear`] they come from the exact
+//! biases Kw by ~6 %). With [`Fidelity::Linear`] they come from the exact
 //! linear response with damping; with [`Fidelity::Nonlinear`] from the nonlinear
 //! virtual test at the experiment's conditions ([`super::model_peaks`]), sampled on
 //! the measured frequencies when there is a measured gain curve.
@@ -13,9 +13,51 @@
 //! peak the model does not have costs a residual of 100 % of its frequency.
 
 use super::model_peaks::ModelPeaks;
-use super::{cost_function, Fidelity, Objective, ObjectiveError};
+use super::registry::{Definition, SetupError, Source, Stage};
+use super::{measured, Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::frequency_response::FrequencyTest;
+use crate::io::experiment_file::Kind;
 use crate::model::Params;
+
+/// The resonance objective: fed by default by every frequency response and resonance
+/// list; determines the drive stiffnesses.
+pub static DEFINITION: Definition = Definition {
+    name: "resonance",
+    summary: "relative error of the resonance frequencies",
+    reads: &[Kind::FrequencyResponse, Kind::Resonance],
+    needs: "a frequency_response or resonance experiment",
+    properties: Properties {
+        smoothness: Smoothness::Smooth,
+        frequency_response: true,
+    },
+    determines: drive_stiffnesses,
+    default_weight: |kind, stage| match (kind, stage) {
+        (Kind::FrequencyResponse, Stage::Search) | (Kind::Resonance, _) => Some(1.0),
+        _ => None,
+    },
+    build,
+};
+
+/// The drive stiffnesses: Kw, and Kg where there is a spur stage.
+pub(super) fn drive_stiffnesses(p: &Params) -> Vec<&'static str> {
+    if p.kg.is_some() {
+        vec!["Kw", "Kg"]
+    } else {
+        vec!["Kw"]
+    }
+}
+
+fn build(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, SetupError> {
+    let hz = measured::peaks(source)?
+        .iter()
+        .map(|p| p.frequency_hz)
+        .collect();
+    let o = ResonanceMatch::new(hz, fidelity, measured::frequency_test(source.experiment));
+    Ok(Box::new(match measured::grid(source.experiment) {
+        Some(grid) => o.on_grid(grid),
+        None => o,
+    }))
+}
 
 /// One scaled residual is this relative frequency error (0.1 %).
 pub const SCALE: f64 = 1e-3;
@@ -81,7 +123,7 @@ impl Objective for ResonanceMatch {
         format!("{} % of each resonance frequency", SCALE * 100.0)
     }
 
-    fn detail(&self, r: &[f64]) -> Option<serde_json::Value> {
+    fn detail(&self, r: &[f64]) -> Option<Detail> {
         let miss: Vec<f64> = r
             .iter()
             .zip(&self.measured_hz)
@@ -93,15 +135,13 @@ impl Objective for ResonanceMatch {
             .map(|(m, f)| f + m)
             .collect();
         let max = miss.iter().fold(0.0f64, |a, m| a.max(m.abs()));
-        Some(serde_json::json!({
-            "measured_hz": self.measured_hz,
-            "model_hz": model,
-            "max_miss_hz": max,
-        }))
+        Some(Detail::Resonance {
+            measured_hz: self.measured_hz.clone(),
+            model_hz: model,
+            max_miss_hz: max,
+        })
     }
 }
-
-cost_function!(ResonanceMatch);
 
 #[cfg(test)]
 mod tests {

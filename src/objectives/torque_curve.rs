@@ -1,5 +1,5 @@
 //! Torque-curve residual: the error of the motor torque of the closed-loop virtual
-//! torque test against the measured curve, sample by sample (paper §4.2, MODEL.md §6:
+//! torque test against the measured curve, sample by sample (paper §4.2:
 //! Coulomb friction and viscous damping from the torque curve).
 //!
 //! The model runs the test at the file's conditions (amplitude, period, loop) and is
@@ -11,9 +11,51 @@
 //! one Coulomb and one viscous sum. Fit one Coulomb and one viscous parameter (the
 //! rest fixed), or expect the identifiability warning.
 
-use super::{cost_function, Objective, ObjectiveError};
+use super::registry::{Definition, SetupError, Source};
+use super::{Detail, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::torque_curve::{simulate_torque, TorqueTest};
+use crate::io::experiment_file::{Data, Kind};
 use crate::model::Params;
+
+/// The torque-curve objective: a closed-loop simulation (rough); determines the motor's
+/// Coulomb friction and viscous damping (the table's reach the motor divided by the
+/// ratio, 1/90 for the worm, and hardly show in its torque).
+pub static DEFINITION: Definition = Definition {
+    name: "torque_curve",
+    summary: "error of the motor torque of the closed-loop torque test, sample by sample",
+    reads: &[Kind::TorqueCurve],
+    needs: "a torque_curve experiment",
+    properties: Properties {
+        smoothness: Smoothness::Rough,
+        frequency_response: false,
+    },
+    determines: |_| vec!["fm", "Cm"],
+    default_weight: |kind, _| (kind == Kind::TorqueCurve).then_some(1.0),
+    build,
+};
+
+fn build(
+    source: &Source<'_>,
+    _: crate::objectives::Fidelity,
+) -> Result<Box<dyn Objective>, SetupError> {
+    let exp = source.experiment;
+    let Data::TorqueCurve {
+        time_s,
+        motor_torque_nm,
+        ..
+    } = &exp.data
+    else {
+        return Err(SetupError::Unsupported {
+            file: source.file.into(),
+            kind: source.kind().name(),
+        });
+    };
+    Ok(Box::new(TorqueResidual::new(
+        time_s.clone(),
+        motor_torque_nm.clone(),
+        TorqueTest::from_conditions(&exp.manifest.conditions),
+    )))
+}
 
 /// One scaled residual is this fraction of the measured RMS torque.
 pub const SCALE_OF_RMS: f64 = 0.01;
@@ -72,11 +114,9 @@ impl Objective for TorqueResidual {
         )
     }
 
-    fn detail(&self, r: &[f64]) -> Option<serde_json::Value> {
+    fn detail(&self, r: &[f64]) -> Option<Detail> {
         let n = r.len().max(1) as f64;
         let rms = (r.iter().map(|x| x * x).sum::<f64>() / n).sqrt() * self.scale_nm;
-        Some(serde_json::json!({ "rms_error_nm": rms }))
+        Some(Detail::Torque { rms_error_nm: rms })
     }
 }
-
-cost_function!(TorqueResidual);

@@ -1,5 +1,5 @@
 //! Unbalance-step residual: where the deviation θt − θm·Rg·Rw of the unbalance test
-//! steps across the backlash (paper §4.5, MODEL.md §5.5), model against measurement.
+//! steps across the backlash (paper §4.5), model against measurement.
 //!
 //! Physics: the table, vertical with a mass m at radius e, turns at constant speed ω;
 //! the mesh carries Ct·ω + ft·sgn(ω) − Tu(θt). Where the gravity torque
@@ -22,12 +22,44 @@
 
 use rayon::prelude::*;
 
-use super::{cost_function, Objective, ObjectiveError};
+use super::registry::{Definition, SetupError, Source};
+use super::{Detail, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::fluctuation::{
     self, locate_step, pass_samples, run_window, FluctuationTest, STEP_LOCATE_HALF_WIDTH,
 };
-use crate::io::experiment_file::{Direction, Experiment};
+use crate::io::experiment_file::{Direction, Experiment, Kind};
 use crate::model::Params;
+
+/// The unbalance-step objective: closed-loop simulations (rough); determines the
+/// table's Coulomb friction ft.
+pub static DEFINITION: Definition = Definition {
+    name: "unbalance_step",
+    summary:
+        "error of the table angles where the unbalance test's deviation steps across the backlash",
+    reads: &[Kind::Unbalance],
+    needs: "an unbalance experiment",
+    properties: Properties {
+        smoothness: Smoothness::Rough,
+        frequency_response: false,
+    },
+    determines: |_| vec!["ft"],
+    default_weight: |kind, _| (kind == Kind::Unbalance).then_some(1.0),
+    build,
+};
+
+fn build(
+    source: &Source<'_>,
+    _: crate::objectives::Fidelity,
+) -> Result<Box<dyn Objective>, SetupError> {
+    let o = UnbalanceStep::new(source.file, source.experiment).map_err(|e| SetupError::Data {
+        file: source.file.into(),
+        reason: match e {
+            ObjectiveError::Data { reason, .. } => reason,
+            other => other.to_string(),
+        },
+    })?;
+    Ok(Box::new(o))
+}
 
 /// One scaled residual is this much table angle, deg: a twentieth of a degree, 0.009
 /// N·m = 3.3 % of ft for the worm preset with 10 kg at 0.1 m (∂θ/∂ft = 1/(m·g·e) rad
@@ -178,21 +210,19 @@ impl Objective for UnbalanceStep {
         format!("{SCALE_DEG}° of table angle per step (model − measured step angle)")
     }
 
-    fn detail(&self, r: &[f64]) -> Option<serde_json::Value> {
+    fn detail(&self, r: &[f64]) -> Option<Detail> {
         let model: Vec<Option<f64>> = r
             .iter()
             .zip(&self.steps)
             .map(|(x, st)| (*x != MISSING_STEP_RESIDUAL).then(|| st.angle_deg + x * SCALE_DEG))
             .collect();
-        Some(serde_json::json!({
-            "direction": self.steps.iter().map(|s| s.direction.to_string()).collect::<Vec<_>>(),
-            "measured_step_deg": self.steps.iter().map(|s| s.angle_deg).collect::<Vec<_>>(),
-            "model_step_deg": model,
-        }))
+        Some(Detail::UnbalanceSteps {
+            direction: self.steps.iter().map(|s| s.direction).collect(),
+            measured_step_deg: self.steps.iter().map(|s| s.angle_deg).collect(),
+            model_step_deg: model,
+        })
     }
 }
-
-cost_function!(UnbalanceStep);
 
 #[cfg(test)]
 mod tests {

@@ -1,0 +1,133 @@
+//! Several starts of one local search, in parallel (rayon): the given start, then a
+//! Latin hypercube in the bounds. Each start's record is handed to a callback as it
+//! finishes (to checkpoint); a start finished before a resume is not run again, one
+//! interrupted continues from where it had got to.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::problem::{Monitor, Problem};
+use super::solvers::{self, Limits, Method};
+use super::space::ParamSpace;
+use super::termination::Termination;
+use crate::objectives::Objective;
+
+/// How one stage searches (resolved by the [`super::plan`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    pub method: Method,
+    /// Starts: the given start, then a Latin hypercube in the bounds.
+    pub starts: usize,
+    pub seed: u64,
+    pub max_iters: u64,
+    /// Forward-difference step of the Gauss–Newton Jacobian, solver coordinates
+    /// (≈ 2× as much in ln p for the default ×100 range).
+    pub fd_step: f64,
+    /// Stop after this many evaluations in all (None: no limit).
+    pub max_evaluations: Option<usize>,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            method: Method::Lsq,
+            starts: 4,
+            seed: 1,
+            max_iters: 50,
+            fd_step: 1e-5,
+            max_evaluations: None,
+        }
+    }
+}
+
+/// One start of a search, as reported and checkpointed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StartRecord {
+    pub index: usize,
+    /// Physical start values of the fitted parameters.
+    pub initial: Vec<f64>,
+    /// Physical result values (`None` if interrupted before a result).
+    pub result: Option<Vec<f64>>,
+    /// The cost at the result (`None`: no finite cost, e.g. nothing evaluated).
+    pub cost: Option<f64>,
+    pub iterations: u64,
+    pub termination: Termination,
+}
+
+impl StartRecord {
+    /// A start that ran to its end (not interrupted).
+    pub fn finished(&self) -> bool {
+        !self.termination.interrupted() && self.result.is_some()
+    }
+
+    /// The cost, +∞ when there is none.
+    pub fn cost_or_infinity(&self) -> f64 {
+        self.cost.unwrap_or(f64::INFINITY)
+    }
+}
+
+/// Runs the starts of `settings` (skipping those `done` already holds as finished),
+/// in parallel; `on_done` is called after each start (to checkpoint). Returns every
+/// start, in index order. The best point of all evaluations is in `monitor`.
+pub fn search(
+    space: &ParamSpace,
+    objective: &dyn Objective,
+    settings: &Settings,
+    monitor: &Monitor,
+    done: &[StartRecord],
+    on_done: &(dyn Fn(&StartRecord) + Sync),
+) -> Vec<StartRecord> {
+    for d in done.iter().filter(|d| d.finished()) {
+        if let (Some(v), Some(c)) = (&d.result, d.cost) {
+            monitor.offer(c, v);
+        }
+    }
+    let mut records: Vec<StartRecord> = space
+        .starts(settings.starts, settings.seed)
+        .into_par_iter()
+        .enumerate()
+        .map(|(index, initial)| {
+            if let Some(d) = done.iter().find(|d| d.index == index && d.finished()) {
+                return d.clone();
+            }
+            let record = one_start(space, objective, settings, monitor, done, index, initial);
+            on_done(&record);
+            record
+        })
+        .collect();
+    records.sort_by_key(|r| r.index);
+    records
+}
+
+/// Start `index` from `initial`, or from where an interrupted run of it had got to.
+fn one_start(
+    space: &ParamSpace,
+    objective: &dyn Objective,
+    settings: &Settings,
+    monitor: &Monitor,
+    done: &[StartRecord],
+    index: usize,
+    initial: Vec<f64>,
+) -> StartRecord {
+    let from = done
+        .iter()
+        .find(|d| d.index == index)
+        .and_then(|d| d.result.clone())
+        .unwrap_or_else(|| initial.clone());
+    let problem = Problem::new(space, objective, monitor, settings);
+    let limits = Limits {
+        max_iters: settings.max_iters,
+        seed: settings.seed.wrapping_add(index as u64),
+    };
+    let out = solvers::run(settings.method, problem, space.to_solver(&from), limits);
+    let result =
+        (!out.x.is_empty()).then(|| space.from_solver(&nalgebra::DVector::from_vec(out.x.clone())));
+    StartRecord {
+        index,
+        initial,
+        result,
+        cost: out.cost.is_finite().then_some(out.cost),
+        iterations: out.iterations,
+        termination: out.termination,
+    }
+}

@@ -1,0 +1,100 @@
+//! Fixtures shared by the tests and the benches: each returns the experiment and the
+//! parameter set that made it (diffsol's `robertson() -> (problem, solution)`), so a
+//! test states its truth once, from the preset behind the file
+//! (`fixtures/make-identification-fixtures.sh` rebuilds the files from the presets).
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+use rtid::identify::ExperimentSpec;
+use rtid::io::experiment_file;
+use rtid::model::{presets, Params};
+
+/// A fixture file's path (`worm-gear/frequency_response.json`).
+pub fn fixture_path(relative: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(relative)
+}
+
+/// The experiment in a fixture file.
+pub fn experiment(relative: &str) -> ExperimentSpec {
+    let path = fixture_path(relative);
+    let exp = experiment_file::read(&path)
+        .unwrap_or_else(|e| panic!("fixture {relative} does not read: {e}"));
+    ExperimentSpec::new(relative, exp)
+}
+
+/// An experiment and the parameters that made it.
+pub struct Fixture {
+    pub spec: ExperimentSpec,
+    pub truth: Params,
+}
+
+fn fixture(relative: &str, preset: &str) -> Fixture {
+    Fixture {
+        spec: experiment(relative),
+        truth: presets::load(preset).expect("a shipped preset"),
+    }
+}
+
+/// The worm gear's frequency response: ±20 N·m with a 2000 N·m table brake, the
+/// nonlinear virtual test (both meshes loaded, both resonances show).
+pub fn worm_frequency_response() -> Fixture {
+    fixture("worm-gear/frequency_response.json", "worm-gear")
+}
+
+/// As [`worm_frequency_response`] with 1 % Gaussian noise on the amplitude ratio.
+pub fn worm_frequency_response_noisy() -> Fixture {
+    fixture("worm-gear-noisy/frequency_response.json", "worm-gear")
+}
+
+/// The worm gear's friction-torque curve (full-closed loop, 30°·sin(2πt/3 s)).
+pub fn worm_torque_curve() -> Fixture {
+    fixture("worm-gear/torque_curve.json", "worm-gear")
+}
+
+/// As [`worm_torque_curve`] with 1 % (of the RMS) Gaussian noise on the torque.
+pub fn worm_torque_curve_noisy() -> Fixture {
+    fixture("worm-gear-noisy/torque_curve.json", "worm-gear")
+}
+
+/// The worm gear's unbalance test (10 kg at 0.1 m, 360°/min).
+pub fn worm_unbalance() -> Fixture {
+    fixture("worm-gear/unbalance.json", "worm-gear")
+}
+
+/// As [`worm_unbalance`] with 2″ of Gaussian noise on the table angle.
+pub fn worm_unbalance_noisy() -> Fixture {
+    fixture("worm-gear-noisy/unbalance.json", "worm-gear")
+}
+
+/// The roller gear cam's frequency response, 10–1000 Hz.
+pub fn roller_frequency_response() -> Fixture {
+    fixture("roller-gear-cam/frequency_response.json", "roller-gear-cam")
+}
+
+/// The paper's measured worm resonances (230, 280 Hz); `truth` is only the preset
+/// (the paper's table does not reproduce its own measurements).
+pub fn paper_worm() -> Fixture {
+    fixture("paper/worm-gear.json", "worm-gear")
+}
+
+/// `truth` with the named parameters multiplied by their factors: a start off the
+/// truth.
+pub fn off(truth: &Params, factors: &[(&str, f64)]) -> Params {
+    let mut p = truth.clone();
+    for (name, factor) in factors {
+        let v = p.get(name).unwrap().expect("the parameter applies");
+        p.set(name, v * factor).unwrap();
+    }
+    p
+}
+
+/// `(name, value)` of each of `names` in `p`.
+pub fn values(p: &Params, names: &[&'static str]) -> Vec<(&'static str, f64)> {
+    names
+        .iter()
+        .map(|n| (*n, p.get(n).unwrap().expect("the parameter applies")))
+        .collect()
+}
