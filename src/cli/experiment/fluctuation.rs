@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 
-use super::Common;
+use super::{check, Common};
 use crate::cli::progress;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use rtid::experiments::fluctuation::{self, Evaluation, FluctuationTest};
@@ -72,29 +72,19 @@ pub struct RunArgs {
     pub seed: u64,
 }
 
-/// A positive finite flag value.
-pub fn positive(v: f64, flag: &str) -> anyhow::Result<f64> {
-    if v > 0.0 && v.is_finite() {
-        Ok(v)
-    } else {
-        bail!("{flag} {v}: must be a positive number")
-    }
-}
-
 impl RunArgs {
     /// The test at `speed_deg_per_min`.
     pub fn test(&self, speed_deg_per_min: f64) -> anyhow::Result<FluctuationTest> {
         if self.revolutions == 0 {
             bail!("--revolutions 0: at least one revolution is needed");
         }
-        if !(self.run_in_deg >= 0.0 && self.run_in_deg.is_finite()) {
-            bail!("--run-in-deg {}: must be zero or positive", self.run_in_deg);
-        }
+        check::non_negative(self.run_in_deg, "--run-in-deg")?;
+        check::non_negative(self.noise_arcsec, "--noise-arcsec")?;
         Ok(FluctuationTest {
-            speed: positive(speed_deg_per_min, "--speed-deg-per-min")?.to_radians() / 60.0,
+            speed: check::positive(speed_deg_per_min, "--speed-deg-per-min")?.to_radians() / 60.0,
             revolutions: self.revolutions,
             run_in: self.run_in_deg.to_radians(),
-            sample_period: positive(self.sample_period_s, "--sample-period-s")?,
+            sample_period: check::positive(self.sample_period_s, "--sample-period-s")?,
             loop_mode: self.loop_mode,
             ..Default::default()
         })
@@ -116,11 +106,6 @@ pub fn run_test(
     test: &FluctuationTest,
     run: &RunArgs,
 ) -> anyhow::Result<()> {
-    anyhow::ensure!(
-        run.noise_arcsec >= 0.0 && run.noise_arcsec.is_finite(),
-        "--noise-arcsec {}: must be zero or positive",
-        run.noise_arcsec
-    );
     let name = test.kind().name();
     let bar = progress::bar(test.duration().ceil() as u64, name, common.quiet);
     let mut record = fluctuation::run(p, test, |done, _| bar.set_position(done as u64))?;

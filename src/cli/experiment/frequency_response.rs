@@ -4,10 +4,12 @@ use std::path::Path;
 
 use anyhow::bail;
 
+use super::check;
 use super::Common;
 use crate::cli::progress;
 use rtid::experiments::frequency_response::{self as fr, FrequencyTest, Point};
-use rtid::io::experiment_file::{self, Data, Experiment, Kind, Manifest};
+use rtid::experiments::measurement_noise;
+use rtid::io::experiment_file::{Data, Experiment};
 
 pub const LONG_ABOUT: &str = "\
 Frequency response (paper §4.1): open loop, the motor driven by a sinusoidal torque \
@@ -72,66 +74,37 @@ pub struct Args {
     pub seed: u64,
 }
 
+impl Args {
+    /// The test the flags describe, checked before anything runs.
+    fn test(&self) -> anyhow::Result<FrequencyTest> {
+        let (from, to, step) = (
+            check::positive(self.from_hz, "--from-hz")?,
+            check::positive(self.to_hz, "--to-hz")?,
+            check::positive(self.step_hz, "--step-hz")?,
+        );
+        if to < from {
+            bail!("--to-hz {to} is below --from-hz {from}");
+        }
+        check::non_negative(self.refine_step_hz, "--refine-step-hz")?;
+        check::finite(self.preload_nm, "--preload-nm")?;
+        check::non_negative(self.noise_percent, "--noise-percent")?;
+        let count = ((to - from) / step + 1e-9).floor() as usize;
+        Ok(FrequencyTest {
+            frequencies_hz: (0..=count).map(|i| from + step * i as f64).collect(),
+            amplitude_nm: check::positive(self.amplitude_nm, "--amplitude-nm")?,
+            preload_nm: self.preload_nm,
+            refine_step_hz: self.refine_step_hz,
+            ..Default::default()
+        })
+    }
+}
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
-    let finite_positive = |v: f64, flag: &str| -> anyhow::Result<f64> {
-        if v > 0.0 && v.is_finite() {
-            Ok(v)
-        } else {
-            bail!("{flag} {v}: must be a positive number")
-        }
-    };
-    let (from, to, step) = (
-        finite_positive(a.from_hz, "--from-hz")?,
-        finite_positive(a.to_hz, "--to-hz")?,
-        finite_positive(a.step_hz, "--step-hz")?,
-    );
-    if to < from {
-        bail!("--to-hz {to} is below --from-hz {from}");
-    }
-    if !(a.refine_step_hz >= 0.0 && a.refine_step_hz.is_finite()) {
-        bail!(
-            "--refine-step-hz {}: must be zero or positive",
-            a.refine_step_hz
-        );
-    }
-    if !a.preload_nm.is_finite() {
-        bail!("--preload-nm {}: must be a finite torque", a.preload_nm);
-    }
+    let test = a.test()?;
     a.common.create_out()?;
-    let count = ((to - from) / step + 1e-9).floor() as usize;
-    let test = FrequencyTest {
-        frequencies_hz: (0..=count).map(|i| from + step * i as f64).collect(),
-        amplitude_nm: finite_positive(a.amplitude_nm, "--amplitude-nm")?,
-        preload_nm: a.preload_nm,
-        refine_step_hz: a.refine_step_hz,
-        ..Default::default()
-    };
-    let points: Vec<Point> = if a.linear {
-        let solve = |freqs: &[f64]| -> anyhow::Result<Vec<Point>> {
-            Ok(fr::linear(&p, freqs)?
-                .into_iter()
-                .zip(freqs)
-                .map(|((gain_db, phase_deg), &frequency_hz)| Point {
-                    frequency_hz,
-                    gain_db,
-                    phase_deg,
-                    motor_amplitude_rad: f64::NAN,
-                    table_amplitude_rad: f64::NAN,
-                    contact_loss: [0.0, 0.0],
-                    settled: true,
-                    below_resolution: false,
-                    simulated_s: 0.0,
-                })
-                .collect())
-        };
-        let mut points = solve(&test.frequencies_hz)?;
-        if test.refine_step_hz > 0.0 {
-            let extra = fr::refinement(&points, &test);
-            points.extend(solve(&extra)?);
-            points.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-        }
-        points
+    let points = if a.linear {
+        fr::linear_points(&p, &test)?
     } else {
         let expected = test.frequencies_hz.len() as u64
             + 6 * (1 + (test.refine_half_width_hz / test.refine_step_hz.max(1e-9)) as u64);
@@ -141,65 +114,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         points
     };
     warn_about_backlash(&points);
-    let freqs: Vec<f64> = points.iter().map(|q| q.frequency_hz).collect();
-    let linear_db: Vec<f64> = fr::linear(&p, &freqs)?.into_iter().map(|g| g.0).collect();
-    let mut extra = experiment_file::Columns::new();
-    extra.insert(
-        "contact_loss_spur".into(),
-        points.iter().map(|q| q.contact_loss[0]).collect(),
-    );
-    extra.insert(
-        "contact_loss_drive".into(),
-        points.iter().map(|q| q.contact_loss[1]).collect(),
-    );
-    extra.insert(
-        "settled".into(),
-        points
-            .iter()
-            .map(|q| f64::from(u8::from(q.settled)))
-            .collect(),
-    );
-    extra.insert(
-        "below_resolution".into(),
-        points
-            .iter()
-            .map(|q| f64::from(u8::from(q.below_resolution)))
-            .collect(),
-    );
-    extra.insert("linear_gain_db".into(), linear_db);
-    anyhow::ensure!(
-        a.noise_percent >= 0.0 && a.noise_percent.is_finite(),
-        "--noise-percent {}: must be zero or positive",
-        a.noise_percent
-    );
-    let mut gain_db: Vec<f64> = points.iter().map(|q| q.gain_db).collect();
-    rtid::experiments::measurement_noise::perturb_gain_db(&mut gain_db, a.noise_percent, a.seed);
-    let data = Data::FrequencyResponse {
-        frequency_hz: freqs,
-        gain_db,
-        phase_rad: Some(points.iter().map(|q| q.phase_deg.to_radians()).collect()),
-        extra,
-    };
-    let mut manifest = Manifest::new(Kind::FrequencyResponse);
-    manifest.mechanism = Some(p.name.clone());
-    manifest.conditions.torque_amplitude_nm = Some(test.amplitude_nm);
-    manifest.conditions.preload_nm = Some(test.preload_nm);
-    manifest.notes = Some(format!(
-        "{}{}",
-        if a.linear {
-            "virtual test by rtid: linear response solved in the frequency domain"
-        } else {
-            "virtual test by rtid: nonlinear time simulation per frequency"
-        },
-        if a.noise_percent > 0.0 {
-            format!(
-                "; {} % Gaussian noise on the amplitude ratio (seed {})",
-                a.noise_percent, a.seed
-            )
-        } else {
-            String::new()
+    let mut data = fr::to_data(&p, &points)?;
+    let mut manifest = fr::manifest(&p, &test, a.linear);
+    if a.noise_percent > 0.0 {
+        if let Data::FrequencyResponse { gain_db, .. } = &mut data {
+            measurement_noise::perturb_gain_db(gain_db, a.noise_percent, a.seed);
         }
-    ));
+        manifest.notes = Some(format!(
+            "{}; {} % Gaussian noise on the amplitude ratio (seed {})",
+            manifest.notes.unwrap_or_default(),
+            a.noise_percent,
+            a.seed
+        ));
+    }
     a.common
         .write_and_report("frequency_response", manifest, &data, report)
 }

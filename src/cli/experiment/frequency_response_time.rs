@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 
-use super::fluctuation::positive;
+use super::check::positive;
 use super::Common;
 use crate::cli::progress;
 use rtid::experiments::frequency_response_estimate::{

@@ -2,6 +2,7 @@
 //! experiment files (the same format as measured data, so the two compare directly)
 //! with a plot. One file per test.
 
+pub mod check;
 pub mod fluctuation;
 pub mod frequency_response;
 pub mod frequency_response_time;

@@ -6,7 +6,7 @@ use anyhow::bail;
 
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
-use super::Common;
+use super::{check, Common};
 use crate::cli::progress;
 use rtid::experiments::{iso230, positioning};
 use rtid::io::experiment_file::Experiment;
@@ -57,44 +57,37 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
+    let test = test(&a)?;
     a.common.create_out()?;
-    run_positioning(&a, &p)
+    run_positioning(&a, &p, test)
 }
 
-fn run_positioning(a: &Args, p: &Params) -> anyhow::Result<()> {
-    let positive = |v: f64, flag: &str| -> anyhow::Result<f64> {
-        if v > 0.0 && v.is_finite() {
-            Ok(v)
-        } else {
-            bail!("{flag} {v}: must be a positive number")
-        }
-    };
-    let step = positive(a.target_step_deg, "--target-step-deg")?;
+/// The test the flags describe, checked before anything runs.
+fn test(a: &Args) -> anyhow::Result<positioning::PositioningTest> {
+    let step = check::positive(a.target_step_deg, "--target-step-deg")?;
     if a.runs < 2 {
         bail!(
             "--runs {}: ISO 230-2 needs at least 2 runs per direction (5 in the standard test)",
             a.runs
         );
     }
-    if !(a.noise_arcsec >= 0.0 && a.noise_arcsec.is_finite()) {
-        bail!(
-            "--noise-arcsec {}: must be zero or positive",
-            a.noise_arcsec
-        );
-    }
+    check::non_negative(a.noise_arcsec, "--noise-arcsec")?;
     let count = (360.0 / step).floor() as usize;
-    let test = positioning::PositioningTest {
+    Ok(positioning::PositioningTest {
         targets: (0..=count)
             .map(|i| (step * i as f64).to_radians())
             .collect(),
         runs: a.runs,
-        dwell: positive(a.dwell_s, "--dwell-s")?,
-        speed: positive(a.speed_deg_per_min, "--speed-deg-per-min")?.to_radians() / 60.0,
+        dwell: check::positive(a.dwell_s, "--dwell-s")?,
+        speed: check::positive(a.speed_deg_per_min, "--speed-deg-per-min")?.to_radians() / 60.0,
         noise: a.noise_arcsec / iso230::ARCSEC_PER_RAD,
         seed: a.seed,
         loop_mode: a.loop_mode,
         ..Default::default()
-    };
+    })
+}
+
+fn run_positioning(a: &Args, p: &Params, test: positioning::PositioningTest) -> anyhow::Result<()> {
     let bar = progress::bar(test.readings() as u64, "positioning", a.common.quiet);
     let readings = positioning::run(p, &test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();

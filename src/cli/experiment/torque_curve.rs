@@ -2,13 +2,11 @@
 
 use std::path::Path;
 
-use anyhow::bail;
-
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use rtid::experiments::torque_curve::TorqueReport;
 use rtid::report::torque_curve as figures;
 
-use super::Common;
+use super::{check, Common};
 use crate::cli::progress;
 use rtid::experiments::torque_curve::{self, TorqueTest};
 use rtid::io::experiment_file::Experiment;
@@ -65,39 +63,29 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
+    let test = test(&a)?;
     a.common.create_out()?;
-    run_torque_curve(&a, &p)
+    run_torque_curve(&a, &p, test)
 }
 
-/// The test the flags describe, or why they do not describe one.
+/// The test the flags describe, or why they do not describe one (checked before
+/// anything runs).
 fn test(a: &Args) -> anyhow::Result<TorqueTest> {
-    let positive = |v: f64, flag: &str| -> anyhow::Result<f64> {
-        if v > 0.0 && v.is_finite() {
-            Ok(v)
-        } else {
-            bail!("{flag} {v}: must be a positive number")
-        }
-    };
+    check::non_negative(a.noise_percent, "--noise-percent")?;
     Ok(TorqueTest {
-        amplitude: positive(a.amplitude_deg, "--amplitude-deg")?.to_radians(),
-        period: positive(a.period_s, "--period-s")?,
-        periods: positive(a.periods, "--periods")?,
+        amplitude: check::positive(a.amplitude_deg, "--amplitude-deg")?.to_radians(),
+        period: check::positive(a.period_s, "--period-s")?,
+        periods: check::positive(a.periods, "--periods")?,
         loop_mode: a.loop_mode,
         ..Default::default()
     })
 }
 
-fn run_torque_curve(a: &Args, p: &Params) -> anyhow::Result<()> {
-    let test = test(a)?;
+fn run_torque_curve(a: &Args, p: &Params, test: TorqueTest) -> anyhow::Result<()> {
     let total = (test.run_in_periods + test.periods).ceil() as u64;
     let bar = progress::bar(total, "torque curve", a.common.quiet);
     let mut curve = torque_curve::run(p, &test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
-    anyhow::ensure!(
-        a.noise_percent >= 0.0 && a.noise_percent.is_finite(),
-        "--noise-percent {}: must be zero or positive",
-        a.noise_percent
-    );
     rtid::experiments::measurement_noise::perturb_by_rms(
         &mut curve.motor_torque,
         a.noise_percent,

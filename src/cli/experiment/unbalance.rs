@@ -1,6 +1,7 @@
 //! `rtid experiment unbalance`.
 
-use super::fluctuation::{positive, run_test, RunArgs};
+use super::check::positive;
+use super::fluctuation::{run_test, RunArgs};
 use super::Common;
 use rtid::experiments::fluctuation::{FluctuationTest, DEFAULT_UNBALANCE};
 

@@ -1,108 +1,18 @@
-//! The frequency-response test as a virtual experiment (paper §4.1, MODEL.md §5.1).
-//!
-//! Open loop, motor torque `preload·Rg·Rw + A·sin(2πft)`, table brake `−preload`.
-//! Every frequency is an independent nonlinear time simulation. They run in
-//! [`LANES`]-wide batches advanced in lockstep ([`LaneSimulation`], vectorised), one
-//! batch per rayon worker; a lane whose frequency has settled is refilled at once
-//! with the next frequency of the shared queue, so lanes rarely idle. A lane
-//! computes bit for bit what a lone simulation of its frequency computes
-//! ([`simulate_point`] is the same code with one lane). Gain = 20·log10 of the
-//! steady amplitude of the table angle over that of the motor angle × Rg·Rw; its
-//! peaks are the resonances (the damped motor-held modes).
-//!
-//! **Start.** Each run starts from the steady state of the linearised model (exact
-//! complex response to the sine, plus the static twist of the preload with the
-//! flanks in contact), which removes most of the transient.
-//!
-//! **Steady state.** The run proceeds in windows of whole drive cycles (at least
-//! [`FrequencyTest::window_s`] long). In each window the table and motor angles,
-//! sampled ≥ 40 times a cycle, are fitted by least squares with an offset, a
-//! quadratic drift (an open-loop sine from rest makes the whole drive drift, and
-//! Coulomb friction makes that drift uneven) and sin/cos at the drive frequency. The
-//! point is settled when the gain changes by less than `tolerance_db` and each
-//! amplitude by less than 10× that in relative terms between two successive windows;
-//! after `max_duration_s` the last window is used and the point is marked unsettled.
-//!
-//! **Backlash.** Per frequency, the fraction of the last window's samples in which
-//! each mesh is out of contact (inside its gap) is reported. Where it is not zero the
-//! table rattles in the gap and the "gain" is not a property of the drive.
+//! The frequencies of the test, each an independent nonlinear simulation, run in
+//! lockstep lanes (module docs of the parent): the lane runner, its window sampler,
+//! and the initial state of each run.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use nalgebra::{Complex, DVector};
 use rayon::prelude::*;
 
-use crate::input::Sine;
+use super::sines::Sines;
+use super::{FrequencyTest, Point, LANES};
 use crate::model::drive::{idx::*, Drive, NSTATE};
-use crate::model::lanes::Lanes;
 use crate::model::modes::LinearModel;
 use crate::model::Params;
-use crate::peaks::Peak;
 use crate::sim::{default_step, LaneSimulation, SimError};
-
-/// Frequencies advanced together by one worker (two AVX2 registers per state).
-pub const LANES: usize = 4;
-
-/// Conditions of the test (defaults: MODEL.md §5.1).
-#[derive(Clone, Debug, PartialEq)]
-pub struct FrequencyTest {
-    /// Coarse grid, Hz (default 10, 20, …, 600).
-    pub frequencies_hz: Vec<f64>,
-    /// Sine amplitude of the motor torque, N·m (default 5).
-    pub amplitude_nm: f64,
-    /// Table brake torque balanced by a motor DC torque, N·m (default 0).
-    pub preload_nm: f64,
-    /// Refinement step around each coarse peak, Hz (default 1; 0: none).
-    pub refine_step_hz: f64,
-    /// Half-width of the refined band around each coarse peak, Hz (default 10).
-    pub refine_half_width_hz: f64,
-    /// Gain change between windows below which a point is settled, dB (0.01).
-    pub tolerance_db: f64,
-    /// Minimum window length, s (whole cycles; default 0.02).
-    pub window_s: f64,
-    /// Longest simulation per frequency, s (default 1).
-    pub max_duration_s: f64,
-    /// Integration step (default: the model's).
-    pub dt: Option<f64>,
-}
-
-impl Default for FrequencyTest {
-    fn default() -> Self {
-        FrequencyTest {
-            frequencies_hz: (1..=60).map(|i| 10.0 * i as f64).collect(),
-            amplitude_nm: 5.0,
-            preload_nm: 0.0,
-            refine_step_hz: 1.0,
-            refine_half_width_hz: 10.0,
-            tolerance_db: 0.01,
-            window_s: 0.02,
-            max_duration_s: 1.0,
-            dt: None,
-        }
-    }
-}
-
-/// The result at one frequency.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct Point {
-    pub frequency_hz: f64,
-    pub gain_db: f64,
-    /// Phase of the table relative to the motor angle, degrees.
-    pub phase_deg: f64,
-    /// Steady amplitudes, rad.
-    pub motor_amplitude_rad: f64,
-    pub table_amplitude_rad: f64,
-    /// Fraction of the last window out of contact: spur mesh, drive mesh.
-    pub contact_loss: [f64; 2],
-    /// Whether the amplitudes settled before `max_duration_s`.
-    pub settled: bool,
-    /// Whether the table amplitude was below the table encoder's resolution (the
-    /// table held inside the gap, say): the gain is then computed with that
-    /// resolution as the table amplitude, the floor a measurement would show.
-    pub below_resolution: bool,
-    /// Simulated time, s.
-    pub simulated_s: f64,
-}
 
 /// Samples of one window: time, motor angle, table angle, and contact counts.
 struct Window {
@@ -232,111 +142,6 @@ fn take(next: &AtomicUsize, n: usize, failed: Option<&AtomicBool>) -> Option<usi
     (i < n).then_some(i)
 }
 
-/// The motor torques `offset + amplitude·sin(ωt)` of `L` lanes, each exactly as
-/// [`Sine::step_torques`] computes them for its own clock `t` = steps·dt (the same
-/// rotations of (sin, cos) by half steps, the same resynchronisation every
-/// [`Sine::RESYNC`] steps or on a clock jump), but advanced lane-wise.
-struct Sines<const L: usize> {
-    dt: f64,
-    amplitude: [f64; L],
-    offset: [f64; L],
-    omega: [f64; L],
-    /// sin, cos of ω·t at the next step start, and of ω·dt/2.
-    sin: [f64; L],
-    cos: [f64; L],
-    half_sin: [f64; L],
-    half_cos: [f64; L],
-    /// Steps taken (the lane's clock is steps·dt), and steps left before the next
-    /// resynchronisation (0: now).
-    steps: [f64; L],
-    count: [u32; L],
-    next_t: [f64; L],
-}
-
-impl<const L: usize> Sines<L> {
-    /// Zero torque in every lane.
-    fn new(dt: f64) -> Self {
-        Sines {
-            dt,
-            amplitude: [0.0; L],
-            offset: [0.0; L],
-            omega: [0.0; L],
-            sin: [0.0; L],
-            cos: [1.0; L],
-            half_sin: [0.0; L],
-            half_cos: [1.0; L],
-            steps: [0.0; L],
-            count: [u32::MAX; L],
-            next_t: [0.0; L],
-        }
-    }
-
-    /// Lane `l` starts `input`'s sine at t = 0 (a fresh [`Sine`]).
-    fn start(&mut self, l: usize, frequency_hz: f64, amplitude_nm: f64, offset_nm: f64) {
-        self.amplitude[l] = amplitude_nm;
-        self.offset[l] = offset_nm;
-        self.omega[l] = std::f64::consts::TAU * frequency_hz;
-        (self.half_sin[l], self.half_cos[l]) = (0.5 * self.omega[l] * self.dt).sin_cos();
-        self.steps[l] = 0.0;
-        self.count[l] = 0;
-        self.next_t[l] = f64::NAN;
-    }
-
-    /// Lane `l` applies no torque.
-    fn stop(&mut self, l: usize) {
-        (self.amplitude[l], self.offset[l]) = (0.0, 0.0);
-        self.count[l] = u32::MAX;
-    }
-
-    /// The torques of every lane at the start, middle and end of the next step.
-    #[inline]
-    fn step_torques(&mut self) -> [[f64; L]; 3] {
-        let h = self.dt;
-        let t = Lanes(self.steps) * h;
-        let jump = t.zip(Lanes(self.next_t), |t, n| {
-            if (t - n).abs() > 1e-6 * h {
-                1.0
-            } else {
-                0.0
-            }
-        });
-        let mut resync = jump.any(|j| j != 0.0);
-        for c in &mut self.count {
-            resync |= *c == 0;
-        }
-        if resync {
-            self.resync(t, jump);
-        }
-        for c in &mut self.count {
-            *c = c.wrapping_sub(1);
-        }
-        let rotate = |s: Lanes<L>, c: Lanes<L>| {
-            let (sh, ch) = (Lanes(self.half_sin), Lanes(self.half_cos));
-            (s * ch + c * sh, c * ch - s * sh)
-        };
-        let (s0, c0) = (Lanes(self.sin), Lanes(self.cos));
-        let (s1, c1) = rotate(s0, c0);
-        let (s2, c2) = rotate(s1, c1);
-        let (a, o) = (Lanes(self.amplitude), Lanes(self.offset));
-        self.sin = s2.0;
-        self.cos = c2.0;
-        self.next_t = (t + h).0;
-        self.steps = (Lanes(self.steps) + 1.0).0;
-        [s0, s1, s2].map(|s| (o + a * s).0)
-    }
-
-    #[cold]
-    #[inline(never)]
-    fn resync(&mut self, t: Lanes<L>, jump: Lanes<L>) {
-        for l in 0..L {
-            if self.count[l] == 0 || jump.0[l] != 0.0 {
-                (self.sin[l], self.cos[l]) = (self.omega[l] * t.0[l]).sin_cos();
-                self.count[l] = Sine::RESYNC;
-            }
-        }
-    }
-}
-
 /// One frequency in progress in a lane: its input, its current window and the
 /// amplitudes of the previous one.
 struct Run {
@@ -441,8 +246,11 @@ impl Run {
         // The smallest table amplitude a measurement resolves (0.0001° encoder), and a
         // floor for the ideal-encoder case, so that a table at rest gives a finite gain.
         let floor = p.controller.table_encoder_resolution.max(1e-12);
-        let [(am, pm), (at, pt)] =
-            super::stepped_sine::components(&rec.t, [&rec.motor, &rec.table], self.omega);
+        let [(am, pm), (at, pt)] = crate::experiments::stepped_sine::components(
+            &rec.t,
+            [&rec.motor, &rec.table],
+            self.omega,
+        );
         let below_resolution = at < floor;
         let gain = 20.0 * (at.max(floor) / (am.max(f64::MIN_POSITIVE) * ratio)).log10();
         let settled = self.previous.is_some_and(|(g, a, b)| {
@@ -529,7 +337,7 @@ fn run_lanes<const L: usize>(
 
 /// Every frequency of `freqs`, in [`LANES`]-wide batches on the rayon workers;
 /// points in the order of `freqs`.
-fn simulate_all(
+pub(super) fn simulate_all(
     p: &Params,
     freqs: &[f64],
     test: &FrequencyTest,
@@ -562,78 +370,6 @@ fn simulate_all(
     Ok(points.into_iter().flatten().collect())
 }
 
-/// The whole test: the coarse grid, then `refine_step_hz` steps around each local
-/// maximum, all in parallel; `progress()` is called after every point. Points come
-/// back sorted by frequency.
-pub fn sweep(
-    p: &Params,
-    test: &FrequencyTest,
-    progress: &(dyn Fn() + Sync),
-) -> Result<Vec<Point>, SimError> {
-    let mut points = simulate_all(p, &test.frequencies_hz, test, progress)?;
-    points.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-    if test.refine_step_hz > 0.0 {
-        let extra = refinement(&points, test);
-        points.extend(simulate_all(p, &extra, test, progress)?);
-        points.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-    }
-    Ok(points)
-}
-
-/// The frequencies to add around each local maximum of the coarse gain.
-pub fn refinement(points: &[Point], test: &FrequencyTest) -> Vec<f64> {
-    let gains: Vec<(f64, f64)> = points.iter().map(|p| (p.frequency_hz, p.gain_db)).collect();
-    let mut extra: Vec<f64> = Vec::new();
-    for i in crate::peaks::local_maxima(&gains) {
-        let centre = gains[i].0;
-        let n = (test.refine_half_width_hz / test.refine_step_hz).floor() as i64;
-        for k in -n..=n {
-            let f = centre + k as f64 * test.refine_step_hz;
-            let known = |g: f64| (g - f).abs() < 1e-9;
-            if f > 0.0
-                && !points.iter().any(|p| known(p.frequency_hz))
-                && !extra.iter().any(|&g| known(g))
-            {
-                extra.push(f);
-            }
-        }
-    }
-    extra
-}
-
-/// Resonances reported by the evaluation of a gain curve (the highest local maxima).
-pub const RESONANCES: usize = 4;
-
-/// What the evaluation of a frequency-response file finds: its resonances.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct Evaluation {
-    /// The highest [`RESONANCES`] local maxima of the gain, each located by the
-    /// parabola through it and its neighbours, ascending in frequency.
-    pub peaks: Vec<Peak>,
-    /// Points of the curve.
-    pub points: usize,
-}
-
-/// Evaluates a gain curve (frequencies ascending).
-pub fn evaluate(frequency_hz: &[f64], gain_db: &[f64]) -> Evaluation {
-    let curve: Vec<(f64, f64)> = frequency_hz
-        .iter()
-        .copied()
-        .zip(gain_db.iter().copied())
-        .collect();
-    Evaluation {
-        peaks: crate::peaks::maxima(&curve, RESONANCES),
-        points: curve.len(),
-    }
-}
-
-/// The gain (dB) and phase (deg) of the linearised model at `freqs_hz`, solved in the
-/// frequency domain (no backlash, no friction).
-pub fn linear(p: &Params, freqs_hz: &[f64]) -> Result<Vec<(f64, f64)>, crate::model::ParamError> {
-    use crate::model::linear_response::{Channel, LinearResponse};
-    Ok(LinearResponse::new(p, Channel::TableOverMotor)?.gain_phase(freqs_hz))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -646,35 +382,10 @@ mod tests {
             .iter()
             .map(|&t| 3.0 + 20.0 * t - 5.0 * t * t + 0.7 * (omega * t + 0.4).sin())
             .collect();
-        let [(a, phi)] = super::super::stepped_sine::components(&t, [&x], omega);
+        let [(a, phi)] = super::crate::experiments::stepped_sine::components(&t, [&x], omega);
         assert!(
             (a - 0.7).abs() < 1e-9 && (phi - 0.4).abs() < 1e-9,
             "{a} {phi}"
         );
-    }
-
-    #[test]
-    fn lanes_of_sines_equal_lone_sines() {
-        use crate::input::TorqueInput;
-        let dt = 1e-5;
-        let mut lanes = Sines::<4>::new(dt);
-        let mut lone: Vec<(Sine, u64)> = Vec::new();
-        for (l, f) in [10.0, 230.0, 599.0, 47.5].into_iter().enumerate() {
-            lanes.start(l, f, 5.0, 0.1 * l as f64);
-            lone.push((Sine::new(f, 5.0, 0.1 * l as f64), 0));
-        }
-        for k in 0..20_000 {
-            if k == 7_000 {
-                // Lane 2 restarts with another frequency, out of step with the rest.
-                lanes.start(2, 321.0, 3.0, -1.0);
-                lone[2] = (Sine::new(321.0, 3.0, -1.0), 0);
-            }
-            let m = lanes.step_torques();
-            for (l, (sine, steps)) in lone.iter_mut().enumerate() {
-                let expected = sine.step_torques(*steps as f64 * dt, dt);
-                *steps += 1;
-                assert_eq!([m[0][l], m[1][l], m[2][l]], expected, "lane {l}, step {k}");
-            }
-        }
     }
 }

@@ -1,0 +1,85 @@
+//! The frequency-response test as experiment-file data: the points as a gain curve
+//! with their diagnostics (contact loss per mesh, settled, below resolution) and the
+//! exact linear gain beside them, the manifest, and the test solved on the linear
+//! model alone (`--linear`).
+
+use super::{linear, refinement, FrequencyTest, Point};
+use crate::io::experiment_file::{Columns, Data, Kind, Manifest};
+use crate::model::{ParamError, Params};
+
+/// The test on the linear model, solved in the frequency domain: the coarse grid,
+/// then the refinement around each peak, sorted by frequency.
+pub fn linear_points(p: &Params, test: &FrequencyTest) -> Result<Vec<Point>, ParamError> {
+    let solve = |freqs: &[f64]| -> Result<Vec<Point>, ParamError> {
+        Ok(linear(p, freqs)?
+            .into_iter()
+            .zip(freqs)
+            .map(|((gain_db, phase_deg), &frequency_hz)| Point {
+                frequency_hz,
+                gain_db,
+                phase_deg,
+                motor_amplitude_rad: f64::NAN,
+                table_amplitude_rad: f64::NAN,
+                contact_loss: [0.0, 0.0],
+                settled: true,
+                below_resolution: false,
+                simulated_s: 0.0,
+            })
+            .collect())
+    };
+    let mut points = solve(&test.frequencies_hz)?;
+    if test.refine_step_hz > 0.0 {
+        let extra = refinement(&points, test);
+        points.extend(solve(&extra)?);
+        points.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    }
+    Ok(points)
+}
+
+/// The experiment-file form of the points of `p`'s test: gain and phase, the
+/// diagnostics as extra columns, and `linear_gain_db`, the exact linear response.
+pub fn to_data(p: &Params, points: &[Point]) -> Result<Data, ParamError> {
+    let frequency_hz: Vec<f64> = points.iter().map(|q| q.frequency_hz).collect();
+    let flag = |f: fn(&Point) -> bool| -> Vec<f64> {
+        points.iter().map(|q| f64::from(u8::from(f(q)))).collect()
+    };
+    let mut extra = Columns::new();
+    extra.insert(
+        "contact_loss_spur".into(),
+        points.iter().map(|q| q.contact_loss[0]).collect(),
+    );
+    extra.insert(
+        "contact_loss_drive".into(),
+        points.iter().map(|q| q.contact_loss[1]).collect(),
+    );
+    extra.insert("settled".into(), flag(|q| q.settled));
+    extra.insert("below_resolution".into(), flag(|q| q.below_resolution));
+    extra.insert(
+        "linear_gain_db".into(),
+        linear(p, &frequency_hz)?.into_iter().map(|g| g.0).collect(),
+    );
+    Ok(Data::FrequencyResponse {
+        gain_db: points.iter().map(|q| q.gain_db).collect(),
+        phase_rad: Some(points.iter().map(|q| q.phase_deg.to_radians()).collect()),
+        frequency_hz,
+        extra,
+    })
+}
+
+/// The manifest of a virtual frequency-response test (`linear`: solved on the
+/// linear model).
+pub fn manifest(p: &Params, test: &FrequencyTest, linear: bool) -> Manifest {
+    let mut m = Manifest::new(Kind::FrequencyResponse);
+    m.mechanism = Some(p.name.clone());
+    m.conditions.torque_amplitude_nm = Some(test.amplitude_nm);
+    m.conditions.preload_nm = Some(test.preload_nm);
+    m.notes = Some(
+        if linear {
+            "virtual test by rtid: linear response solved in the frequency domain"
+        } else {
+            "virtual test by rtid: nonlinear time simulation per frequency"
+        }
+        .into(),
+    );
+    m
+}
