@@ -1,0 +1,1 @@
+//! Linear units, current-driven records and servo traces.
