@@ -835,8 +835,9 @@ fn code_blocks(text: &str) -> Vec<(&str, String)> {
     blocks
 }
 
-/// docs/experiment-files.md shows one manifest and CSV head per kind: they must load,
-/// and the positioning example's two forms (deviation, measured) must agree.
+/// docs/experiment-files.md shows a manifest and CSV head per kind (and more for some
+/// kinds: each CSV goes with the manifest above it): they must load, and the
+/// positioning example's first two forms (deviation, measured) must agree.
 #[test]
 fn the_documented_examples_load() {
     let doc = include_str!("../../../docs/experiment-files.md");
@@ -845,24 +846,33 @@ fn the_documented_examples_load() {
     let mut kinds = Vec::new();
     for section in examples.split("\n### ").skip(1) {
         let title = section.lines().next().unwrap().trim();
-        let blocks = code_blocks(section);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("example.json");
-        std::fs::write(&path, &blocks.iter().find(|(l, _)| *l == "json").unwrap().1).unwrap();
-        let manifest = read_manifest(&path).unwrap();
-        assert_eq!(manifest.kind.name(), title);
-        kinds.push(manifest.kind);
+        let mut manifest: Option<Manifest> = None;
         let mut read_back = Vec::new();
-        for (_, csv) in blocks.iter().filter(|(l, _)| *l == "csv") {
-            std::fs::write(data_path(&path, &manifest), csv).unwrap();
-            let e = read(&path).unwrap_or_else(|e| panic!("{title}: {e}"));
-            assert_eq!(e.data.len(), 4, "{title}");
-            read_back.push(e.data);
+        for (language, body) in code_blocks(section) {
+            if language == "json" {
+                std::fs::write(&path, &body).unwrap();
+                let m = read_manifest(&path).unwrap_or_else(|e| panic!("{title}: {e}"));
+                assert_eq!(m.kind.name(), title);
+                if manifest.is_none() {
+                    kinds.push(m.kind);
+                }
+                if !m.kind.has_data_file() {
+                    assert_eq!(read(&path).unwrap().data.len(), 2);
+                }
+                manifest = Some(m);
+            } else if language == "csv" {
+                let m = manifest.as_ref().expect("a CSV example after its manifest");
+                std::fs::write(data_path(&path, m), &body).unwrap();
+                let e = read(&path).unwrap_or_else(|e| panic!("{title}: {e}"));
+                assert_eq!(e.data.len(), 4, "{title}");
+                read_back.push(e.data);
+            }
         }
+        let manifest = manifest.unwrap_or_else(|| panic!("{title} has no manifest"));
         if manifest.kind.has_data_file() {
             assert!(!read_back.is_empty(), "{title} has no CSV example");
-        } else {
-            assert_eq!(read(&path).unwrap().data.len(), 2);
         }
         if let [Data::Positioning {
             direction: d1,
@@ -872,12 +882,16 @@ fn the_documented_examples_load() {
             direction: d2,
             deviation_rad: x2,
             ..
-        }] = read_back.as_slice()
+        }, ..] = read_back.as_slice()
         {
             assert_eq!(d1, d2);
             for (a, b) in x1.iter().zip(x2) {
                 assert!((a - b).abs() < 0.01 * ARCSEC, "{a} vs {b}");
             }
+        }
+        let axes: Vec<Option<Axis>> = read_back.iter().map(Data::axis).collect();
+        if title == "torque_curve" || title == "positioning" {
+            assert_eq!(axes.last(), Some(&Some(Axis::Linear)), "{title}");
         }
     }
     assert_eq!(kinds, Kind::ALL);
