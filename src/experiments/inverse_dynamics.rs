@@ -1,6 +1,8 @@
 //! Inverse-dynamic identification by least squares (IDIM-LS) of a rigid axis:
 //!
-//!     F = M·q'' + Fv·q' + Fc·sign(q') + OF
+//! ```text
+//! F = M·q'' + Fv·q' + Fc·sign(q') + OF
+//! ```
 //!
 //! i.e. MODEL.md §1.1's direct drive M·q'' = F − Fv·q' − Fc·sign(q') − OF with the
 //! drive's effort F (N or N·m) on the left: M the mass or inertia (kg or kg·m²), Fv the

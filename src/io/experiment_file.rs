@@ -275,7 +275,7 @@ pub enum ExperimentFileError {
         line: u64,
         message: String,
     },
-    /// [`write`] was given data that would not read back.
+    /// [`write()`] was given data that would not read back.
     #[error("cannot write experiment {path}: {message}")]
     Invalid { path: PathBuf, message: String },
     /// A file cannot be written.

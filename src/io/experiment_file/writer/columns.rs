@@ -41,124 +41,70 @@ fn scaled<'a>(name: impl Into<Cow<'a, str>>, v: &[f64], per_unit: f64) -> Column
 
 /// The columns to write for `data`, extra columns last (none for resonance).
 pub(super) fn out_columns(data: &Data) -> Vec<Column<'_>> {
-    let (mut columns, extra) = match data {
-        Data::Resonance { .. } => return Vec::new(),
+    let Some(extra) = data.extra() else {
+        return Vec::new();
+    };
+    let mut columns = match data {
+        Data::Resonance { .. } => Vec::new(),
         Data::FrequencyResponse {
             frequency_hz,
             gain_db,
             phase_rad,
-            extra,
+            ..
         } => {
             let mut c = vec![
                 plain("frequency_hz", frequency_hz),
                 plain("gain_db", gain_db),
             ];
             c.extend(phase_rad.as_deref().map(|p| scaled("phase_deg", p, DEG)));
-            (c, extra)
+            c
         }
         Data::TorqueCurve {
             time_s,
             motor_torque_nm,
             table_angle_rad,
-            extra,
+            ..
         } => {
+            let table = table_angle_rad.as_deref();
             let mut c = vec![
                 plain("time_s", time_s),
                 plain("motor_torque_nm", motor_torque_nm),
             ];
-            let table = table_angle_rad.as_deref();
             c.extend(table.map(|a| scaled("table_angle_deg", a, DEG)));
-            (c, extra)
+            c
         }
         Data::ForceCurve {
             time_s,
             force_n,
             table_position_m,
-            extra,
+            ..
         } => {
-            let mut c = vec![plain("time_s", time_s), plain("force_n", force_n)];
             let table = table_position_m.as_deref();
+            let mut c = vec![plain("time_s", time_s), plain("force_n", force_n)];
             c.extend(table.map(|x| plain("table_position_m", x)));
-            (c, extra)
+            c
         }
-        Data::Positioning {
-            target_rad,
-            direction,
-            run,
-            deviation_rad,
-            extra,
-        } => (
-            runs(
-                scaled("target_deg", target_rad, DEG),
-                direction,
-                run,
-                scaled("deviation_arcsec", deviation_rad, ARCSEC),
-            ),
-            extra,
-        ),
-        Data::LinearPositioning {
-            target_m,
-            direction,
-            run,
-            deviation_m,
-            extra,
-        } => (
-            runs(
-                scaled("target_mm", target_m, MM),
-                direction,
-                run,
-                scaled("deviation_um", deviation_m, UM),
-            ),
-            extra,
-        ),
+        Data::Positioning { .. } | Data::LinearPositioning { .. } => positioning(data),
         Data::Fluctuation {
             time_s,
             motor_angle_rad,
             table_angle_rad,
-            extra,
+            ..
         }
         | Data::Unbalance {
             time_s,
             motor_angle_rad,
             table_angle_rad,
-            extra,
-        } => (
-            vec![
-                plain("time_s", time_s),
-                scaled("motor_angle_deg", motor_angle_rad, DEG),
-                scaled("table_angle_deg", table_angle_rad, DEG),
-            ],
-            extra,
-        ),
-        Data::FrequencyResponseTime {
-            time_s,
-            motor_torque_nm: input,
-            motor_angle_rad,
-            table_angle_rad,
-            extra,
+            ..
+        } => vec![
+            plain("time_s", time_s),
+            scaled("motor_angle_deg", motor_angle_rad, DEG),
+            scaled("table_angle_deg", table_angle_rad, DEG),
+        ],
+        Data::FrequencyResponseTime { .. } | Data::FrequencyResponseTimeCurrent { .. } => {
+            record(data)
         }
-        | Data::FrequencyResponseTimeCurrent {
-            time_s,
-            motor_current_a: input,
-            motor_angle_rad,
-            table_angle_rad,
-            extra,
-        } => {
-            let input_name = match data {
-                Data::FrequencyResponseTime { .. } => "motor_torque_nm",
-                _ => "motor_current_a",
-            };
-            (
-                vec![
-                    plain("time_s", time_s),
-                    plain(input_name, input),
-                    scaled("motor_angle_deg", motor_angle_rad, DEG),
-                    scaled("table_angle_deg", table_angle_rad, DEG),
-                ],
-                extra,
-            )
-        }
-        Data::ServoTrace(trace) => (servo_trace(trace), &trace.extra),
+        Data::ServoTrace(trace) => servo_trace(trace),
     };
     for (name, v) in extra {
         columns.push(plain(name.as_str(), v));
@@ -166,24 +112,85 @@ pub(super) fn out_columns(data: &Data) -> Vec<Column<'_>> {
     columns
 }
 
-/// A command signal's column, named after its unit.
-fn signal<'a>(base: &str, s: &'a Signal) -> Column<'a> {
-    plain(format!("{base}_{}", s.unit.suffix()), &s.values)
-}
-
-/// The four columns of a positioning file.
-fn runs<'a>(
-    target: Column<'a>,
-    direction: &'a [Direction],
-    run: &'a [u32],
-    deviation: Column<'a>,
-) -> Vec<Column<'a>> {
+/// The four columns of a positioning file: targets in degrees and deviations in
+/// arc-seconds, or targets in mm and deviations in µm.
+fn positioning(data: &Data) -> Vec<Column<'_>> {
+    let (target, direction, run, deviation) = match data {
+        Data::Positioning {
+            target_rad,
+            direction,
+            run,
+            deviation_rad,
+            ..
+        } => (
+            scaled("target_deg", target_rad, DEG),
+            direction,
+            run,
+            scaled("deviation_arcsec", deviation_rad, ARCSEC),
+        ),
+        Data::LinearPositioning {
+            target_m,
+            direction,
+            run,
+            deviation_m,
+            ..
+        } => (
+            scaled("target_mm", target_m, MM),
+            direction,
+            run,
+            scaled("deviation_um", deviation_m, UM),
+        ),
+        _ => return Vec::new(),
+    };
     vec![
         target,
         ("direction".into(), Cells::Directions(direction)),
         ("run".into(), Cells::Runs(run)),
         deviation,
     ]
+}
+
+/// A frequency-response record's columns, its input as `motor_torque_nm` or
+/// `motor_current_a`.
+fn record(data: &Data) -> Vec<Column<'_>> {
+    let (time_s, input, motor_angle_rad, table_angle_rad) = match data {
+        Data::FrequencyResponseTime {
+            time_s,
+            motor_torque_nm,
+            motor_angle_rad,
+            table_angle_rad,
+            ..
+        } => (
+            time_s,
+            plain("motor_torque_nm", motor_torque_nm),
+            motor_angle_rad,
+            table_angle_rad,
+        ),
+        Data::FrequencyResponseTimeCurrent {
+            time_s,
+            motor_current_a,
+            motor_angle_rad,
+            table_angle_rad,
+            ..
+        } => (
+            time_s,
+            plain("motor_current_a", motor_current_a),
+            motor_angle_rad,
+            table_angle_rad,
+        ),
+        _ => return Vec::new(),
+    };
+    vec![
+        plain("time_s", time_s),
+        input,
+        scaled("motor_angle_deg", motor_angle_rad, DEG),
+        scaled("table_angle_deg", table_angle_rad, DEG),
+    ]
+}
+
+/// A command signal's column, named after its unit.
+fn signal<'a>(base: &str, s: &'a Signal) -> Column<'a> {
+    plain(format!("{base}_{}", s.unit.suffix()), &s.values)
 }
 
 /// A servo trace's columns: positions in degrees or metres, the effort as `torque_nm`
