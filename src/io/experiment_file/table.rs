@@ -222,6 +222,7 @@ impl Table {
         }
     }
 
+    /// An error about the header row.
     fn header_error(&self, message: String) -> Error {
         Error::Csv {
             path: self.path.clone(),
@@ -342,7 +343,7 @@ fn run(text: &str) -> Result<u32, String> {
     }
 }
 
-/// "an angle" or "a length", for an error message.
+/// What a column of `axis` holds, for an error message.
 fn unit_kind(axis: Axis) -> &'static str {
     match axis {
         Axis::Rotary => "an angle or a torque (rotary)",
