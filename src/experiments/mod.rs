@@ -5,6 +5,7 @@ pub mod fluctuation;
 pub mod frequency_response;
 pub mod frequency_response_estimate;
 pub mod frequency_response_record;
+pub mod inverse_dynamics;
 pub mod iso230;
 pub mod measurement_noise;
 pub mod positioning;

@@ -1,17 +1,28 @@
 //! Experiment files (MODEL.md §7): a JSON manifest plus, for every kind but `resonance`,
-//! one CSV file beside it, read into typed data in SI units (angles in rad, time in s,
-//! torque in N·m, frequency in Hz, gain in dB) and written back atomically.
+//! one CSV file beside it, read into typed data in SI units (angles in rad, lengths in
+//! m, time in s, torque in N·m, force in N, frequency in Hz, gain in dB) and written
+//! back atomically.
 //!
 //! The contract is "extend, never break": unknown manifest keys, unknown condition keys
 //! and extra CSV columns are kept, not rejected. Every malformed input is one
 //! [`ExperimentFileError`] naming the file and, where they apply, the line and the
 //! column. The format, with an example per kind, is in `docs/experiment-files.md`.
 
+mod conditions;
+mod data;
+mod sampling;
 mod table;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_units;
+mod units;
 mod writer;
 
+pub use conditions::{Conditions, Excitation};
+pub use data::{Data, ServoTrace, Signal};
+pub use sampling::{check_uniform, sample_period, NonUniform, SAMPLING_TOLERANCE};
+pub use units::{Axis, CommandUnit};
 pub use writer::write;
 
 use std::collections::BTreeMap;
@@ -20,15 +31,6 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
-
-use crate::model::params::LoopMode;
-
-/// Radians per degree.
-const DEG: f64 = std::f64::consts::PI / 180.0;
-/// Radians per arc-second.
-const ARCSEC: f64 = std::f64::consts::PI / 648_000.0;
-/// The angle suffixes the reader accepts, with radians per unit.
-const ANGLE_UNITS: [(&str, f64); 3] = [("deg", DEG), ("rad", 1.0), ("arcsec", ARCSEC)];
 
 /// Extra numeric columns, by their name in the file, values as written (no unit
 /// conversion): columns a reader does not use but keeps, such as a virtual
@@ -51,14 +53,17 @@ pub enum Kind {
     Fluctuation,
     /// As [`Kind::Fluctuation`], with an offset mass on a vertical table.
     Unbalance,
-    /// Raw time series of a frequency-response test (motor torque, motor and table
-    /// angle, uniformly sampled), from which the gain curve is estimated.
+    /// Raw time series of a frequency-response test (motor torque or current, motor and
+    /// table angle, uniformly sampled), from which the gain curve is estimated.
     FrequencyResponseTime,
+    /// A recorded closed-loop run: position command, the loop's encoder, the drive's
+    /// effort and the controller output over uniformly sampled time.
+    ServoTrace,
 }
 
 impl Kind {
-    /// Every kind, in the order of MODEL.md §7.
-    pub const ALL: [Kind; 7] = [
+    /// Every kind, in the order of MODEL.md §7, then the kinds added since.
+    pub const ALL: [Kind; 8] = [
         Kind::FrequencyResponse,
         Kind::Resonance,
         Kind::TorqueCurve,
@@ -66,6 +71,7 @@ impl Kind {
         Kind::Fluctuation,
         Kind::Unbalance,
         Kind::FrequencyResponseTime,
+        Kind::ServoTrace,
     ];
 
     /// The name used in manifests (`frequency_response`, …).
@@ -78,6 +84,7 @@ impl Kind {
             Kind::Fluctuation => "fluctuation",
             Kind::Unbalance => "unbalance",
             Kind::FrequencyResponseTime => "frequency_response_time",
+            Kind::ServoTrace => "servo_trace",
         }
     }
 
@@ -93,7 +100,8 @@ impl fmt::Display for Kind {
     }
 }
 
-/// The sense in which a positioning target was approached.
+/// The sense in which a positioning target was approached (on a linear axis: the
+/// positive or negative direction of the axis).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Direction {
@@ -138,156 +146,6 @@ impl std::str::FromStr for Direction {
                 "`{s}` is not a direction (expected up, down, ccw or cw)"
             )),
         }
-    }
-}
-
-/// How a frequency-response record was excited.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Excitation {
-    /// A sine held for `dwell_s` at each of `frequencies_hz` in turn.
-    SteppedSine,
-    /// Random noise, a chirp or a multisine: every frequency at once.
-    Broadband,
-}
-
-impl Excitation {
-    /// The name written to manifests.
-    pub fn name(self) -> &'static str {
-        match self {
-            Excitation::SteppedSine => "stepped_sine",
-            Excitation::Broadband => "broadband",
-        }
-    }
-}
-
-/// The `conditions` of a manifest: how the experiment was run. Every field is optional,
-/// in the unit its name carries; [`Conditions::with_defaults`] fills in MODEL.md §7's
-/// defaults. Unknown keys are kept in `extra`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Conditions {
-    /// Frequency response: amplitude of the sinusoidal motor torque, N·m (default 5).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub torque_amplitude_nm: Option<f64>,
-    /// Frequency response: brake torque on the table, balanced by a motor DC torque, that
-    /// keeps the flanks loaded (MODEL.md §5.1), N·m (default 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub preload_nm: Option<f64>,
-    /// Torque curve: amplitude of the commanded table motion, deg (default 30).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub amplitude_deg: Option<f64>,
-    /// Torque curve: period of the commanded table motion, s (default 3).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub period_s: Option<f64>,
-    /// Feedback arrangement: `semi_closed` or `full_closed` (default `full_closed` for the
-    /// torque curve, `semi_closed` for positioning, fluctuation and unbalance).
-    #[serde(rename = "loop", default, skip_serializing_if = "Option::is_none")]
-    pub loop_mode: Option<LoopMode>,
-    /// Positioning: dwell at each target, s (default 1). Stepped-sine frequency
-    /// response record: time spent at each frequency, s.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub dwell_s: Option<f64>,
-    /// Fluctuation and unbalance: table speed, deg/min (default 180 and 360).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub speed_deg_per_min: Option<f64>,
-    /// Fluctuation, unbalance and frequency-response records: table turns per motor
-    /// turn, Rg·Rw (no default here: it comes from the mechanism).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub ratio: Option<f64>,
-    /// Unbalance: the offset mass, kg.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub mass_kg: Option<f64>,
-    /// Unbalance: the mass's distance from the table axis, m.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub radius_m: Option<f64>,
-    /// Frequency-response record: `stepped_sine` or `broadband` (default: stepped_sine
-    /// when `frequencies_hz` is given, else broadband).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub excitation: Option<Excitation>,
-    /// Stepped-sine frequency-response record: the drive frequencies in the order
-    /// played, Hz, each held for `dwell_s` from the first sample on.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub frequencies_hz: Option<Vec<f64>>,
-    /// Condition keys this version does not know, kept as written.
-    #[serde(flatten)]
-    pub extra: Map<String, Value>,
-}
-
-impl Conditions {
-    /// The JSON keys of the typed fields.
-    const KEYS: [&'static str; 12] = [
-        "torque_amplitude_nm",
-        "preload_nm",
-        "amplitude_deg",
-        "period_s",
-        "loop",
-        "dwell_s",
-        "speed_deg_per_min",
-        "ratio",
-        "mass_kg",
-        "radius_m",
-        "excitation",
-        "frequencies_hz",
-    ];
-
-    /// True when no condition is given.
-    pub fn is_empty(&self) -> bool {
-        *self == Conditions::default()
-    }
-
-    /// A copy with MODEL.md §7's defaults for `kind` filled in where a value is absent
-    /// (the ratio excepted: it depends on the mechanism).
-    pub fn with_defaults(&self, kind: Kind) -> Conditions {
-        let mut c = self.clone();
-        match kind {
-            Kind::FrequencyResponse => {
-                c.torque_amplitude_nm.get_or_insert(5.0);
-                c.preload_nm.get_or_insert(0.0);
-            }
-            Kind::Resonance => {}
-            Kind::TorqueCurve => {
-                c.amplitude_deg.get_or_insert(30.0);
-                c.period_s.get_or_insert(3.0);
-                c.loop_mode.get_or_insert(LoopMode::FullClosed);
-            }
-            Kind::Positioning => {
-                c.loop_mode.get_or_insert(LoopMode::SemiClosed);
-                c.dwell_s.get_or_insert(1.0);
-            }
-            Kind::Fluctuation | Kind::Unbalance => {
-                let speed = if kind == Kind::Fluctuation {
-                    180.0
-                } else {
-                    360.0
-                };
-                c.speed_deg_per_min.get_or_insert(speed);
-                c.loop_mode.get_or_insert(LoopMode::SemiClosed);
-            }
-            Kind::FrequencyResponseTime => {
-                let stepped = c.frequencies_hz.is_some();
-                c.excitation.get_or_insert(if stepped {
-                    Excitation::SteppedSine
-                } else {
-                    Excitation::Broadband
-                });
-            }
-        }
-        c
-    }
-
-    /// The numeric fields with their keys.
-    fn numbers(&self) -> [(&'static str, Option<f64>); 9] {
-        [
-            ("torque_amplitude_nm", self.torque_amplitude_nm),
-            ("preload_nm", self.preload_nm),
-            ("amplitude_deg", self.amplitude_deg),
-            ("period_s", self.period_s),
-            ("dwell_s", self.dwell_s),
-            ("speed_deg_per_min", self.speed_deg_per_min),
-            ("ratio", self.ratio),
-            ("mass_kg", self.mass_kg),
-            ("radius_m", self.radius_m),
-        ]
     }
 }
 
@@ -344,112 +202,6 @@ impl Manifest {
             peaks_hz: None,
             peak_gain_db: None,
             extra: Map::new(),
-        }
-    }
-}
-
-/// The measured data of an experiment, in SI units (angles in rad). All series of one
-/// variant have the same length; `extra` columns too.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Data {
-    /// Gain of table over motor angle (× Rg·Rw) per drive frequency; frequencies increase
-    /// strictly.
-    FrequencyResponse {
-        frequency_hz: Vec<f64>,
-        gain_db: Vec<f64>,
-        phase_rad: Option<Vec<f64>>,
-        extra: Columns,
-    },
-    /// Resonance peaks, from the manifest.
-    Resonance {
-        peaks_hz: Vec<f64>,
-        peak_gain_db: Option<Vec<f64>>,
-    },
-    /// Motor torque over time (times increase strictly).
-    TorqueCurve {
-        time_s: Vec<f64>,
-        motor_torque_nm: Vec<f64>,
-        table_angle_rad: Option<Vec<f64>>,
-        extra: Columns,
-    },
-    /// One row per approach: target, direction, run number (≥ 1) and deviation
-    /// (measured − target).
-    Positioning {
-        target_rad: Vec<f64>,
-        direction: Vec<Direction>,
-        run: Vec<u32>,
-        deviation_rad: Vec<f64>,
-        extra: Columns,
-    },
-    /// Motor-shaft and table angle over time (times increase strictly).
-    Fluctuation {
-        time_s: Vec<f64>,
-        motor_angle_rad: Vec<f64>,
-        table_angle_rad: Vec<f64>,
-        extra: Columns,
-    },
-    /// As [`Data::Fluctuation`], with the unbalance mass mounted.
-    Unbalance {
-        time_s: Vec<f64>,
-        motor_angle_rad: Vec<f64>,
-        table_angle_rad: Vec<f64>,
-        extra: Columns,
-    },
-    /// Motor torque, motor-shaft angle and table angle over uniformly sampled time
-    /// (see [`uniform_step`]).
-    FrequencyResponseTime {
-        time_s: Vec<f64>,
-        motor_torque_nm: Vec<f64>,
-        motor_angle_rad: Vec<f64>,
-        table_angle_rad: Vec<f64>,
-        extra: Columns,
-    },
-}
-
-impl Data {
-    /// The kind of experiment this data belongs to.
-    pub fn kind(&self) -> Kind {
-        match self {
-            Data::FrequencyResponse { .. } => Kind::FrequencyResponse,
-            Data::Resonance { .. } => Kind::Resonance,
-            Data::TorqueCurve { .. } => Kind::TorqueCurve,
-            Data::Positioning { .. } => Kind::Positioning,
-            Data::Fluctuation { .. } => Kind::Fluctuation,
-            Data::Unbalance { .. } => Kind::Unbalance,
-            Data::FrequencyResponseTime { .. } => Kind::FrequencyResponseTime,
-        }
-    }
-
-    /// Number of rows (of peaks, for resonance).
-    pub fn len(&self) -> usize {
-        match self {
-            Data::FrequencyResponse {
-                frequency_hz: v, ..
-            }
-            | Data::Resonance { peaks_hz: v, .. }
-            | Data::TorqueCurve { time_s: v, .. }
-            | Data::Positioning { target_rad: v, .. }
-            | Data::Fluctuation { time_s: v, .. }
-            | Data::Unbalance { time_s: v, .. }
-            | Data::FrequencyResponseTime { time_s: v, .. } => v.len(),
-        }
-    }
-
-    /// True when there are no rows.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// The extra columns (none for resonance).
-    pub fn extra(&self) -> Option<&Columns> {
-        match self {
-            Data::Resonance { .. } => None,
-            Data::FrequencyResponse { extra, .. }
-            | Data::TorqueCurve { extra, .. }
-            | Data::Positioning { extra, .. }
-            | Data::Fluctuation { extra, .. }
-            | Data::Unbalance { extra, .. }
-            | Data::FrequencyResponseTime { extra, .. } => Some(extra),
         }
     }
 }
@@ -523,7 +275,7 @@ pub enum ExperimentFileError {
         line: u64,
         message: String,
     },
-    /// [`write`] was given data that would not read back.
+    /// [`write()`] was given data that would not read back.
     #[error("cannot write experiment {path}: {message}")]
     Invalid { path: PathBuf, message: String },
     /// A file cannot be written.
@@ -570,6 +322,7 @@ pub fn read(path: &Path) -> Result<Experiment, ExperimentFileError> {
     }
     let data_path = data_path(path, &manifest);
     let data = table::Table::read(&data_path, path)?.data(manifest.kind)?;
+    check_against_data(&manifest, &data).map_err(|m| manifest_error(path, &m))?;
     Ok(Experiment {
         manifest,
         data,
@@ -597,9 +350,7 @@ pub fn read_manifest(path: &Path) -> Result<Manifest, ExperimentFileError> {
                 }
             },
         })?;
-    if manifest.kind == Kind::FrequencyResponseTime {
-        check_record_conditions(&manifest.conditions).map_err(|m| manifest_error(path, &m))?;
-    }
+    conditions::check(manifest.kind, &manifest.conditions).map_err(|m| manifest_error(path, &m))?;
     if let (Some(peaks), Some(gains)) = (&manifest.peaks_hz, &manifest.peak_gain_db) {
         if peaks.len() != gains.len() {
             return Err(manifest_error(
@@ -631,99 +382,17 @@ fn manifest_error(path: &Path, message: &str) -> ExperimentFileError {
     }
 }
 
-/// The conditions a frequency-response record needs: for a stepped sine the frequencies
-/// (positive) and the dwell (positive); a positive ratio where one is given. (JSON
-/// numbers are finite, so `<= 0` is the whole check.)
-fn check_record_conditions(c: &Conditions) -> Result<(), String> {
-    let c = c.with_defaults(Kind::FrequencyResponseTime);
-    if let Some(r) = c.ratio.filter(|r| *r <= 0.0) {
-        return Err(format!(
-            "`conditions.ratio` is {r}: it must be positive (Rg·Rw)"
-        ));
+/// The conditions that need the data to be checked: a multisine's period and lines
+/// against the record's sampling.
+fn check_against_data(manifest: &Manifest, data: &Data) -> Result<(), String> {
+    let c = manifest.conditions.with_defaults(manifest.kind);
+    match data {
+        Data::FrequencyResponseTime { time_s, .. }
+        | Data::FrequencyResponseTimeCurrent { time_s, .. }
+            if c.excitation == Some(Excitation::Multisine) =>
+        {
+            conditions::check_multisine_record(&c, time_s)
+        }
+        _ => Ok(()),
     }
-    if c.excitation != Some(Excitation::SteppedSine) {
-        return Ok(());
-    }
-    let frequencies = c.frequencies_hz.as_deref().unwrap_or_default();
-    if frequencies.is_empty() {
-        return Err(
-            "a stepped-sine record needs `conditions.frequencies_hz`: the drive \
-                    frequencies in the order played, Hz"
-                .into(),
-        );
-    }
-    if let Some(f) = frequencies.iter().find(|f| **f <= 0.0) {
-        return Err(format!(
-            "`conditions.frequencies_hz` holds {f}: drive frequencies must be positive"
-        ));
-    }
-    match c.dwell_s {
-        None => Err(
-            "a stepped-sine record needs `conditions.dwell_s`: the time spent at \
-                     each frequency, s"
-                .into(),
-        ),
-        Some(d) if d <= 0.0 => Err(format!(
-            "`conditions.dwell_s` is {d}: the dwell at each frequency must be positive"
-        )),
-        Some(_) => Ok(()),
-    }
-}
-
-/// Largest departure of one time step from the record's median step, as a fraction of
-/// that step, that a frequency-response record may have (a DAQ writing times rounded
-/// to 1 µs at 20 kHz stays within 2 %; one dropped sample is a 100 % departure).
-pub const SAMPLING_TOLERANCE: f64 = 0.05;
-
-/// A time step of a record that should be uniformly sampled but is not.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NonUniform {
-    /// Index of the sample that ends the step.
-    pub row: usize,
-    /// The step there, s.
-    pub step: f64,
-    /// The record's median step, s.
-    pub median: f64,
-}
-
-impl fmt::Display for NonUniform {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "the step from the previous row is {:.6e} s where the record steps {:.6e} s: \
-             the samples must be uniformly spaced (within {:.0} % of a step)",
-            self.step,
-            self.median,
-            100.0 * SAMPLING_TOLERANCE
-        )
-    }
-}
-
-/// Checks that strictly increasing `time` is uniformly sampled: every step within
-/// [`SAMPLING_TOLERANCE`] of the median step. Fewer than two samples pass.
-pub fn check_uniform(time: &[f64]) -> Result<(), NonUniform> {
-    let steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
-    if steps.is_empty() {
-        return Ok(());
-    }
-    let mut sorted = steps.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted[sorted.len() / 2];
-    match steps
-        .iter()
-        .position(|s| (s - median).abs() > SAMPLING_TOLERANCE * median)
-    {
-        Some(i) => Err(NonUniform {
-            row: i + 1,
-            step: steps[i],
-            median,
-        }),
-        None => Ok(()),
-    }
-}
-
-/// The sampling period of a uniformly sampled record: the mean step, which rounding
-/// of the individual times does not bias. `None` for fewer than two samples.
-pub fn sample_period(time: &[f64]) -> Option<f64> {
-    (time.len() >= 2).then(|| (time[time.len() - 1] - time[0]) / (time.len() - 1) as f64)
 }

@@ -3,7 +3,12 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{Columns, Data, ExperimentFileError as Error, Kind, ANGLE_UNITS};
+mod kinds;
+
+pub(super) use kinds::reserved;
+
+use super::units::units_for;
+use super::{Axis, Columns, CommandUnit, ExperimentFileError as Error};
 
 /// A CSV file read into memory, with the columns taken so far marked.
 pub(super) struct Table {
@@ -15,11 +20,13 @@ pub(super) struct Table {
     used: Vec<bool>,
 }
 
-/// A column to read: its index and radians per unit (1 for non-angles).
+/// A column to read: its index, SI units per unit written (1 for a column read as
+/// written) and, for a position or an effort, the axis its unit implies.
 #[derive(Clone, Copy)]
 struct Col {
     index: usize,
     scale: f64,
+    axis: Option<Axis>,
 }
 
 impl Table {
@@ -70,129 +77,6 @@ impl Table {
         })
     }
 
-    /// The typed data of `kind` (not resonance, which has no table).
-    pub(super) fn data(mut self, kind: Kind) -> Result<Data, Error> {
-        use Order::{Any, Increasing};
-        Ok(match kind {
-            Kind::FrequencyResponse => {
-                let (f, g) = (self.column("frequency_hz")?, self.column("gain_db")?);
-                let p = self.angle("phase")?;
-                Data::FrequencyResponse {
-                    frequency_hz: self.numbers(f, Increasing)?,
-                    gain_db: self.numbers(g, Any)?,
-                    phase_rad: p.map(|p| self.numbers(p, Any)).transpose()?,
-                    extra: self.extras(),
-                }
-            }
-            Kind::Resonance => {
-                return Err(Error::Manifest {
-                    path: self.path,
-                    message: "a resonance experiment has no data file".into(),
-                })
-            }
-            Kind::TorqueCurve => {
-                let (t, q) = (self.column("time_s")?, self.column("motor_torque_nm")?);
-                let a = self.angle("table_angle")?;
-                Data::TorqueCurve {
-                    time_s: self.numbers(t, Increasing)?,
-                    motor_torque_nm: self.numbers(q, Any)?,
-                    table_angle_rad: a.map(|a| self.numbers(a, Any)).transpose()?,
-                    extra: self.extras(),
-                }
-            }
-            Kind::Positioning => self.positioning()?,
-            Kind::FrequencyResponseTime => {
-                let (t, q) = (self.column("time_s")?, self.column("motor_torque_nm")?);
-                let m = self.required_angle("motor_angle")?;
-                let a = self.required_angle("table_angle")?;
-                let time_s = self.numbers(t, Increasing)?;
-                if let Err(e) = super::check_uniform(&time_s) {
-                    return Err(self.cell(self.rows[e.row].0, t.index, e.to_string()));
-                }
-                Data::FrequencyResponseTime {
-                    time_s,
-                    motor_torque_nm: self.numbers(q, Any)?,
-                    motor_angle_rad: self.numbers(m, Any)?,
-                    table_angle_rad: self.numbers(a, Any)?,
-                    extra: self.extras(),
-                }
-            }
-            Kind::Fluctuation | Kind::Unbalance => {
-                let t = self.column("time_s")?;
-                let m = self.required_angle("motor_angle")?;
-                let a = self.required_angle("table_angle")?;
-                let (time_s, motor_angle_rad, table_angle_rad) = (
-                    self.numbers(t, Increasing)?,
-                    self.numbers(m, Any)?,
-                    self.numbers(a, Any)?,
-                );
-                let extra = self.extras();
-                if kind == Kind::Fluctuation {
-                    Data::Fluctuation {
-                        time_s,
-                        motor_angle_rad,
-                        table_angle_rad,
-                        extra,
-                    }
-                } else {
-                    Data::Unbalance {
-                        time_s,
-                        motor_angle_rad,
-                        table_angle_rad,
-                        extra,
-                    }
-                }
-            }
-        })
-    }
-
-    /// Target, direction, run, and deviation from a `deviation_*` column or else as
-    /// `measured_*` − target. With both, `deviation_*` is used and `measured_*` kept as
-    /// an extra column.
-    fn positioning(mut self) -> Result<Data, Error> {
-        let target = self.required_angle("target")?;
-        let (d, r) = (self.column("direction")?, self.column("run")?);
-        let (deviation, measured) = match self.angle("deviation")? {
-            Some(c) => (c, false),
-            None => match self.angle("measured")? {
-                Some(c) => (c, true),
-                None => {
-                    let mut alternatives = vec!["measured_rad".into(), "measured_arcsec".into()];
-                    alternatives.extend(ANGLE_UNITS.map(|(u, _)| format!("deviation_{u}")));
-                    return Err(self.missing("measured_deg", alternatives));
-                }
-            },
-        };
-        let target_rad = self.numbers(target, Order::Any)?;
-        let deviation_rad = if !measured {
-            self.numbers(deviation, Order::Any)?
-        } else {
-            // In a common unit, subtract first and scale once: exact for close values.
-            let same = deviation.scale == target.scale;
-            let unit = |c: Col| if same { Col { scale: 1.0, ..c } } else { c };
-            let m = self.numbers(unit(deviation), Order::Any)?;
-            let t = self.numbers(unit(target), Order::Any)?;
-            let scale = if same { target.scale } else { 1.0 };
-            let mut dev = Vec::with_capacity(m.len());
-            for ((m, t), (line, _)) in m.iter().zip(&t).zip(&self.rows) {
-                let x = (m - t) * scale;
-                if !x.is_finite() {
-                    let message = "measured − target is not finite".to_string();
-                    return Err(self.cell(*line, deviation.index, message));
-                }
-                dev.push(x);
-            }
-            dev
-        };
-        Ok(Data::Positioning {
-            target_rad,
-            direction: self.parse(d, |s| s.parse())?,
-            run: self.parse(r, run)?,
-            deviation_rad,
-            extra: self.extras(),
-        })
-    }
-
     fn find(&self, name: &str) -> Option<usize> {
         self.header.iter().position(|h| h == name)
     }
@@ -203,37 +87,148 @@ impl Table {
             .find(name)
             .ok_or_else(|| self.missing(name, Vec::new()))?;
         self.used[index] = true;
-        Ok(Col { index, scale: 1.0 })
+        Ok(Col {
+            index,
+            scale: 1.0,
+            axis: None,
+        })
     }
 
-    /// The angle column `{base}_deg`, `{base}_rad` or `{base}_arcsec`, if there is one.
-    fn angle(&mut self, base: &str) -> Result<Option<Col>, Error> {
-        let found: Vec<(String, Col)> = ANGLE_UNITS
-            .iter()
-            .filter_map(|&(unit, scale)| {
-                let name = format!("{base}_{unit}");
-                self.find(&name).map(|index| (name, Col { index, scale }))
-            })
-            .collect();
+    /// The position column `{base}_{unit}` for any of `bases` and the units each base
+    /// admits ([`units_for`]), converted to rad or m, if there is one. Two columns for
+    /// the same position are an error.
+    fn position(&mut self, bases: &[&str]) -> Result<Option<Col>, Error> {
+        let mut found: Vec<(String, Col)> = Vec::new();
+        for base in bases {
+            for unit in units_for(base) {
+                let name = format!("{base}_{}", unit.suffix);
+                if let Some(index) = self.find(&name) {
+                    let col = Col {
+                        index,
+                        scale: unit.si,
+                        axis: Some(unit.axis),
+                    };
+                    found.push((name, col));
+                }
+            }
+        }
         match found.as_slice() {
             [] => Ok(None),
             [(_, c)] => {
                 self.used[c.index] = true;
                 Ok(Some(*c))
             }
-            [(a, _), (b, _), ..] => Err(Error::Csv {
-                path: self.path.clone(),
-                line: self.header_line,
-                message: format!("columns `{a}` and `{b}` give the same angle: keep one"),
-            }),
+            [(a, ca), (b, cb), ..] => {
+                let rotary = [ca, cb].iter().all(|c| c.axis == Some(Axis::Rotary));
+                let what = if rotary { "angle" } else { "position" };
+                Err(self.header_error(format!(
+                    "columns `{a}` and `{b}` give the same {what}: keep one"
+                )))
+            }
         }
     }
 
-    fn required_angle(&mut self, base: &str) -> Result<Col, Error> {
-        self.angle(base)?.ok_or_else(|| {
-            let alternatives = ["rad", "arcsec"].map(|u| format!("{base}_{u}")).to_vec();
-            self.missing(&format!("{base}_deg"), alternatives)
+    /// As [`Table::position`], required: missing, the error names the first base in
+    /// degrees (or metres for a base without angles) and every other spelling.
+    fn required_position(&mut self, bases: &[&str]) -> Result<Col, Error> {
+        self.position(bases)?.ok_or_else(|| {
+            let mut names = bases.iter().flat_map(|b| {
+                units_for(b)
+                    .iter()
+                    .map(move |u| format!("{b}_{}", u.suffix))
+            });
+            let first = names.next().unwrap_or_default();
+            self.missing(&first, names.collect())
         })
+    }
+
+    /// The one column of `choices` (name, what it means) present, if any; two of them
+    /// are an error saying they give the same `what`.
+    fn one_of<T: Copy>(
+        &mut self,
+        choices: &[(&str, T)],
+        what: &str,
+    ) -> Result<Option<(Col, T)>, Error> {
+        let found: Vec<(&str, usize, T)> = choices
+            .iter()
+            .filter_map(|&(name, t)| self.find(name).map(|i| (name, i, t)))
+            .collect();
+        match found.as_slice() {
+            [] => Ok(None),
+            [(_, index, t)] => {
+                self.used[*index] = true;
+                let col = Col {
+                    index: *index,
+                    scale: 1.0,
+                    axis: None,
+                };
+                Ok(Some((col, *t)))
+            }
+            [(a, ..), (b, ..), ..] => Err(self.header_error(format!(
+                "columns `{a}` and `{b}` give the same {what}: keep one"
+            ))),
+        }
+    }
+
+    /// As [`Table::one_of`], required.
+    fn required_one_of<T: Copy>(
+        &mut self,
+        choices: &[(&str, T)],
+        what: &str,
+    ) -> Result<(Col, T), Error> {
+        self.one_of(choices, what)?.ok_or_else(|| {
+            let rest = choices[1..].iter().map(|(n, _)| n.to_string()).collect();
+            self.missing(choices[0].0, rest)
+        })
+    }
+
+    /// The drive's effort among `choices` (a torque name and a force name), required,
+    /// marked with the axis it implies.
+    fn effort(&mut self, choices: &[(&str, Axis); 2]) -> Result<Col, Error> {
+        let (col, axis) = self.required_one_of(choices, "drive effort")?;
+        Ok(Col {
+            axis: Some(axis),
+            ..col
+        })
+    }
+
+    /// A command signal `{base}_v`, `_a`, `_nm` or `_n`, if there is one.
+    fn command(&mut self, base: &str) -> Result<Option<(Col, CommandUnit)>, Error> {
+        let names = CommandUnit::ALL.map(|u| (format!("{base}_{}", u.suffix()), u));
+        let choices = names.each_ref().map(|(n, u)| (n.as_str(), *u));
+        self.one_of(&choices, "signal")
+    }
+
+    /// The axis all of `cols` agree on (rotary when none carries one). A column whose
+    /// unit belongs to the other axis than the first one's is an error naming both.
+    fn same_axis(&self, cols: &[Option<Col>]) -> Result<Axis, Error> {
+        let mut with_axis = cols
+            .iter()
+            .flatten()
+            .filter_map(|c| c.axis.map(|a| (c.index, a)));
+        let Some((first, axis)) = with_axis.next() else {
+            return Ok(Axis::Rotary);
+        };
+        match with_axis.find(|(_, a)| *a != axis) {
+            None => Ok(axis),
+            Some((other, other_axis)) => Err(self.header_error(format!(
+                "column `{}` is {} but `{}` is {}: a file's positions and efforts must \
+                 all be rotary (deg, rad, arcsec; nm) or all linear (m, mm, um; n)",
+                self.header[other],
+                unit_kind(other_axis),
+                self.header[first],
+                unit_kind(axis),
+            ))),
+        }
+    }
+
+    /// An error about the header row.
+    fn header_error(&self, message: String) -> Error {
+        Error::Csv {
+            path: self.path.clone(),
+            line: self.header_line,
+            message,
+        }
     }
 
     fn missing(&self, column: &str, alternatives: Vec<String>) -> Error {
@@ -345,6 +340,14 @@ fn run(text: &str) -> Result<u32, String> {
         Ok(x as u32)
     } else {
         Err(format!("`{text}` is not a run number (a whole number ≥ 1)"))
+    }
+}
+
+/// What a column of `axis` holds, for an error message.
+fn unit_kind(axis: Axis) -> &'static str {
+    match axis {
+        Axis::Rotary => "an angle or a torque (rotary)",
+        Axis::Linear => "a length or a force (linear)",
     }
 }
 

@@ -1,4 +1,6 @@
+use super::units::ARCSEC;
 use super::*;
+use crate::model::params::LoopMode;
 
 /// Writes `files` (name, text) into a fresh folder; returns it and the path of the first.
 fn files(files: &[(&str, &str)]) -> (tempfile::TempDir, PathBuf) {
@@ -95,7 +97,62 @@ fn samples() -> Vec<Data> {
             table_angle_rad: series(n, 2e-4),
             extra: extra(n),
         },
+        Data::ForceCurve {
+            time_s: times(n),
+            force_n: series(n, 20.0),
+            table_position_m: Some(series(n, 0.1)),
+            extra: extra(n),
+        },
+        Data::LinearPositioning {
+            target_m: (0..n).map(|i| (i / 2) as f64 * 0.025).collect(),
+            direction: (0..n)
+                .map(|i| {
+                    if i % 3 == 0 {
+                        Direction::Down
+                    } else {
+                        Direction::Up
+                    }
+                })
+                .collect(),
+            run: (1..=n as u32).rev().collect(),
+            deviation_m: series(n, 0.0).iter().map(|x| x * 1e-6).collect(),
+            extra: Columns::new(),
+        },
+        Data::FrequencyResponseTimeCurrent {
+            time_s: times(n),
+            motor_current_a: series(n, -3.0),
+            motor_angle_rad: series(n, 7.0),
+            table_angle_rad: series(n, -0.6),
+            extra: extra(n),
+        },
+        servo_trace(Axis::Linear, n),
+        servo_trace(Axis::Rotary, n),
     ]
+}
+
+/// A servo trace with every optional column.
+fn servo_trace(axis: Axis, n: usize) -> Data {
+    let unit = match axis {
+        Axis::Rotary => CommandUnit::NewtonMetre,
+        Axis::Linear => CommandUnit::Volt,
+    };
+    Data::ServoTrace(ServoTrace {
+        axis,
+        time_s: times(n),
+        reference_position: series(n, 1e-3),
+        position: series(n, 2e-3),
+        table_position: Some(series(n, 3e-3)),
+        effort: series(n, 50.0),
+        controller_output: Some(Signal {
+            unit,
+            values: series(n, 1.0),
+        }),
+        controller_added: Some(Signal {
+            unit,
+            values: series(n, 0.1),
+        }),
+        extra: extra(n),
+    })
 }
 
 /// The numeric series of `data` in a fixed order, for comparison within 1e-12.
@@ -126,14 +183,30 @@ fn numbers(data: &Data) -> Vec<Vec<f64>> {
             table_angle_rad.clone().unwrap_or_default(),
         ],
         Data::Positioning {
-            target_rad,
-            deviation_rad,
+            target_rad: target,
+            deviation_rad: deviation,
+            run,
+            ..
+        }
+        | Data::LinearPositioning {
+            target_m: target,
+            deviation_m: deviation,
             run,
             ..
         } => vec![
-            target_rad.clone(),
-            deviation_rad.clone(),
+            target.clone(),
+            deviation.clone(),
             run.iter().map(|&r| r as f64).collect(),
+        ],
+        Data::ForceCurve {
+            time_s,
+            force_n,
+            table_position_m,
+            ..
+        } => vec![
+            time_s.clone(),
+            force_n.clone(),
+            table_position_m.clone().unwrap_or_default(),
         ],
         Data::Fluctuation {
             time_s,
@@ -153,16 +226,35 @@ fn numbers(data: &Data) -> Vec<Vec<f64>> {
         ],
         Data::FrequencyResponseTime {
             time_s,
-            motor_torque_nm,
+            motor_torque_nm: input,
+            motor_angle_rad,
+            table_angle_rad,
+            ..
+        }
+        | Data::FrequencyResponseTimeCurrent {
+            time_s,
+            motor_current_a: input,
             motor_angle_rad,
             table_angle_rad,
             ..
         } => vec![
             time_s.clone(),
-            motor_torque_nm.clone(),
+            input.clone(),
             motor_angle_rad.clone(),
             table_angle_rad.clone(),
         ],
+        Data::ServoTrace(t) => {
+            let signal = |s: &Option<Signal>| s.as_ref().map_or(vec![], |s| s.values.clone());
+            vec![
+                t.time_s.clone(),
+                t.reference_position.clone(),
+                t.position.clone(),
+                t.table_position.clone().unwrap_or_default(),
+                t.effort.clone(),
+                signal(&t.controller_output),
+                signal(&t.controller_added),
+            ]
+        }
     };
     v.extend(data.extra().into_iter().flat_map(|e| e.values().cloned()));
     v
@@ -186,6 +278,16 @@ fn every_kind_survives_a_round_trip() {
         write(&path, &manifest, &data).unwrap();
         let back = read(&path).unwrap();
         assert_eq!(back.data.kind(), kind);
+        assert_eq!(back.data.axis(), data.axis(), "{kind}");
+        assert_eq!(
+            std::mem::discriminant(&back.data),
+            std::mem::discriminant(&data),
+            "{kind}"
+        );
+        if let (Data::ServoTrace(a), Data::ServoTrace(b)) = (&data, &back.data) {
+            let units = |t: &ServoTrace| t.controller_output.as_ref().map(|s| s.unit);
+            assert_eq!(units(a), units(b));
+        }
         let (a, b) = (numbers(&data), numbers(&back.data));
         assert_eq!(a.len(), b.len(), "{kind}");
         for (x, y) in a.iter().zip(&b) {
@@ -196,8 +298,18 @@ fn every_kind_survives_a_round_trip() {
                 direction: d1,
                 extra: e1,
                 ..
+            }
+            | Data::LinearPositioning {
+                direction: d1,
+                extra: e1,
+                ..
             },
             Data::Positioning {
+                direction: d2,
+                extra: e2,
+                ..
+            }
+            | Data::LinearPositioning {
                 direction: d2,
                 extra: e2,
                 ..
@@ -432,7 +544,7 @@ fn malformed_csv_files_name_file_line_and_column() {
         (tc, "time_s,motor_torque_nm,time_s\n0,1,0\n", "line 1: column `time_s` appears twice"),
         (tc, "time_s,motor_torque_nm,table_angle_deg,table_angle_rad\n0,1,0,0\n", "columns `table_angle_deg` and `table_angle_rad` give the same angle"),
         ("fluctuation", "time_s,motor_angle_deg\n0,1\n", "missing column `table_angle_deg` (or `table_angle_rad`, `table_angle_arcsec`) (header: time_s,motor_angle_deg)"),
-        (pos, "target_deg,direction,run\n0,up,1\n", "missing column `measured_deg` (or `measured_rad`, `measured_arcsec`, `deviation_deg`, `deviation_rad`, `deviation_arcsec`)"),
+        (pos, "target_deg,direction,run\n0,up,1\n", "missing column `measured_deg` (or `measured_rad`, `measured_arcsec`, `measured_m`, `measured_mm`, `measured_um`, `deviation_deg`, `deviation_rad`, `deviation_arcsec`, `deviation_m`, `deviation_mm`, `deviation_um`)"),
         (pos, "target_deg,direction,run,measured_deg\n0,up,1,0\n0,sideways,1,0\n", "line 3, column `direction`: `sideways` is not a direction (expected up, down, ccw or cw)"),
         (pos, "target_deg,direction,run,measured_deg\n0,up,0,0\n", "line 2, column `run`: run 0: runs are numbered from 1"),
         (pos, "target_deg,direction,run,measured_deg\n0,up,-1,0\n", "line 2, column `run`: `-1` is not a run number"),
@@ -453,7 +565,7 @@ fn malformed_frequency_response_records_name_file_line_and_column() {
     for (csv, expected) in [
         (
             "time_s,motor_angle_deg,table_angle_deg\n0,0,0\n".to_string(),
-            "run.csv, line 1: missing column `motor_torque_nm` (header: time_s,motor_angle_deg,table_angle_deg)".to_string(),
+            "run.csv, line 1: missing column `motor_torque_nm` (or `motor_current_a`) (header: time_s,motor_angle_deg,table_angle_deg)".to_string(),
         ),
         (
             "time_s,motor_torque_nm,table_angle_deg\n0,0,0\n".into(),
@@ -461,7 +573,7 @@ fn malformed_frequency_response_records_name_file_line_and_column() {
         ),
         (
             "time_s,motor_torque_nm,motor_angle_deg\n0,0,0\n".into(),
-            "run.csv, line 1: missing column `table_angle_deg` (or `table_angle_rad`, `table_angle_arcsec`)".into(),
+            "run.csv, line 1: missing column `table_angle_deg` (or `table_angle_rad`, `table_angle_arcsec`, `load_angle_deg`, `load_angle_rad`, `load_angle_arcsec`)".into(),
         ),
         (
             "time_s,motor_torque_nm,motor_angle_deg,motor_angle_rad,table_angle_deg\n0,0,0,0,0\n".into(),
@@ -512,7 +624,7 @@ fn malformed_frequency_response_records_name_file_line_and_column() {
         (r#"{"frequencies_hz": [10, -20], "dwell_s": 1}"#, "m.json: `conditions.frequencies_hz` holds -20"),
         (r#"{"frequencies_hz": [10], "dwell_s": 0}"#, "m.json: `conditions.dwell_s` is 0"),
         (r#"{"ratio": -0.01}"#, "m.json: `conditions.ratio` is -0.01"),
-        (r#"{"excitation": "sweep"}"#, "m.json, line 1, column 91: unknown variant `sweep`, expected `stepped_sine` or `broadband`"),
+        (r#"{"excitation": "sweep"}"#, "m.json, line 1, column 91: unknown variant `sweep`, expected one of `stepped_sine`, `broadband`, `multisine`"),
     ] {
         let manifest = format!(r#"{{"kind": "{k}", "data": "run.csv", "conditions": {conditions}}}"#);
         let (_dir, path) = files(&[("m.json", &manifest), ("run.csv", &csv)]);
@@ -723,8 +835,9 @@ fn code_blocks(text: &str) -> Vec<(&str, String)> {
     blocks
 }
 
-/// docs/experiment-files.md shows one manifest and CSV head per kind: they must load,
-/// and the positioning example's two forms (deviation, measured) must agree.
+/// docs/experiment-files.md shows a manifest and CSV head per kind (and more for some
+/// kinds: each CSV goes with the manifest above it): they must load, and the
+/// positioning example's first two forms (deviation, measured) must agree.
 #[test]
 fn the_documented_examples_load() {
     let doc = include_str!("../../../docs/experiment-files.md");
@@ -733,24 +846,33 @@ fn the_documented_examples_load() {
     let mut kinds = Vec::new();
     for section in examples.split("\n### ").skip(1) {
         let title = section.lines().next().unwrap().trim();
-        let blocks = code_blocks(section);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("example.json");
-        std::fs::write(&path, &blocks.iter().find(|(l, _)| *l == "json").unwrap().1).unwrap();
-        let manifest = read_manifest(&path).unwrap();
-        assert_eq!(manifest.kind.name(), title);
-        kinds.push(manifest.kind);
+        let mut manifest: Option<Manifest> = None;
         let mut read_back = Vec::new();
-        for (_, csv) in blocks.iter().filter(|(l, _)| *l == "csv") {
-            std::fs::write(data_path(&path, &manifest), csv).unwrap();
-            let e = read(&path).unwrap_or_else(|e| panic!("{title}: {e}"));
-            assert_eq!(e.data.len(), 4, "{title}");
-            read_back.push(e.data);
+        for (language, body) in code_blocks(section) {
+            if language == "json" {
+                std::fs::write(&path, &body).unwrap();
+                let m = read_manifest(&path).unwrap_or_else(|e| panic!("{title}: {e}"));
+                assert_eq!(m.kind.name(), title);
+                if manifest.is_none() {
+                    kinds.push(m.kind);
+                }
+                if !m.kind.has_data_file() {
+                    assert_eq!(read(&path).unwrap().data.len(), 2);
+                }
+                manifest = Some(m);
+            } else if language == "csv" {
+                let m = manifest.as_ref().expect("a CSV example after its manifest");
+                std::fs::write(data_path(&path, m), &body).unwrap();
+                let e = read(&path).unwrap_or_else(|e| panic!("{title}: {e}"));
+                assert_eq!(e.data.len(), 4, "{title}");
+                read_back.push(e.data);
+            }
         }
+        let manifest = manifest.unwrap_or_else(|| panic!("{title} has no manifest"));
         if manifest.kind.has_data_file() {
             assert!(!read_back.is_empty(), "{title} has no CSV example");
-        } else {
-            assert_eq!(read(&path).unwrap().data.len(), 2);
         }
         if let [Data::Positioning {
             direction: d1,
@@ -760,12 +882,16 @@ fn the_documented_examples_load() {
             direction: d2,
             deviation_rad: x2,
             ..
-        }] = read_back.as_slice()
+        }, ..] = read_back.as_slice()
         {
             assert_eq!(d1, d2);
             for (a, b) in x1.iter().zip(x2) {
                 assert!((a - b).abs() < 0.01 * ARCSEC, "{a} vs {b}");
             }
+        }
+        let axes: Vec<Option<Axis>> = read_back.iter().map(Data::axis).collect();
+        if title == "torque_curve" || title == "positioning" {
+            assert_eq!(axes.last(), Some(&Some(Axis::Linear)), "{title}");
         }
     }
     assert_eq!(kinds, Kind::ALL);

@@ -5,15 +5,18 @@ use std::borrow::Cow;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::{
-    Conditions, Data, Direction, ExperimentFileError, Kind, Manifest, ANGLE_UNITS, ARCSEC, DEG,
-};
+mod columns;
+
+use columns::{out_columns, Cells};
+
+use super::{Conditions, Data, ExperimentFileError, Kind, Manifest};
 
 /// Writes an experiment: the CSV (unless resonance) beside the manifest, named by
 /// `manifest.data` or after the manifest, then the manifest as pretty JSON, each
 /// atomically. The written manifest has `data` set to the CSV's name and, for a
 /// resonance, `peaks_hz` and `peak_gain_db` from `data`. Angles are written in degrees
-/// (positioning deviations in arc-seconds), numbers in Rust's shortest round-trip form.
+/// (positioning deviations in arc-seconds), lengths in metres (positioning targets in
+/// mm, deviations in µm), numbers in Rust's shortest round-trip form.
 /// Data that would not read back (unequal lengths, non-finite values, times not
 /// increasing, run 0, extra columns named like a column the reader uses) is refused
 /// before anything is written.
@@ -37,6 +40,9 @@ pub fn write(
         ));
     }
     check_manifest(manifest).map_err(|m| invalid(manifest_path, m))?;
+    if let Data::ServoTrace(trace) = data {
+        check_signals(trace).map_err(|m| invalid(manifest_path, m))?;
+    }
     let mut out = manifest.clone();
     if let Data::Resonance {
         peaks_hz,
@@ -111,15 +117,24 @@ fn check_manifest(m: &Manifest) -> Result<(), String> {
     if let Some(f) = c.frequencies_hz.iter().flatten().find(|v| !v.is_finite()) {
         return Err(format!("condition `frequencies_hz` holds {f}"));
     }
-    if m.kind == Kind::FrequencyResponseTime {
-        super::check_record_conditions(c)?;
-    }
+    super::conditions::check(m.kind, c)?;
     for (key, values) in [("peaks_hz", &m.peaks_hz), ("peak_gain_db", &m.peak_gain_db)] {
         if let Some(v) = values.iter().flatten().find(|v| !v.is_finite()) {
             return Err(format!("`{key}` holds {v}"));
         }
     }
     Ok(())
+}
+
+/// An added signal is in the controller output's unit (the reader requires it).
+fn check_signals(t: &super::ServoTrace) -> Result<(), String> {
+    match (&t.controller_output, &t.controller_added) {
+        (Some(out), Some(added)) if out.unit != added.unit => Err(format!(
+            "the added signal is in {} but the controller output in {}",
+            added.unit, out.unit
+        )),
+        _ => Ok(()),
+    }
 }
 
 fn check_peaks(peaks_hz: &[f64], peak_gain_db: Option<&[f64]>) -> Result<(), String> {
@@ -145,145 +160,6 @@ fn check_peaks(peaks_hz: &[f64], peak_gain_db: Option<&[f64]>) -> Result<(), Str
     }
 }
 
-/// The cells of one column to write, in the file's unit.
-enum Cells<'a> {
-    Numbers(Cow<'a, [f64]>),
-    Directions(&'a [Direction]),
-    Runs(&'a [u32]),
-}
-
-impl Cells<'_> {
-    fn len(&self) -> usize {
-        match self {
-            Cells::Numbers(v) => v.len(),
-            Cells::Directions(v) => v.len(),
-            Cells::Runs(v) => v.len(),
-        }
-    }
-}
-
-/// The columns [`write`] writes for `data`, extra columns last (none for resonance).
-fn out_columns(data: &Data) -> Vec<(Cow<'_, str>, Cells<'_>)> {
-    fn plain<'a>(name: &'static str, v: &'a [f64]) -> (Cow<'a, str>, Cells<'a>) {
-        (name.into(), Cells::Numbers(v.into()))
-    }
-    fn angle(name: &'static str, v: &[f64], per_unit: f64) -> (Cow<'static, str>, Cells<'static>) {
-        let converted = v.iter().map(|x| x / per_unit).collect::<Vec<f64>>();
-        (name.into(), Cells::Numbers(converted.into()))
-    }
-    let (mut columns, extra) = match data {
-        Data::Resonance { .. } => return Vec::new(),
-        Data::FrequencyResponse {
-            frequency_hz,
-            gain_db,
-            phase_rad,
-            extra,
-        } => {
-            let mut c = vec![
-                plain("frequency_hz", frequency_hz),
-                plain("gain_db", gain_db),
-            ];
-            c.extend(phase_rad.as_deref().map(|p| angle("phase_deg", p, DEG)));
-            (c, extra)
-        }
-        Data::TorqueCurve {
-            time_s,
-            motor_torque_nm,
-            table_angle_rad,
-            extra,
-        } => {
-            let mut c = vec![
-                plain("time_s", time_s),
-                plain("motor_torque_nm", motor_torque_nm),
-            ];
-            c.extend(
-                table_angle_rad
-                    .as_deref()
-                    .map(|a| angle("table_angle_deg", a, DEG)),
-            );
-            (c, extra)
-        }
-        Data::Positioning {
-            target_rad,
-            direction,
-            run,
-            deviation_rad,
-            extra,
-        } => (
-            vec![
-                angle("target_deg", target_rad, DEG),
-                ("direction".into(), Cells::Directions(direction)),
-                ("run".into(), Cells::Runs(run)),
-                angle("deviation_arcsec", deviation_rad, ARCSEC),
-            ],
-            extra,
-        ),
-        Data::Fluctuation {
-            time_s,
-            motor_angle_rad,
-            table_angle_rad,
-            extra,
-        }
-        | Data::Unbalance {
-            time_s,
-            motor_angle_rad,
-            table_angle_rad,
-            extra,
-        } => (
-            vec![
-                plain("time_s", time_s),
-                angle("motor_angle_deg", motor_angle_rad, DEG),
-                angle("table_angle_deg", table_angle_rad, DEG),
-            ],
-            extra,
-        ),
-        Data::FrequencyResponseTime {
-            time_s,
-            motor_torque_nm,
-            motor_angle_rad,
-            table_angle_rad,
-            extra,
-        } => (
-            vec![
-                plain("time_s", time_s),
-                plain("motor_torque_nm", motor_torque_nm),
-                angle("motor_angle_deg", motor_angle_rad, DEG),
-                angle("table_angle_deg", table_angle_rad, DEG),
-            ],
-            extra,
-        ),
-    };
-    for (name, v) in extra {
-        columns.push((name.as_str().into(), Cells::Numbers(v.as_slice().into())));
-    }
-    columns
-}
-
-/// The column names the reader interprets for `kind`: an extra column must not take one.
-fn reserved(kind: Kind) -> Vec<String> {
-    let (plain, angles): (&[&str], &[&str]) = match kind {
-        Kind::FrequencyResponse => (&["frequency_hz", "gain_db"], &["phase"]),
-        Kind::Resonance => (&[], &[]),
-        Kind::TorqueCurve => (&["time_s", "motor_torque_nm"], &["table_angle"]),
-        Kind::Positioning => (&["direction", "run"], &["target", "deviation"]),
-        Kind::Fluctuation | Kind::Unbalance => (&["time_s"], &["motor_angle", "table_angle"]),
-        Kind::FrequencyResponseTime => (
-            &["time_s", "motor_torque_nm"],
-            &["motor_angle", "table_angle"],
-        ),
-    };
-    let angle_names = angles.iter().flat_map(|base| {
-        ANGLE_UNITS
-            .iter()
-            .map(move |(unit, _)| format!("{base}_{unit}"))
-    });
-    plain
-        .iter()
-        .map(|s| s.to_string())
-        .chain(angle_names)
-        .collect()
-}
-
 /// Everything the reader would refuse, checked before a byte is written.
 fn check_columns(data: &Data, columns: &[(Cow<'_, str>, Cells<'_>)]) -> Result<(), String> {
     let Some((first, cells)) = columns.first() else {
@@ -294,7 +170,7 @@ fn check_columns(data: &Data, columns: &[(Cow<'_, str>, Cells<'_>)]) -> Result<(
         return Err("no rows".into());
     }
     let fixed = columns.len() - data.extra().map_or(0, |e| e.len());
-    let reserved = reserved(data.kind());
+    let reserved = super::table::reserved(data.kind());
     for (i, (name, cells)) in columns.iter().enumerate() {
         if i >= fixed {
             if name.is_empty() || name.trim() != name || name.starts_with('#') {
@@ -326,7 +202,7 @@ fn check_columns(data: &Data, columns: &[(Cow<'_, str>, Cells<'_>)]) -> Result<(
                             v[row + 1]
                         ));
                     }
-                    if data.kind() == Kind::FrequencyResponseTime {
+                    if matches!(data.kind(), Kind::FrequencyResponseTime | Kind::ServoTrace) {
                         if let Err(e) = super::check_uniform(v) {
                             return Err(format!("column `{name}`, row {}: {e}", e.row + 1));
                         }

@@ -1,0 +1,307 @@
+//! Which columns each kind reads, under which names, into which [`Data`] variant. The
+//! names are listed once here, for the reader and for [`reserved`] (the names the writer
+//! refuses for an extra column).
+
+use super::super::data::{ServoTrace, Signal};
+use super::super::units::units_for;
+use super::{Col, Order, Table};
+use crate::io::experiment_file::{Axis, CommandUnit, Data, ExperimentFileError as Error, Kind};
+
+use Order::{Any, Increasing};
+
+/// The table's position in a torque curve: an angle, or a length on a linear axis.
+const TABLE: [&str; 2] = ["table_angle", "table_position"];
+/// The drive's effort in a torque curve: motor torque, or force on a linear axis.
+const CURVE_EFFORT: [(&str, Axis); 2] =
+    [("motor_torque_nm", Axis::Rotary), ("force_n", Axis::Linear)];
+/// The input of a frequency-response record: a torque, or a current when the torque
+/// constant is not known (FdiTools' two-mass bench).
+const RECORD_INPUT: [(&str, Input); 2] = [
+    ("motor_torque_nm", Input::Torque),
+    ("motor_current_a", Input::Current),
+];
+/// The driven body's angle in a frequency-response record: `load_angle` is the name
+/// of a two-mass bench's second motor (FdiTools).
+const RECORD_LOAD: [&str; 2] = ["table_angle", "load_angle"];
+/// The loop's encoder in a servo trace: `motor_position` is EMPS's name for it (the
+/// encoder on the motor, in a semi-closed loop), kept as the file has it.
+const SERVO_LOOP: [&str; 2] = ["position", "motor_position"];
+/// The drive's effort in a servo trace.
+const SERVO_EFFORT: [(&str, Axis); 2] = [("torque_nm", Axis::Rotary), ("force_n", Axis::Linear)];
+
+/// What drives a frequency-response record.
+#[derive(Clone, Copy, PartialEq)]
+enum Input {
+    Torque,
+    Current,
+}
+
+impl Table {
+    /// The typed data of `kind` (not resonance, which has no table).
+    pub(in crate::io::experiment_file) fn data(mut self, kind: Kind) -> Result<Data, Error> {
+        match kind {
+            Kind::FrequencyResponse => {
+                let (f, g) = (self.column("frequency_hz")?, self.column("gain_db")?);
+                let p = self.position(&["phase"])?;
+                Ok(Data::FrequencyResponse {
+                    frequency_hz: self.numbers(f, Increasing)?,
+                    gain_db: self.numbers(g, Any)?,
+                    phase_rad: p.map(|p| self.numbers(p, Any)).transpose()?,
+                    extra: self.extras(),
+                })
+            }
+            Kind::Resonance => Err(Error::Manifest {
+                path: self.path,
+                message: "a resonance experiment has no data file".into(),
+            }),
+            Kind::TorqueCurve => self.torque_curve(),
+            Kind::Positioning => self.positioning(),
+            Kind::Fluctuation | Kind::Unbalance => self.fluctuation(kind),
+            Kind::FrequencyResponseTime => self.record(),
+            Kind::ServoTrace => self.servo_trace(),
+        }
+    }
+
+    /// Time, the drive's torque or force and optionally the table's angle or position,
+    /// all rotary or all linear.
+    fn torque_curve(mut self) -> Result<Data, Error> {
+        let t = self.column("time_s")?;
+        let effort = self.effort(&CURVE_EFFORT)?;
+        let table = self.position(&TABLE)?;
+        let axis = self.same_axis(&[Some(effort), table])?;
+        let time_s = self.numbers(t, Increasing)?;
+        let effort = self.numbers(effort, Any)?;
+        let table = table.map(|a| self.numbers(a, Any)).transpose()?;
+        let extra = self.extras();
+        Ok(match axis {
+            Axis::Rotary => Data::TorqueCurve {
+                time_s,
+                motor_torque_nm: effort,
+                table_angle_rad: table,
+                extra,
+            },
+            Axis::Linear => Data::ForceCurve {
+                time_s,
+                force_n: effort,
+                table_position_m: table,
+                extra,
+            },
+        })
+    }
+
+    /// Target, direction, run, and deviation from a `deviation_*` column or else as
+    /// `measured_*` − target, in angles or in lengths. With both, `deviation_*` is used
+    /// and `measured_*` kept as an extra column.
+    fn positioning(mut self) -> Result<Data, Error> {
+        let target = self.required_position(&["target"])?;
+        let (d, r) = (self.column("direction")?, self.column("run")?);
+        let (deviation, measured) = match self.position(&["deviation"])? {
+            Some(c) => (c, false),
+            None => match self.position(&["measured"])? {
+                Some(c) => (c, true),
+                None => {
+                    let mut names = ["measured", "deviation"].into_iter().flat_map(|b| {
+                        units_for(b)
+                            .iter()
+                            .map(move |u| format!("{b}_{}", u.suffix))
+                    });
+                    let first = names.next().unwrap_or_default();
+                    return Err(self.missing(&first, names.collect()));
+                }
+            },
+        };
+        let axis = self.same_axis(&[Some(target), Some(deviation)])?;
+        let target_si = self.numbers(target, Any)?;
+        let deviation_si = if measured {
+            self.measured_minus_target(deviation, target)?
+        } else {
+            self.numbers(deviation, Any)?
+        };
+        let (direction, run) = (self.parse(d, |s| s.parse())?, self.parse(r, super::run)?);
+        let extra = self.extras();
+        Ok(match axis {
+            Axis::Rotary => Data::Positioning {
+                target_rad: target_si,
+                direction,
+                run,
+                deviation_rad: deviation_si,
+                extra,
+            },
+            Axis::Linear => Data::LinearPositioning {
+                target_m: target_si,
+                direction,
+                run,
+                deviation_m: deviation_si,
+                extra,
+            },
+        })
+    }
+
+    /// measured − target in SI units. In a common unit, subtract first and scale once:
+    /// exact for close values.
+    fn measured_minus_target(&self, measured: Col, target: Col) -> Result<Vec<f64>, Error> {
+        let same = measured.scale == target.scale;
+        let unit = |c: Col| if same { Col { scale: 1.0, ..c } } else { c };
+        let m = self.numbers(unit(measured), Any)?;
+        let t = self.numbers(unit(target), Any)?;
+        let scale = if same { target.scale } else { 1.0 };
+        let mut deviation = Vec::with_capacity(m.len());
+        for ((m, t), (line, _)) in m.iter().zip(&t).zip(&self.rows) {
+            let x = (m - t) * scale;
+            if !x.is_finite() {
+                let message = "measured − target is not finite".to_string();
+                return Err(self.cell(*line, measured.index, message));
+            }
+            deviation.push(x);
+        }
+        Ok(deviation)
+    }
+
+    /// Time, motor-shaft angle and table angle (rotary only: MODEL.md §5.4 evaluates
+    /// θt − θm·Rg·Rw over the table angle).
+    fn fluctuation(mut self, kind: Kind) -> Result<Data, Error> {
+        let t = self.column("time_s")?;
+        let m = self.required_position(&["motor_angle"])?;
+        let a = self.required_position(&["table_angle"])?;
+        let (time_s, motor_angle_rad, table_angle_rad) = (
+            self.numbers(t, Increasing)?,
+            self.numbers(m, Any)?,
+            self.numbers(a, Any)?,
+        );
+        let extra = self.extras();
+        Ok(if kind == Kind::Fluctuation {
+            Data::Fluctuation {
+                time_s,
+                motor_angle_rad,
+                table_angle_rad,
+                extra,
+            }
+        } else {
+            Data::Unbalance {
+                time_s,
+                motor_angle_rad,
+                table_angle_rad,
+                extra,
+            }
+        })
+    }
+
+    /// A frequency-response record: uniform time, motor torque or current, motor
+    /// angle, table (or load) angle.
+    fn record(mut self) -> Result<Data, Error> {
+        let t = self.column("time_s")?;
+        let (input, kind) = self.required_one_of(&RECORD_INPUT, "input")?;
+        let m = self.required_position(&["motor_angle"])?;
+        let a = self.required_position(&RECORD_LOAD)?;
+        let time_s = self.uniform_time(t)?;
+        let (input, motor_angle_rad, table_angle_rad) = (
+            self.numbers(input, Any)?,
+            self.numbers(m, Any)?,
+            self.numbers(a, Any)?,
+        );
+        let extra = self.extras();
+        Ok(match kind {
+            Input::Torque => Data::FrequencyResponseTime {
+                time_s,
+                motor_torque_nm: input,
+                motor_angle_rad,
+                table_angle_rad,
+                extra,
+            },
+            Input::Current => Data::FrequencyResponseTimeCurrent {
+                time_s,
+                motor_current_a: input,
+                motor_angle_rad,
+                table_angle_rad,
+                extra,
+            },
+        })
+    }
+
+    /// A servo trace: uniform time, reference and loop position, optional table
+    /// position, effort, optional controller output and added signal.
+    fn servo_trace(mut self) -> Result<Data, Error> {
+        let t = self.column("time_s")?;
+        let reference = self.required_position(&["reference_position"])?;
+        let position = self.required_position(&SERVO_LOOP)?;
+        let table = self.position(&["table_position"])?;
+        let effort = self.effort(&SERVO_EFFORT)?;
+        let axis = self.same_axis(&[Some(reference), Some(position), table, Some(effort)])?;
+        let output = self.command("controller_output")?;
+        let added = self.command("controller_added")?;
+        if let (Some((_, out)), Some((col, add))) = (output, added) {
+            if out != add {
+                let message = format!(
+                    "column `{}` is in {add} but the controller output in {out}: an added \
+                     signal is in the controller output's unit",
+                    self.header[col.index]
+                );
+                return Err(self.header_error(message));
+            }
+        }
+        let time_s = self.uniform_time(t)?;
+        let signal = |(col, unit): (Col, CommandUnit)| -> Result<Signal, Error> {
+            let values = self.numbers(col, Any)?;
+            Ok(Signal { unit, values })
+        };
+        Ok(Data::ServoTrace(ServoTrace {
+            axis,
+            time_s,
+            reference_position: self.numbers(reference, Any)?,
+            position: self.numbers(position, Any)?,
+            table_position: table.map(|c| self.numbers(c, Any)).transpose()?,
+            effort: self.numbers(effort, Any)?,
+            controller_output: output.map(signal).transpose()?,
+            controller_added: added.map(signal).transpose()?,
+            extra: self.extras(),
+        }))
+    }
+
+    /// Strictly increasing, uniformly sampled time.
+    fn uniform_time(&self, t: Col) -> Result<Vec<f64>, Error> {
+        let time_s = self.numbers(t, Increasing)?;
+        match crate::io::experiment_file::check_uniform(&time_s) {
+            Ok(()) => Ok(time_s),
+            Err(e) => Err(self.cell(self.rows[e.row].0, t.index, e.to_string())),
+        }
+    }
+}
+
+/// The column names the reader interprets for `kind`: an extra column must not take one.
+pub(in crate::io::experiment_file) fn reserved(kind: Kind) -> Vec<String> {
+    let (plain, positions): (Vec<&str>, Vec<&str>) = match kind {
+        Kind::FrequencyResponse => (vec!["frequency_hz", "gain_db"], vec!["phase"]),
+        Kind::Resonance => (vec![], vec![]),
+        Kind::TorqueCurve => (
+            vec!["time_s", CURVE_EFFORT[0].0, CURVE_EFFORT[1].0],
+            TABLE.to_vec(),
+        ),
+        Kind::Positioning => (vec!["direction", "run"], vec!["target", "deviation"]),
+        Kind::Fluctuation | Kind::Unbalance => (vec!["time_s"], vec!["motor_angle", "table_angle"]),
+        Kind::FrequencyResponseTime => {
+            let mut p = vec!["motor_angle"];
+            p.extend(RECORD_LOAD);
+            (vec!["time_s", RECORD_INPUT[0].0, RECORD_INPUT[1].0], p)
+        }
+        Kind::ServoTrace => {
+            let mut p = vec!["reference_position", "table_position"];
+            p.extend(SERVO_LOOP);
+            (vec!["time_s", SERVO_EFFORT[0].0, SERVO_EFFORT[1].0], p)
+        }
+    };
+    let position_names = positions.into_iter().flat_map(|b| {
+        units_for(b)
+            .iter()
+            .map(move |u| format!("{b}_{}", u.suffix))
+    });
+    let commands = ["controller_output", "controller_added"]
+        .into_iter()
+        .filter(|_| kind == Kind::ServoTrace)
+        .flat_map(|b| CommandUnit::ALL.map(|u| format!("{b}_{}", u.suffix())));
+    plain
+        .into_iter()
+        .map(str::to_string)
+        .chain(position_names)
+        .chain(commands)
+        .collect()
+}
