@@ -291,8 +291,13 @@ fn write_report(
     let (indices, file) = sweep::write_indices(sweep, rows, out)?;
     let charts = if sweep.method == Method::Grid {
         let design = sweep.design()?;
-        let y = sweep::output_columns(sweep, rows);
-        figures::grid_plots(&sweep.factors, &design.values, &sweep.output_columns(), &y)?
+        let y = sweep::output_matrix(sweep, rows);
+        figures::grid_plots(
+            &sweep.factors,
+            design.values.view(),
+            &sweep.output_columns(),
+            y.view(),
+        )?
     } else {
         figures::tornadoes(&indices)?
     };

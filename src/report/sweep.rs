@@ -4,6 +4,7 @@
 
 use std::collections::BTreeMap;
 
+use ndarray::{ArrayView1, ArrayView2};
 use plotters::prelude::*;
 
 use super::figure::{Figure, FigureError, Series, Style};
@@ -205,23 +206,24 @@ fn axis_label(f: &Factor) -> String {
 
 /// Plots of a grid: each output column over the factor (one factor: a line per
 /// output column) or over the two factors (a heat map per column); none for more
-/// factors. `values[i]` are the factor values of row i, `y[c][i]` output column c
-/// (NaN: missing). Returns (column, SVG).
+/// factors. Row `i` of `values` holds the factor values of design point `i`, row `i`
+/// of `y` its outputs (columns `names`; NaN: missing). Returns (column, SVG).
 pub fn grid_plots(
     factors: &[Factor],
-    values: &[Vec<f64>],
+    values: ArrayView2<f64>,
     names: &[String],
-    y: &[Vec<f64>],
+    y: ArrayView2<f64>,
 ) -> Result<Vec<(String, String)>, FigureError> {
     let mut charts = Vec::new();
-    for (name, col) in names.iter().zip(y) {
+    for (name, col) in names.iter().zip(y.columns()) {
         if col.iter().all(|v| !v.is_finite()) {
             continue;
         }
         let svg = match factors.len() {
             1 => {
                 let pts = values
-                    .iter()
+                    .rows()
+                    .into_iter()
                     .zip(col)
                     .map(|(v, &c)| (axis(&factors[0], v[0]), c))
                     .collect();
@@ -258,8 +260,8 @@ fn colour(t: f64) -> RGBColor {
 fn heat_map(
     name: &str,
     factors: &[Factor],
-    values: &[Vec<f64>],
-    col: &[f64],
+    values: ArrayView2<f64>,
+    col: ArrayView1<f64>,
 ) -> Result<String, FigureError> {
     let text = drawing(name);
     let (fx, fy) = (&factors[0], &factors[1]);
@@ -291,7 +293,7 @@ fn heat_map(
             .disable_mesh()
             .draw()
             .map_err(|e| text(&e))?;
-        c.draw_series(values.iter().zip(col).map(|(v, &z)| {
+        c.draw_series(values.rows().into_iter().zip(col).map(|(v, &z)| {
             let (x, y) = (axis(fx, v[0]), axis(fy, v[1]));
             let fill = if z.is_finite() {
                 colour((z - lo) / span).filled()

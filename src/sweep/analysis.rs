@@ -113,7 +113,7 @@ pub fn analyse(sweep: &Sweep, rows: &BTreeMap<usize, Vec<String>>) -> Result<Ind
                 .into_iter()
                 .map(|s| vec![s])
                 .collect(),
-            Method::Morris { .. } => match morris::indices(&design.unit, &y, k) {
+            Method::Morris { .. } => match morris::indices(design.unit.view(), &y, k) {
                 Some(m) => m
                     .iter()
                     .map(|m| vec![Some(m.mu_star), Some(m.mu), Some(m.sigma)])

@@ -18,6 +18,7 @@
 //!   the seed), and A_B^(i) (A with column i from B). Base row j gives the k + 2
 //!   points A_j, B_j, A_B^(1)_j … A_B^(k)_j, at indices j·(k + 2) + 0, 1, 2 + i.
 
+use ndarray::Array2;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use serde::{Deserialize, Serialize};
@@ -60,11 +61,11 @@ impl Method {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum DesignError {
-    #[error("no parameter to vary: give at least one --vary")]
+    #[error("no parameter to vary")]
     NoFactors,
-    #[error("--vary {name}: the {method} method needs a range NAME=LOW..HIGH")]
+    #[error("{name}: the {method} method needs a range LOW..HIGH")]
     NoRange { name: String, method: &'static str },
-    #[error("{name} is {value} at the base point: a logarithmic sensitivity needs a value other than 0 (use --set, or a global method)")]
+    #[error("{name} is {value} at the base point: a logarithmic sensitivity needs a value other than 0 (set another base value, or use a global method)")]
     ZeroBase { name: String, value: f64 },
     #[error("the grid has {points} points, more than the limit of {limit}: use fewer levels, or a Morris or Sobol design")]
     TooLarge { points: f64, limit: usize },
@@ -79,15 +80,16 @@ pub enum DesignError {
 /// Most points a grid may have (beyond this a global method is the better tool).
 pub const MAX_GRID_POINTS: usize = 1_000_000;
 
-/// The points of a design, as unit coordinates and as parameter values.
+/// The points of a design, as unit coordinates and as parameter values: one row per
+/// point, one column per factor.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Design {
     pub method: Method,
     pub factors: Vec<Factor>,
     /// Unit coordinates in [0, 1]^k (local: the log step, −h, 0 or +h).
-    pub unit: Vec<Vec<f64>>,
-    /// Parameter values, SI, one per factor.
-    pub values: Vec<Vec<f64>>,
+    pub unit: Array2<f64>,
+    /// Parameter values, SI.
+    pub values: Array2<f64>,
 }
 
 impl Design {
@@ -139,20 +141,27 @@ impl Design {
         Ok(Design {
             method: method.clone(),
             factors: factors.to_vec(),
-            unit,
-            values,
+            unit: matrix(unit, k),
+            values: matrix(values, k),
         })
     }
 
     /// Number of points.
     pub fn len(&self) -> usize {
-        self.values.len()
+        self.values.nrows()
     }
 
     /// Whether the design has no point.
     pub fn is_empty(&self) -> bool {
-        self.values.is_empty()
+        self.values.nrows() == 0
     }
+}
+
+/// Points (rows of `k` values) as a matrix.
+fn matrix(rows: Points, k: usize) -> Array2<f64> {
+    let n = rows.len();
+    Array2::from_shape_vec((n, k), rows.into_iter().flatten().collect())
+        .expect("every point has one value per factor")
 }
 
 fn setting(what: &'static str, value: f64, reason: &'static str) -> DesignError {
@@ -192,7 +201,7 @@ fn grid(factors: &[Factor]) -> Result<Vec<Vec<f64>>, DesignError> {
 fn local(factors: &[Factor], base: &[f64], step: f64) -> Result<(Points, Points), DesignError> {
     if !(step > 0.0 && step <= 0.5) {
         return Err(setting(
-            "--step",
+            "step",
             step,
             "the relative step must lie in (0, 0.5]",
         ));
@@ -228,14 +237,14 @@ fn morris(
 ) -> Result<Vec<Vec<f64>>, DesignError> {
     if trajectories < 2 {
         return Err(setting(
-            "--trajectories",
+            "trajectories",
             trajectories as f64,
             "at least 2 are needed for σ",
         ));
     }
     if levels < 2 || levels % 2 != 0 {
         return Err(setting(
-            "--levels",
+            "levels",
             levels as f64,
             "the Morris grid needs an even number of levels ≥ 2",
         ));
@@ -270,7 +279,7 @@ fn morris(
 fn saltelli(k: usize, samples: usize, seed: u64) -> Result<Vec<Vec<f64>>, DesignError> {
     if !(2..=MAX_SOBOL_SAMPLES).contains(&samples) {
         return Err(setting(
-            "--samples",
+            "samples",
             samples as f64,
             "the base sample must lie in 2..=65536",
         ));
@@ -317,9 +326,9 @@ mod tests {
     fn the_grid_varies_the_first_factor_slowest() {
         let d = Design::new(&Method::Grid, &factors(2), &[], 0).unwrap();
         assert_eq!(d.len(), 9);
-        assert_eq!(d.values[1], vec![1.0, 1.5]);
-        assert_eq!(d.values[3], vec![1.5, 1.0]);
-        assert_eq!(d.values[8], vec![2.0, 2.0]);
+        assert_eq!(d.values.row(1).to_vec(), vec![1.0, 1.5]);
+        assert_eq!(d.values.row(3).to_vec(), vec![1.5, 1.0]);
+        assert_eq!(d.values.row(8).to_vec(), vec![2.0, 2.0]);
     }
 
     #[test]
@@ -336,20 +345,18 @@ mod tests {
         )
         .unwrap();
         let delta = 4.0 / 6.0;
-        for t in d.unit.chunks(k + 1) {
+        for t in d.unit.axis_chunks_iter(ndarray::Axis(0), k + 1) {
             let mut changed = vec![false; k];
-            for w in t.windows(2) {
-                let diff: Vec<usize> = (0..k).filter(|&i| w[0][i] != w[1][i]).collect();
+            for s in 0..k {
+                let (a, b) = (t.row(s), t.row(s + 1));
+                let diff: Vec<usize> = (0..k).filter(|&i| a[i] != b[i]).collect();
                 assert_eq!(diff.len(), 1);
                 let i = diff[0];
-                assert!(((w[1][i] - w[0][i]).abs() - delta).abs() < 1e-12);
+                assert!(((b[i] - a[i]).abs() - delta).abs() < 1e-12);
                 assert!(!changed[i]);
                 changed[i] = true;
             }
-            assert!(t
-                .iter()
-                .flatten()
-                .all(|&u| (-1e-12..=1.0 + 1e-12).contains(&u)));
+            assert!(t.iter().all(|&u| (-1e-12..=1.0 + 1e-12).contains(&u)));
         }
     }
 
@@ -367,11 +374,11 @@ mod tests {
         )
         .unwrap();
         assert_eq!(d.len(), 8 * (k + 2));
-        for row in d.unit.chunks(k + 2) {
-            let (a, b) = (&row[0], &row[1]);
+        for block in d.unit.axis_chunks_iter(ndarray::Axis(0), k + 2) {
+            let (a, b) = (block.row(0), block.row(1));
             for i in 0..k {
                 for j in 0..k {
-                    assert_eq!(row[2 + i][j], if i == j { b[j] } else { a[j] });
+                    assert_eq!(block[[2 + i, j]], if i == j { b[j] } else { a[j] });
                 }
             }
         }

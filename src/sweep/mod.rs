@@ -27,6 +27,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Mutex;
 
+use ndarray::Array2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -198,10 +199,10 @@ impl Sweep {
 
     /// The row of design point `index` (fields as written to the file).
     pub fn row(&self, design: &Design, evaluator: &Evaluator, index: usize) -> Vec<String> {
-        let values = &design.values[index];
+        let values = design.values.row(index).to_vec();
         let n_out = evaluator.columns().len();
         let result = self
-            .params_at(values)
+            .params_at(&values)
             .map_err(outputs::OutputError::from)
             .and_then(|p| evaluator.evaluate(&p));
         let mut row = Vec::with_capacity(2 + values.len() + n_out);
@@ -378,15 +379,16 @@ pub fn write_indices(
     Ok((indices, Some(path)))
 }
 
-/// The output columns of complete rows as numbers: `y[c][i]` is output column `c` of
-/// the row of design point `i` (NaN where it is empty).
-pub fn output_columns(sweep: &Sweep, rows: &BTreeMap<usize, Vec<String>>) -> Vec<Vec<f64>> {
+/// The outputs of complete rows as numbers: row `i` holds design point `i`'s output
+/// columns (NaN where empty).
+pub fn output_matrix(sweep: &Sweep, rows: &BTreeMap<usize, Vec<String>>) -> Array2<f64> {
     let k = sweep.factors.len();
-    (0..sweep.output_columns().len())
-        .map(|j| {
-            rows.values()
-                .map(|r| r[1 + k + j].parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect()
+    let columns = sweep.output_columns().len();
+    let mut y = Array2::from_elem((rows.len(), columns), f64::NAN);
+    for (mut out, r) in y.rows_mut().into_iter().zip(rows.values()) {
+        for (j, cell) in out.iter_mut().enumerate() {
+            *cell = r[1 + k + j].parse().unwrap_or(f64::NAN);
+        }
+    }
+    y
 }

@@ -7,6 +7,7 @@
 //! effects), σ_i = sample standard deviation of EE_i (interaction or non-linearity).
 //! All three carry the output's unit.
 
+use ndarray::{ArrayView2, Axis};
 use serde::Serialize;
 
 /// Elementary-effect statistics of one factor for one output, output units.
@@ -19,14 +20,15 @@ pub struct MorrisIndex {
 
 /// The statistics of each factor from unit points `unit` and outputs `y` in design
 /// order (trajectories of k + 1 points). `None` if the points are not trajectories.
-pub fn indices(unit: &[Vec<f64>], y: &[f64], k: usize) -> Option<Vec<MorrisIndex>> {
-    if y.len() != unit.len() || unit.len() % (k + 1) != 0 || unit.is_empty() {
+pub fn indices(unit: ArrayView2<f64>, y: &[f64], k: usize) -> Option<Vec<MorrisIndex>> {
+    let n = unit.nrows();
+    if y.len() != n || n % (k + 1) != 0 || n == 0 || unit.ncols() != k {
         return None;
     }
     let mut effects: Vec<Vec<f64>> = vec![Vec::new(); k];
-    for (points, values) in unit.chunks(k + 1).zip(y.chunks(k + 1)) {
+    for (points, values) in unit.axis_chunks_iter(Axis(0), k + 1).zip(y.chunks(k + 1)) {
         for s in 0..k {
-            let (x0, x1) = (&points[s], &points[s + 1]);
+            let (x0, x1) = (points.row(s), points.row(s + 1));
             let i = (0..k).find(|&i| x0[i] != x1[i])?;
             effects[i].push((values[s + 1] - values[s]) / (x1[i] - x0[i]));
         }
@@ -71,7 +73,7 @@ mod tests {
             .iter()
             .map(|x| 3.0 * x[0] - 2.0 * x[1] + 4.0 * x[1] * x[2])
             .collect();
-        let s = indices(&d.unit, &y, 3).unwrap();
+        let s = indices(d.unit.view(), &y, 3).unwrap();
         assert!((s[0].mu_star - 3.0).abs() < 1e-12 && (s[0].mu - 3.0).abs() < 1e-12);
         assert!(s[0].sigma < 1e-12);
         assert!(s[1].sigma > 0.5 && s[2].sigma > 0.5, "{s:?}");

@@ -372,8 +372,6 @@ pub(super) fn simulate_all(
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-
     #[test]
     fn the_sine_fit_ignores_offset_and_drift() {
         let omega = std::f64::consts::TAU * 50.0;
@@ -382,7 +380,7 @@ mod tests {
             .iter()
             .map(|&t| 3.0 + 20.0 * t - 5.0 * t * t + 0.7 * (omega * t + 0.4).sin())
             .collect();
-        let [(a, phi)] = super::crate::experiments::stepped_sine::components(&t, [&x], omega);
+        let [(a, phi)] = crate::experiments::stepped_sine::components(&t, [&x], omega);
         assert!(
             (a - 0.7).abs() < 1e-9 && (phi - 0.4).abs() < 1e-9,
             "{a} {phi}"
