@@ -9,6 +9,8 @@
 //! a temporary folder.
 //! `sweep/point/nonlinear_short`: one point of reversal, repeatability, accuracy,
 //! fluctuation_pp and torque_rms with the short tests.
+//! `sweep/design/sobol_4096x3`: the Saltelli design of 4096 base rows, 3 factors
+//! (20 480 points) built into its matrices.
 //! `sweep/ishigami_indices`: Sobol S1/ST with 100 bootstrap resamples from
 //! 4096 × (3 + 2) outputs (the analysis alone).
 
@@ -94,9 +96,13 @@ fn benches(c: &mut Criterion) {
     let d = Design::new(&m, &factors, &[], 0).unwrap();
     let y: Vec<f64> = d
         .values
-        .iter()
+        .rows()
+        .into_iter()
         .map(|x| x[0].sin() + 7.0 * x[1].sin().powi(2) + 0.1 * x[2].powi(4) * x[0].sin())
         .collect();
+    group.bench_function("design/sobol_4096x3", |b| {
+        b.iter(|| Design::new(&m, &factors, &[], 0).unwrap())
+    });
     group.bench_function("ishigami_indices", |b| {
         b.iter(|| sobol::indices(&y, 3, 4096, 100, 0.95, 0).unwrap())
     });

@@ -32,7 +32,12 @@ fn sobol_indices_of_the_ishigami_function_match_the_analytic_values() {
             bootstrap: 100,
         };
         let d = Design::new(&method, &factors, &[], seed).unwrap();
-        let y: Vec<f64> = d.values.iter().map(|x| ishigami(x)).collect();
+        let y: Vec<f64> = d
+            .values
+            .rows()
+            .into_iter()
+            .map(|x| ishigami(&x.to_vec()))
+            .collect();
         let s = sobol::indices(&y, 3, samples, 100, 0.95, seed).unwrap();
         for i in 0..3 {
             assert!(

@@ -70,7 +70,8 @@ mod tests {
         // y = 3·x0 − 2·x1 + 4·x1·x2
         let y: Vec<f64> = d
             .unit
-            .iter()
+            .rows()
+            .into_iter()
             .map(|x| 3.0 * x[0] - 2.0 * x[1] + 4.0 * x[1] * x[2])
             .collect();
         let s = indices(d.unit.view(), &y, 3).unwrap();

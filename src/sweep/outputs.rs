@@ -80,11 +80,6 @@ impl Output {
         }
     }
 
-    /// Whether it comes from the linear model (fast: well under a millisecond).
-    pub fn is_linear(self) -> bool {
-        matches!(self, Output::Resonances | Output::PeakGain | Output::Modes)
-    }
-
     /// Its CSV columns (units in the names) for a drive of `topology`.
     pub fn columns(self, topology: Topology) -> Vec<String> {
         let held_modes = match topology {
