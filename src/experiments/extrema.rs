@@ -83,7 +83,11 @@ pub struct Extrema {
 #[non_exhaustive]
 pub enum ExtremaError {
     #[error("freq_hz, gain_db and sigma_db have {freq}, {gain} and {sigma} points: they must be as long")]
-    Lengths { freq: usize, gain: usize, sigma: usize },
+    Lengths {
+        freq: usize,
+        gain: usize,
+        sigma: usize,
+    },
     #[error("{field}[{index}] = {value} is not a finite number (sigma_db: and not negative)")]
     BadValue {
         field: &'static str,
@@ -151,7 +155,11 @@ fn check(f: &[f64], g: &[f64], s: &[f64], opts: &ExtremaOptions) -> Result<(), E
         let bad = |v: f64| !v.is_finite() || (field == "sigma_db" && v < 0.0);
         if let Some(index) = values.iter().position(|&v| bad(v)) {
             let value = values[index];
-            return Err(ExtremaError::BadValue { field, index, value });
+            return Err(ExtremaError::BadValue {
+                field,
+                index,
+                value,
+            });
         }
     }
     if let Some(i) = (1..f.len()).find(|&i| f[i] <= f[i - 1]) {
@@ -243,7 +251,8 @@ mod tests {
         let k = jl * (std::f64::consts::TAU * 54.0).powi(2);
         let c = 0.04 * (k * jl).sqrt();
         let s = Complex::new(0.0, std::f64::consts::TAU * f);
-        let motor = (jl * s * s + c * s + k) / (s * s * (jm * jl * s * s + c * (jm + jl) * s + k * (jm + jl)));
+        let motor = (jl * s * s + c * s + k)
+            / (s * s * (jm * jl * s * s + c * (jm + jl) * s + k * (jm + jl)));
         let w = std::f64::consts::TAU * 180.0;
         let sensor = w * w / (s * s + 2.0 * 0.03 * w * s + w * w);
         20.0 * (motor * sensor).norm().log10()
@@ -265,12 +274,14 @@ mod tests {
         (max, min)
     }
 
-
     fn noisy(sigma: f64, seed: u64) -> (Vec<f64>, Vec<f64>) {
         let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
         let noise = Normal::new(0.0, sigma).unwrap();
         let f: Vec<f64> = (20..=300).map(f64::from).collect();
-        let g = f.iter().map(|&f| curve(f) + noise.sample(&mut rng)).collect();
+        let g = f
+            .iter()
+            .map(|&f| curve(f) + noise.sample(&mut rng))
+            .collect();
         (f, g)
     }
 
@@ -289,7 +300,10 @@ mod tests {
             let found = at(&e.maxima).into_iter().chain(at(&e.minima));
             let exact = max.iter().chain(&min);
             for ((found, exact), tol) in found.zip(exact).zip(tolerance) {
-                assert!((found - exact).abs() < tol, "seed {seed}: {found} vs {exact}");
+                assert!(
+                    (found - exact).abs() < tol,
+                    "seed {seed}: {found} vs {exact}"
+                );
             }
         }
     }
@@ -317,11 +331,18 @@ mod tests {
     #[test]
     fn the_parabola_is_exact_for_a_parabola_and_the_band_limits_the_search() {
         let f: Vec<f64> = (0..11).map(|i| 1000.0 + 2.0 * i as f64).collect();
-        let g: Vec<f64> = f.iter().map(|x| 10.0 - 0.5 * (x - 1009.3).powi(2)).collect();
+        let g: Vec<f64> = f
+            .iter()
+            .map(|x| 10.0 - 0.5 * (x - 1009.3).powi(2))
+            .collect();
         let s = vec![0.0; f.len()];
         let e = extrema(&f, &g, &s, &ExtremaOptions::default()).unwrap();
         assert_eq!(e.maxima.len(), 1);
-        assert!((e.maxima[0].frequency_hz - 1009.3).abs() < 1e-9, "{:?}", e.maxima);
+        assert!(
+            (e.maxima[0].frequency_hz - 1009.3).abs() < 1e-9,
+            "{:?}",
+            e.maxima
+        );
         assert!((e.maxima[0].gain_db - 10.0).abs() < 1e-9);
         let band = ExtremaOptions {
             band_hz: Some((1012.0, 1020.0)),
@@ -340,23 +361,30 @@ mod tests {
         ));
         assert!(matches!(
             extrema(&f, &[0.0, f64::NAN, 0.0], &[0.0; 3], &o),
-            Err(ExtremaError::BadValue { field: "gain_db", index: 1, .. })
+            Err(ExtremaError::BadValue {
+                field: "gain_db",
+                index: 1,
+                ..
+            })
         ));
         assert!(matches!(
             extrema(&f, &[0.0; 3], &[0.0, -1.0, 0.0], &o),
-            Err(ExtremaError::BadValue { field: "sigma_db", .. })
+            Err(ExtremaError::BadValue {
+                field: "sigma_db",
+                ..
+            })
         ));
         assert!(matches!(
             extrema(&[1.0, 1.0, 2.0], &[0.0; 3], &[0.0; 3], &o),
             Err(ExtremaError::NotIncreasing { index: 1, .. })
         ));
-        let bad = ExtremaOptions {
-            k_sigma: -1.0,
-            ..o
-        };
+        let bad = ExtremaOptions { k_sigma: -1.0, ..o };
         assert!(matches!(
             extrema(&f, &[0.0; 3], &[0.0; 3], &bad),
-            Err(ExtremaError::BadOption { field: "k_sigma", .. })
+            Err(ExtremaError::BadOption {
+                field: "k_sigma",
+                ..
+            })
         ));
     }
 }

@@ -7,6 +7,8 @@ pub mod frequency_response;
 pub mod frequency_response_estimate;
 pub mod frequency_response_record;
 pub mod iso230;
+pub mod line_scatter;
+pub mod local_mode_fit;
 pub mod measurement_noise;
 pub mod multisine;
 pub mod nonlinear_distortion;

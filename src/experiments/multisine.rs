@@ -268,7 +268,10 @@ mod tests {
         let n = period.len();
         let mut buf: Vec<Complex<f64>> = period.iter().map(|&v| Complex::new(v, 0.0)).collect();
         FftPlanner::new().plan_fft_forward(n).process(&mut buf);
-        buf[..n / 2].iter().map(|c| 2.0 * c.norm() / n as f64).collect()
+        buf[..n / 2]
+            .iter()
+            .map(|c| 2.0 * c.norm() / n as f64)
+            .collect()
     }
 
     #[test]
@@ -326,7 +329,10 @@ mod tests {
             assert_eq!(kept, group - 1, "{chunk:?}");
         }
         // Seeded: the same seed the same set, another seed another set.
-        assert_eq!(random, excited_lines(&spec(ro, PhaseRule::Schroeder)).unwrap());
+        assert_eq!(
+            random,
+            excited_lines(&spec(ro, PhaseRule::Schroeder)).unwrap()
+        );
         let other = LineSet::RandomOdd { group, seed: 8 };
         assert_ne!(
             random,

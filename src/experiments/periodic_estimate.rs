@@ -44,6 +44,7 @@
 use rustfft::num_complex::Complex;
 use serde::Serialize;
 
+use super::line_scatter;
 use super::nonlinear_distortion::{self, DistortionBand};
 use super::periodic_record::{PeriodSpectra, PeriodicError, PeriodicRecord};
 
@@ -84,6 +85,9 @@ pub struct FrfLine {
     pub nonlinear_sigma_rel: Option<f64>,
     /// σ of |H| in dB from noise and nonlinear distortion together.
     pub total_gain_sigma_db: f64,
+    /// The gain's scatter from line to line, dB ([`super::line_scatter`]): what the
+    /// periods cannot show (stochastic nonlinear distortion of a full multisine).
+    pub scatter_gain_sigma_db: f64,
 }
 
 impl FrfLine {
@@ -128,11 +132,26 @@ impl FrfEstimate {
     pub fn total_gain_sigma_db(&self) -> Vec<f64> {
         self.lines.iter().map(|l| l.total_gain_sigma_db).collect()
     }
+    /// The uncertainty of the gain as far as the record tells, dB: the larger of
+    /// `total_gain_sigma_db` and `scatter_gain_sigma_db` at each line — the σ to
+    /// search resonances with ([`super::extrema`]).
+    pub fn gain_uncertainty_db(&self) -> Vec<f64> {
+        let larger = |l: &FrfLine| l.total_gain_sigma_db.max(l.scatter_gain_sigma_db);
+        self.lines.iter().map(larger).collect()
+    }
+    /// H at each line.
+    pub fn h(&self) -> Vec<Complex<f64>> {
+        self.lines.iter().map(FrfLine::h).collect()
+    }
 }
 
 /// H1 of `output` over `input` (module docs), both sampled with the record's
 /// reference; `input` may be the reference itself.
-pub fn h1(rec: &PeriodicRecord, input: &[f64], output: &[f64]) -> Result<FrfEstimate, PeriodicError> {
+pub fn h1(
+    rec: &PeriodicRecord,
+    input: &[f64],
+    output: &[f64],
+) -> Result<FrfEstimate, PeriodicError> {
     let x = rec.spectra("input", input)?;
     let y = rec.spectra("output", output)?;
     let nl = nonlinear_relative(rec, &[&y], &[]);
@@ -141,7 +160,11 @@ pub fn h1(rec: &PeriodicRecord, input: &[f64], output: &[f64]) -> Result<FrfEsti
         .iter()
         .zip(nl)
         .map(|(&k, nl)| {
-            let a: Vec<_> = y.line(k).zip(x.line(k)).map(|(y, x)| y * x.conj()).collect();
+            let a: Vec<_> = y
+                .line(k)
+                .zip(x.line(k))
+                .map(|(y, x)| y * x.conj())
+                .collect();
             let b: Vec<_> = x.line(k).map(|x| Complex::new(x.norm_sqr(), 0.0)).collect();
             let g = coherence(&x, &y, k);
             line(rec, k, &a, &b, g, nl, "input")
@@ -166,8 +189,16 @@ pub fn reference_ratio(
         .iter()
         .zip(nl)
         .map(|(&k, nl)| {
-            let a: Vec<_> = y.line(k).zip(r.line(k)).map(|(y, r)| y * r.conj()).collect();
-            let b: Vec<_> = x.line(k).zip(r.line(k)).map(|(x, r)| x * r.conj()).collect();
+            let a: Vec<_> = y
+                .line(k)
+                .zip(r.line(k))
+                .map(|(y, r)| y * r.conj())
+                .collect();
+            let b: Vec<_> = x
+                .line(k)
+                .zip(r.line(k))
+                .map(|(x, r)| x * r.conj())
+                .collect();
             let g = coherence(&x, &y, k);
             line(rec, k, &a, &b, g, nl, "denominator")
         })
@@ -178,10 +209,16 @@ pub fn reference_ratio(
 fn estimate(
     rec: &PeriodicRecord,
     estimator: Estimator,
-    lines: Vec<FrfLine>,
+    mut lines: Vec<FrfLine>,
     y: &PeriodSpectra,
     x: &PeriodSpectra,
 ) -> FrfEstimate {
+    let f: Vec<f64> = lines.iter().map(|l| l.frequency_hz).collect();
+    let g: Vec<f64> = lines.iter().map(|l| l.gain_db).collect();
+    let scatter = line_scatter::scatter(&f, &g, rec.options.scatter_half_window);
+    for (l, s) in lines.iter_mut().zip(scatter) {
+        l.scatter_gain_sigma_db = s;
+    }
     let spacing = rec.spacing_hz();
     let edges = match &rec.options.band_edges_hz {
         Some(e) => e.clone(),
@@ -222,12 +259,21 @@ fn coherence(x: &PeriodSpectra, y: &PeriodSpectra, k: usize) -> f64 {
 /// Relative nonlinear variance of H at each excited line: the sum over the channels
 /// of their odd-degree distortion power over |X̄|² (H1: the output's only — the
 /// input's distortion is part of the excitation the system sees).
-fn nonlinear_relative(rec: &PeriodicRecord, outputs: &[&PeriodSpectra], inputs: &[&PeriodSpectra]) -> Vec<Option<f64>> {
+fn nonlinear_relative(
+    rec: &PeriodicRecord,
+    outputs: &[&PeriodSpectra],
+    inputs: &[&PeriodSpectra],
+) -> Vec<Option<f64>> {
     let k = rec.options.nonlinear_neighbours;
     let per_channel: Vec<(Vec<Option<f64>>, &PeriodSpectra)> = outputs
         .iter()
         .chain(inputs)
-        .map(|s| (nonlinear_distortion::power_at_excited(s, &rec.excited, k), *s))
+        .map(|s| {
+            (
+                nonlinear_distortion::power_at_excited(s, &rec.excited, k),
+                *s,
+            )
+        })
         .collect();
     rec.excited
         .iter()
@@ -262,7 +308,11 @@ fn line(
         return Err(PeriodicError::LineNotExcited { channel, line: k });
     }
     let h = a.iter().sum::<Complex<f64>>() / p / b_mean;
-    let unit = if h.norm() > 0.0 { h / h.norm() } else { Complex::new(1.0, 0.0) };
+    let unit = if h.norm() > 0.0 {
+        h / h.norm()
+    } else {
+        Complex::new(1.0, 0.0)
+    };
     let (mut radial, mut across) = (0.0, 0.0);
     for (a, b) in a.iter().zip(b) {
         let e = (a - h * b) / b_mean * unit.conj();
@@ -272,7 +322,13 @@ fn line(
     let norm = p * (p - 1.0);
     let (radial, across) = (radial / norm, across / norm);
     let modulus = h.norm();
-    let rel = |v: f64| if modulus > 0.0 { v.sqrt() / modulus } else { NO_INFORMATION };
+    let rel = |v: f64| {
+        if modulus > 0.0 {
+            v.sqrt() / modulus
+        } else {
+            NO_INFORMATION
+        }
+    };
     let gain_rel = rel(radial);
     let total = (gain_rel * gain_rel + nl.unwrap_or(0.0) / 2.0).sqrt();
     Ok(FrfLine {
@@ -288,5 +344,82 @@ fn line(
         phase_sigma_deg: rel(across).atan().to_degrees(),
         nonlinear_sigma_rel: nl.map(f64::sqrt),
         total_gain_sigma_db: (DB_PER_NEPER * total).min(NO_INFORMATION),
+        scatter_gain_sigma_db: 0.0, // filled in by `estimate`
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiments::periodic_record::PeriodicOptions;
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+    use std::f64::consts::TAU;
+
+    /// 400 periods of 64 samples: r = cos on lines 3 and 7; the "motor" m = r plus white
+    /// noise of `noise` rms; the "load" l = 2·(r delayed by one sample) plus a little
+    /// noise of its own (l/m = 2·e^{−iω} on the periodic part).
+    fn channels(noise: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(9);
+        let white = Normal::new(0.0, noise).unwrap();
+        let r = |i: usize| {
+            let t = i as f64 / 64.0;
+            (TAU * 3.0 * t).cos() + (TAU * 7.0 * t + 0.5).cos()
+        };
+        let n = 400 * 64;
+        let reference: Vec<f64> = (0..n).map(r).collect();
+        let motor: Vec<f64> = (0..n).map(|i| r(i) + white.sample(&mut rng)).collect();
+        let load: Vec<f64> = (0..n)
+            .map(|i| 2.0 * r(i + 63) + 0.05 * white.sample(&mut rng))
+            .collect();
+        (reference, motor, load)
+    }
+
+    #[test]
+    fn the_reference_ratio_is_unbiased_where_h1_over_a_noisy_motor_is_not() {
+        let (r, m, l) = channels(2.0);
+        let o = PeriodicOptions {
+            samples_per_period: Some(64),
+            ..Default::default()
+        };
+        let rec = PeriodicRecord::new(&r, 64.0, &o).unwrap();
+        assert_eq!(rec.excited, vec![3, 7]);
+        let ratio = reference_ratio(&rec, &l, &m).unwrap();
+        let biased = h1(&rec, &m, &l).unwrap();
+        for (a, b) in ratio.lines.iter().zip(&biased.lines) {
+            let truth = Complex::from_polar(2.0, -TAU * a.line as f64 / 64.0);
+            // Within 3 σ of the truth.
+            let sigma = a.noise_sigma_rel * truth.norm();
+            assert!((a.h() - truth).norm() < 3.0 * sigma, "{a:?} vs {truth}");
+            // H1 divides by Σ|M|² = P·(|M₀|² + σ²): low by 1/(1 + σ²/|M₀|²). Line
+            // amplitude 1; white noise of 2 rms leaves (2/N)²·N·4 = 0.25 per line: 0.8.
+            // Its random error: √(0.25/2/399) ≈ 0.018 radially; 3.5 of them allowed.
+            let expected = 1.0 / (1.0 + 0.25);
+            let low = b.h().norm() / truth.norm();
+            assert!((low - expected).abs() < 0.063, "{low} vs {expected}");
+        }
+    }
+
+    #[test]
+    fn a_line_without_input_power_is_an_error_naming_it() {
+        let (r, m, l) = channels(0.1);
+        let o = PeriodicOptions {
+            samples_per_period: Some(64),
+            ..Default::default()
+        };
+        let rec = PeriodicRecord::new(&r, 64.0, &o).unwrap();
+        let silent = vec![0.0; r.len()];
+        let e = h1(&rec, &silent, &l).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                PeriodicError::LineNotExcited {
+                    channel: "input",
+                    line: 3
+                }
+            ),
+            "{e}"
+        );
+        assert!(reference_ratio(&rec, &l, &m).is_ok());
+    }
 }

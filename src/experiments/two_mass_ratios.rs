@@ -98,7 +98,10 @@ mod tests {
         ));
         assert!(matches!(
             from_frequencies(f64::NAN, 60.0),
-            Err(TwoMassError::BadFrequency { field: "resonance_hz", .. })
+            Err(TwoMassError::BadFrequency {
+                field: "resonance_hz",
+                ..
+            })
         ));
     }
 }
