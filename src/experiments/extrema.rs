@@ -225,7 +225,7 @@ fn vertex(x: &[f64], y: &[f64]) -> (f64, f64) {
     let d = (x0 - x1) * (x0 - x2) * (x1 - x2);
     let a = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / d;
     let b = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / d;
-    if !(a < 0.0) {
+    if a.is_nan() || a >= 0.0 {
         return (x1, y1);
     }
     let xv = (-b / (2.0 * a)).clamp(x0, x2);

@@ -281,7 +281,8 @@ fn se(cov: &DMatrix<f64>, g: &[f64; 5]) -> f64 {
 /// standard errors not yet known (zero).
 fn pair(a: f64, b: f64, c: f64, w_ref: f64) -> Option<SecondOrder> {
     // Complex roots iff b² < 4ac, which also makes c/a positive.
-    if !(b * b < 4.0 * a * c) {
+    let discriminant = b * b - 4.0 * a * c;
+    if discriminant.is_nan() || discriminant >= 0.0 {
         return None;
     }
     let w = (c / a).sqrt();
