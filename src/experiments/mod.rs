@@ -1,15 +1,23 @@
 //! The paper's five tests (MODEL.md §5): virtual experiments and the evaluation of their measured data.
 
 pub mod compare;
+pub mod extrema;
 pub mod fluctuation;
 pub mod frequency_response;
 pub mod frequency_response_estimate;
 pub mod frequency_response_record;
 pub mod inverse_dynamics;
 pub mod iso230;
+pub mod line_scatter;
+pub mod local_mode_fit;
 pub mod measurement_noise;
+pub mod multisine;
+pub mod nonlinear_distortion;
+pub mod periodic_estimate;
+pub mod periodic_record;
 pub mod positioning;
 pub mod spectrum;
 pub mod stepped_sine;
 pub mod torque_curve;
+pub mod two_mass_ratios;
 pub mod welch;
