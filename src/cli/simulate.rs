@@ -219,28 +219,36 @@ impl<W: Write> Recorder for CsvRecorder<W> {
     }
 }
 
+impl Args {
+    /// The numeric options, checked before anything runs.
+    fn check(&self) -> anyhow::Result<()> {
+        if !(self.duration_s > 0.0 && self.duration_s.is_finite()) {
+            bail!(
+                "--duration-s {}: must be a positive number of seconds",
+                self.duration_s
+            );
+        }
+        if !(self.sample_s > 0.0 && self.sample_s.is_finite()) {
+            bail!(
+                "--sample-s {}: must be a positive number of seconds",
+                self.sample_s
+            );
+        }
+        if !self.load_nm.is_finite() {
+            bail!("--load-nm {}: must be a finite torque in N·m", self.load_nm);
+        }
+        Ok(())
+    }
+}
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.model.load()?;
-    if !(a.duration_s > 0.0 && a.duration_s.is_finite()) {
-        bail!(
-            "--duration-s {}: must be a positive number of seconds",
-            a.duration_s
-        );
-    }
+    a.check()?;
     let mut sim = match a.dt_s {
         Some(dt) => Simulation::new(&p, dt)?,
         None => Simulation::with_default_step(&p)?,
     };
     sim.set_load(a.load_nm);
-    if !(a.sample_s > 0.0 && a.sample_s.is_finite()) {
-        bail!(
-            "--sample-s {}: must be a positive number of seconds",
-            a.sample_s
-        );
-    }
-    if !a.load_nm.is_finite() {
-        bail!("--load-nm {}: must be a finite torque in N·m", a.load_nm);
-    }
     let every = ((a.sample_s / sim.dt()).round() as u64).max(1);
     let started = Instant::now();
     let closed = matches!(a.input, InputSpec::Move { .. });
@@ -248,89 +256,102 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         InputSpec::File(path) => Some(torque_file::read(path)?),
         _ => None,
     };
-    let result = write_csv(
+    write_csv(
         &a.out,
         closed,
-        |rec| match &a.input {
-            InputSpec::Sine {
-                freq_hz,
-                amp_nm,
-                offset_nm,
-            } => {
-                let mut input = Sine::new(*freq_hz, *amp_nm, *offset_nm);
-                sim.run_open_loop(&mut input, a.duration_s, rec)
-            }
-            InputSpec::Step { torque_nm, at_s } => {
-                let mut input = Step {
-                    torque_nm: *torque_nm,
-                    at_s: *at_s,
-                };
-                sim.run_open_loop(&mut input, a.duration_s, rec)
-            }
-            InputSpec::File(_) => {
-                let (t, q) = recorded.take().expect("read above");
-                sim.run_open_loop(&mut Samples::new(t, q), a.duration_s, rec)
-            }
-            InputSpec::None => sim.run_open_loop(&mut NoTorque, a.duration_s, rec),
-            InputSpec::Move {
-                target_deg,
-                speed_deg_per_min,
-                loop_mode,
-            } => {
-                let mut q = p.clone();
-                if let Some(m) = loop_mode {
-                    q.controller.loop_mode = *m;
-                }
-                let mut controller = sim.controller(&q)?;
-                let m = Move {
-                    from: 0.0,
-                    to: target_deg.to_radians(),
-                    speed: speed_deg_per_min.map(|v| v.to_radians() / 60.0),
-                };
-                rec.reference = Some((m, 0.0));
-                sim.run_closed_loop(&mut controller, &m, a.duration_s, rec)
-            }
-        },
+        |rec| drive(&mut sim, &p, &a.input, recorded.take(), a.duration_s, rec),
         every,
-    );
-    result?;
+    )?;
     let wall = started.elapsed().as_secs_f64();
+    print_summary(&a, &sim, p.ratio(), wall)
+}
+
+/// Runs `duration` s of `input` (`recorded`: the torque file's samples) on `sim`.
+fn drive<W: Write>(
+    sim: &mut Simulation,
+    p: &rtid::model::Params,
+    input: &InputSpec,
+    recorded: Option<(Vec<f64>, Vec<f64>)>,
+    duration: f64,
+    rec: &mut CsvRecorder<W>,
+) -> Result<(), rtid::sim::SimError> {
+    match input {
+        InputSpec::Sine {
+            freq_hz,
+            amp_nm,
+            offset_nm,
+        } => sim.run_open_loop(&mut Sine::new(*freq_hz, *amp_nm, *offset_nm), duration, rec),
+        InputSpec::Step { torque_nm, at_s } => {
+            let mut input = Step {
+                torque_nm: *torque_nm,
+                at_s: *at_s,
+            };
+            sim.run_open_loop(&mut input, duration, rec)
+        }
+        InputSpec::File(_) => {
+            let (t, q) = recorded.expect("read before the run");
+            sim.run_open_loop(&mut Samples::new(t, q), duration, rec)
+        }
+        InputSpec::None => sim.run_open_loop(&mut NoTorque, duration, rec),
+        InputSpec::Move {
+            target_deg,
+            speed_deg_per_min,
+            loop_mode,
+        } => {
+            let mut q = p.clone();
+            if let Some(m) = loop_mode {
+                q.controller.loop_mode = *m;
+            }
+            let mut controller = sim.controller(&q)?;
+            let m = Move {
+                from: 0.0,
+                to: target_deg.to_radians(),
+                speed: speed_deg_per_min.map(|v| v.to_radians() / 60.0),
+            };
+            rec.reference = Some((m, 0.0));
+            sim.run_closed_loop(&mut controller, &m, duration, rec)
+        }
+    }
+}
+
+/// The run's summary: steps, wall time, final angles; a table or JSON.
+fn print_summary(a: &Args, sim: &Simulation, ratio: f64, wall: f64) -> anyhow::Result<()> {
     let steps = (sim.time() / sim.dt()).round();
     let y = sim.state();
-    let summary = serde_json::json!({
-        "output": a.out,
-        "steps": steps,
-        "dt_s": sim.dt(),
-        "simulated_s": sim.time(),
-        "wall_time_s": wall,
-        "steps_per_s": steps / wall,
-        "final": STATE_NAMES.iter().zip(y).map(|(n, v)| (n.to_string(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
-    });
     if a.json {
+        let summary = serde_json::json!({
+            "output": a.out,
+            "steps": steps,
+            "dt_s": sim.dt(),
+            "simulated_s": sim.time(),
+            "wall_time_s": wall,
+            "steps_per_s": steps / wall,
+            "final": STATE_NAMES.iter().zip(y).map(|(n, v)| (n.to_string(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
+        });
         println!("{}", serde_json::to_string_pretty(&summary)?);
-    } else {
-        let mut t = Table::new();
-        t.load_preset(UTF8_FULL_CONDENSED);
-        t.set_header(["", "value"]);
-        t.add_row(["output", &a.out.display().to_string()]);
-        t.add_row([
-            "steps × dt",
-            &format!("{steps} × {:.3e} s = {:.4} s", sim.dt(), sim.time()),
-        ]);
-        t.add_row([
-            "wall time",
-            &format!("{wall:.3} s ({:.1} M steps/s)", steps / wall / 1e6),
-        ]);
-        t.add_row([
-            "final table angle",
-            &format!("{:.6}°", y[THETA_T].to_degrees()),
-        ]);
-        t.add_row([
-            "final motor angle × ratio",
-            &format!("{:.6}°", (y[THETA_M] * p.ratio()).to_degrees()),
-        ]);
-        println!("{t}");
+        return Ok(());
     }
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header(["", "value"]);
+    t.add_row(["output", &a.out.display().to_string()]);
+    t.add_row([
+        "steps × dt",
+        &format!("{steps} × {:.3e} s = {:.4} s", sim.dt(), sim.time()),
+    ]);
+    t.add_row([
+        "wall time",
+        &format!("{wall:.3} s ({:.1} M steps/s)", steps / wall / 1e6),
+    ]);
+    t.add_row([
+        "final table angle",
+        &format!("{:.6}°", y[THETA_T].to_degrees()),
+    ]);
+    t.add_row([
+        "final motor angle × ratio",
+        &format!("{:.6}°", (y[THETA_M] * ratio).to_degrees()),
+    ]);
+    println!("{t}");
     Ok(())
 }
 

@@ -232,12 +232,8 @@ fn check(name: &'static str, value: f64, ok: bool, why: &'static str) -> Result<
     }
 }
 
-/// Runs the test on the model. `progress(done_s, total_s)` after every simulated second.
-pub fn run(
-    p: &Params,
-    test: &RecordTest,
-    mut progress: impl FnMut(f64, f64),
-) -> Result<Record, RecordError> {
+/// Checks the test's conditions, naming the first that is not valid.
+fn validate(test: &RecordTest) -> Result<(), RecordError> {
     check(
         "amplitude_nm",
         test.amplitude_nm,
@@ -284,12 +280,11 @@ pub fn run(
         }
     }
     let duration = test.duration();
-    check("duration_s", duration, duration > 0.0, "must be positive")?;
-    let mut sim = Simulation::with_default_step(p)?;
-    let dt = sim.dt();
-    let every = ((1.0 / test.sample_rate_hz / dt).round() as u64).max(1);
-    let period = every as f64 * dt;
-    let samples = (duration / period).round() as usize;
+    check("duration_s", duration, duration > 0.0, "must be positive")
+}
+
+/// The drive of `test` on `p`, sampled every `period` s for `samples` samples.
+fn drive(p: &Params, test: &RecordTest, period: f64, samples: usize) -> Drive {
     let held = match test.excitation {
         Excitation::Noise {
             seed,
@@ -298,14 +293,57 @@ pub fn run(
         } => band_limited_noise(samples.max(2), period, from_hz, to_hz, seed),
         _ => Vec::new(),
     };
-    let drive = Drive {
+    Drive {
         excitation: test.excitation.clone(),
         amplitude: test.amplitude_nm,
         offset: test.preload_nm * p.ratio(),
-        duration,
+        duration: test.duration(),
         held,
         period,
-    };
+    }
+}
+
+impl<'a> Sampler<'a> {
+    /// A sampler of `samples` records every `every` steps of `drive`, with `p`'s
+    /// encoders and `test`'s table noise.
+    fn new(p: &Params, test: &RecordTest, drive: &'a Drive, every: u64, samples: usize) -> Self {
+        let counts = p.controller.motor_encoder_counts;
+        Sampler {
+            every,
+            count: 0,
+            drive,
+            motor_quantum: if counts > 0.0 {
+                std::f64::consts::TAU / counts
+            } else {
+                0.0
+            },
+            table_quantum: p.controller.table_encoder_resolution,
+            noise: Normal::new(0.0, test.table_noise_rad).expect("σ ≥ 0"),
+            rng: rand::rngs::StdRng::seed_from_u64(test.seed),
+            record: Record {
+                time: Vec::with_capacity(samples),
+                torque: Vec::with_capacity(samples),
+                motor_angle: Vec::with_capacity(samples),
+                table_angle: Vec::with_capacity(samples),
+            },
+            samples,
+        }
+    }
+}
+
+/// Runs the test on the model. `progress(done_s, total_s)` after every simulated second.
+pub fn run(
+    p: &Params,
+    test: &RecordTest,
+    mut progress: impl FnMut(f64, f64),
+) -> Result<Record, RecordError> {
+    validate(test)?;
+    let mut sim = Simulation::with_default_step(p)?;
+    let dt = sim.dt();
+    let every = ((1.0 / test.sample_rate_hz / dt).round() as u64).max(1);
+    let period = every as f64 * dt;
+    let samples = (test.duration() / period).round() as usize;
+    let drive = drive(p, test, period, samples);
     let start = FrequencyTest {
         amplitude_nm: 0.0,
         preload_nm: test.preload_nm,
@@ -313,27 +351,7 @@ pub fn run(
     };
     sim.set_state(initial_state(p, 1.0, &start));
     sim.set_load(-test.preload_nm);
-    let counts = p.controller.motor_encoder_counts;
-    let mut rec = Sampler {
-        every,
-        count: 0,
-        drive: &drive,
-        motor_quantum: if counts > 0.0 {
-            std::f64::consts::TAU / counts
-        } else {
-            0.0
-        },
-        table_quantum: p.controller.table_encoder_resolution,
-        noise: Normal::new(0.0, test.table_noise_rad).expect("σ ≥ 0"),
-        rng: rand::rngs::StdRng::seed_from_u64(test.seed),
-        record: Record {
-            time: Vec::with_capacity(samples),
-            torque: Vec::with_capacity(samples),
-            motor_angle: Vec::with_capacity(samples),
-            table_angle: Vec::with_capacity(samples),
-        },
-        samples,
-    };
+    let mut rec = Sampler::new(p, test, &drive, every, samples);
     let steps = samples as u64 * every;
     let total = steps as f64 * dt;
     let mut input = &drive;

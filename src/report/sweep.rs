@@ -48,19 +48,7 @@ pub fn tornado_svg(
     }
     bars.sort_by(|a, b| a.value.abs().total_cmp(&b.value.abs()));
     let n = bars.len();
-    let extent = bars
-        .iter()
-        .flat_map(|b| {
-            [
-                Some(b.value),
-                b.second,
-                b.interval.map(|i| i.0),
-                b.interval.map(|i| i.1),
-            ]
-        })
-        .flatten()
-        .filter(|v| v.is_finite());
-    let (lo, hi) = extent.fold((0.0f64, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
+    let (lo, hi) = extent(&bars);
     let pad = 0.08 * (hi - lo).max(1e-12);
     let mut svg = String::new();
     {
@@ -90,35 +78,7 @@ pub fn tornado_svg(
             .light_line_style(RGBColor(235, 235, 235))
             .draw()
             .map_err(|e| text(&e))?;
-        let has_second = bars.iter().any(|b| b.second.is_some());
-        let (h_main, h_second) = if has_second { (0.38, 0.2) } else { (0.35, 0.0) };
-        c.draw_series(bars.iter().enumerate().map(|(i, b)| {
-            let y = i as f64;
-            Rectangle::new(
-                [(0.0, y - h_main), (b.value, y + h_main)],
-                BAR.mix(0.8).filled(),
-            )
-        }))
-        .map_err(|e| text(&e))?
-        .label(legend.0)
-        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 18, y + 5)], BAR.filled()));
-        if has_second {
-            c.draw_series(bars.iter().enumerate().filter_map(|(i, b)| {
-                let y = i as f64;
-                b.second.map(|s| {
-                    Rectangle::new([(0.0, y - h_second), (s, y + h_second)], SECOND.filled())
-                })
-            }))
-            .map_err(|e| text(&e))?
-            .label(legend.1.unwrap_or(""))
-            .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 18, y + 5)], SECOND.filled()));
-        }
-        c.draw_series(bars.iter().enumerate().filter_map(|(i, b)| {
-            let y = i as f64;
-            b.interval
-                .map(|(l, h)| PathElement::new(vec![(l, y), (h, y)], BLACK.stroke_width(2)))
-        }))
-        .map_err(|e| text(&e))?;
+        draw_bars(&mut c, &bars, legend).map_err(|e| text(&e))?;
         c.draw_series(std::iter::once(PathElement::new(
             vec![(0.0, -0.5), (0.0, n as f64 - 0.5)],
             BLACK.stroke_width(1),
@@ -132,6 +92,62 @@ pub fn tornado_svg(
         root.present().map_err(|e| text(&e))?;
     }
     Ok(svg)
+}
+
+/// The range of every value, second value and interval end of `bars`, 0 included.
+fn extent(bars: &[&Bar]) -> (f64, f64) {
+    bars.iter()
+        .flat_map(|b| {
+            [
+                Some(b.value),
+                b.second,
+                b.interval.map(|i| i.0),
+                b.interval.map(|i| i.1),
+            ]
+        })
+        .flatten()
+        .filter(|v| v.is_finite())
+        .fold((0.0f64, 0.0f64), |(l, h), v| (l.min(v), h.max(v)))
+}
+
+type Tornado<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// The bars, the second values beside them (when any) and the intervals, with legends.
+fn draw_bars(
+    c: &mut Tornado<'_, '_>,
+    bars: &[&Bar],
+    legend: (&str, Option<&str>),
+) -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
+    let has_second = bars.iter().any(|b| b.second.is_some());
+    let (h_main, h_second) = if has_second { (0.38, 0.2) } else { (0.35, 0.0) };
+    c.draw_series(bars.iter().enumerate().map(|(i, b)| {
+        let y = i as f64;
+        Rectangle::new(
+            [(0.0, y - h_main), (b.value, y + h_main)],
+            BAR.mix(0.8).filled(),
+        )
+    }))?
+    .label(legend.0)
+    .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 18, y + 5)], BAR.filled()));
+    if has_second {
+        c.draw_series(bars.iter().enumerate().filter_map(|(i, b)| {
+            let y = i as f64;
+            b.second
+                .map(|s| Rectangle::new([(0.0, y - h_second), (s, y + h_second)], SECOND.filled()))
+        }))?
+        .label(legend.1.unwrap_or(""))
+        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 18, y + 5)], SECOND.filled()));
+    }
+    c.draw_series(bars.iter().enumerate().filter_map(|(i, b)| {
+        let y = i as f64;
+        b.interval
+            .map(|(l, h)| PathElement::new(vec![(l, y), (h, y)], BLACK.stroke_width(2)))
+    }))?;
+    Ok(())
 }
 
 /// Tornado charts of every output column of `indices`: (column, SVG).
