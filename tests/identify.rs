@@ -247,21 +247,24 @@ fn an_interrupted_search_still_writes_a_valid_result() {
     let mut c = config(vec![spec], off(&truth, &[("fm", 1.4)]), &["fm", "Cm"]);
     c.search.max_evaluations = Some(5);
     c.search.starts = Some(2);
-    let r = run(&c);
-    assert!(r.result.interrupted);
+    let r = identify(&c, &Monitor::default()).expect("an interrupted search has a result");
+    assert!(r.result.interrupted, "{:#?}", r.result.starts);
     assert!(warns(&r, |w| matches!(w, Warning::Interrupted { .. })));
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("result.json");
     r.result.write(&path).unwrap();
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     for name in ["fm", "Cm"] {
-        let x = v["parameters"][name].as_f64().unwrap();
-        let b = &v["bounds"][name];
-        assert!(x.is_finite() && x >= b[0].as_f64().unwrap() && x <= b[1].as_f64().unwrap());
+        let x = v["parameters"][name].as_f64();
+        let (lo, hi) = (v["bounds"][name][0].as_f64(), v["bounds"][name][1].as_f64());
+        assert!(
+            matches!((x, lo, hi), (Some(x), Some(lo), Some(hi)) if x >= lo && x <= hi),
+            "{name} = {x:?} outside [{lo:?}, {hi:?}]:\n{text}"
+        );
     }
-    assert!(v["cost"].as_f64().unwrap().is_finite());
-    assert_eq!(v["termination"]["code"], "interrupted");
+    assert!(v["cost"].as_f64().is_some_and(f64::is_finite), "{text}");
+    assert_eq!(v["termination"]["code"], "interrupted", "{text}");
 }
 
 #[test]

@@ -35,13 +35,14 @@ impl Bound {
         }
     }
 
-    /// The value at unit coordinate `u`.
+    /// The value at unit coordinate `u` (inside the bounds, rounding included).
     pub fn value(&self, u: f64) -> f64 {
-        if self.log() {
+        let v = if self.log() {
             self.lo * (self.hi / self.lo).powf(u)
         } else {
             self.lo + (self.hi - self.lo) * u
-        }
+        };
+        v.clamp(self.lo, self.hi)
     }
 }
 
