@@ -38,7 +38,7 @@ fn lanes<const L: usize>(d: &Drive, seconds: f64) -> (f64, f64, u64) {
                 motor[s][l] = m[s];
             }
         }
-        kernel.step(d, &mut y, &motor, &[0.0; L], DT);
+        kernel.step(d, &mut y, &motor, &[d.tload(); L], DT);
     }
     let wall = started.elapsed().as_secs_f64();
     std::hint::black_box(y);
