@@ -179,7 +179,7 @@ mod tests {
         // Move 2: 0.1 → −0.1 at 0.1/s: 2 s + 0.05 s; move 3: 0.1 at 0.05/s: 2.025 s.
         let total = 0.2 + 0.6 + 0.2 + 2.05 + 0.2 + 2.025 + 0.2;
         assert!((m.duration() - total).abs() < 1e-12);
-        assert!((m.position(0.2 + 0.6 + 0.2 + 1.0) - 0.0).abs() < 1e-12);
+        assert!(m.position(0.2 + 0.6 + 0.2 + 1.025).abs() < 1e-12);
         assert_eq!(m.position(100.0), 0.0);
         // A short move is triangular: 0.005 at 2/s² takes 2·√(0.0025) = 0.1 s.
         let short = TrapezoidalMoves {
