@@ -363,4 +363,88 @@ mod tests {
             Err(ControllerError::DelayTooLong { .. })
         ));
     }
+
+    /// The EMPS-like P/P law on an ideal encoder: u = Kvp·(Kpp·e − ω).
+    fn drive_with_gain(late: bool) -> Gains {
+        let mut p = presets::load("direct-drive").unwrap();
+        let c = &mut p.controller;
+        (c.kpp, c.kvp, c.kvi, c.tc) = (160.0, 240.0, 0.0, 1e-3);
+        (c.torque_limit, c.drive_gain) = (10.0, 35.0);
+        c.output_delay_periods = if late { 1.0 } else { 0.0 };
+        (c.motor_encoder_counts, c.table_encoder_resolution) = (0.0, 0.0);
+        Gains::new(&p).unwrap()
+    }
+
+    #[test]
+    fn the_output_is_saturated_in_its_own_unit_and_scaled_by_the_drive_gain() {
+        let g = drive_with_gain(false);
+        let mut c = Controller::new(g, 0.0, 0.0);
+        // 1e-4 m of error: 240·160·1e-4 = 3.84 V, 134.4 N.
+        let torque = c.update(1e-4, 0.0, 0.0);
+        assert!((c.output() - 3.84).abs() < 1e-12, "{}", c.output());
+        assert_eq!(torque, 35.0 * c.output());
+        // 1 mm: 38.4 V, saturated at 10 V = 350 N.
+        let mut c = Controller::new(g, 0.0, 0.0);
+        assert_eq!(c.update(1e-3, 0.0, 0.0), 350.0);
+        assert_eq!(c.output(), 10.0);
+    }
+
+    #[test]
+    fn one_sample_late_applies_each_output_a_period_later() {
+        let (now, late) = (drive_with_gain(false), drive_with_gain(true));
+        let (mut a, mut b) = (
+            Controller::new(now, 0.0, 0.0),
+            Controller::new(late, 0.0, 0.0),
+        );
+        let mut previous = 0.0;
+        for k in 0..20 {
+            let (r, q) = (1e-5 * k as f64, 0.7e-5 * k as f64);
+            a.update(r, q, q);
+            b.update(r, q, q);
+            assert_eq!(b.output(), previous, "sample {k}");
+            previous = a.output();
+        }
+    }
+
+    #[test]
+    fn the_added_signal_is_in_the_output_and_saturated_with_it() {
+        let g = drive_with_gain(false);
+        let mut plain = Controller::new(g, 0.0, 0.0);
+        let mut dithered = Controller::new(g, 0.0, 0.0);
+        dithered.set_added(0.25);
+        plain.update(1e-5, 0.0, 0.0);
+        dithered.update(1e-5, 0.0, 0.0);
+        assert!((dithered.output() - plain.output() - 0.25).abs() < 1e-15);
+        dithered.set_added(50.0);
+        dithered.update(1e-5, 0.0, 0.0);
+        assert_eq!(dithered.output(), 10.0);
+    }
+
+    #[test]
+    fn a_position_integrator_accumulates_the_error() {
+        let mut p = presets::load("direct-drive").unwrap();
+        p.controller.kpi = 400.0;
+        (p.controller.motor_encoder_counts, p.controller.kvi) = (0.0, 0.0);
+        let g = Gains::new(&p).unwrap();
+        let mut c = Controller::new(g, 0.0, 0.0);
+        let e = 1e-4;
+        let first = c.update(e, 0.0, 0.0);
+        let second = c.update(e, 0.0, 0.0);
+        // ω* grows by Kpi·Tc·e per period; the output by Kvp times that.
+        assert!(
+            (second - first - g.kvp * g.kpi * g.tc * e).abs() < 1e-9,
+            "{first} {second}"
+        );
+    }
+
+    #[test]
+    fn a_moving_start_sees_the_motion_in_its_first_velocity_sample() {
+        let g = drive_with_gain(false);
+        let mut c = Controller::new(g, 0.5, 0.5);
+        c.start_moving(0.01);
+        // At the first sample the motor is where it was made: the backward difference
+        // is the velocity, 0.01 m/s, and the reference matches the position.
+        c.update(0.5, 0.5, 0.5);
+        assert!((c.output() + g.kvp * 0.01).abs() < 1e-9, "{}", c.output());
+    }
 }

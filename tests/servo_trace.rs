@@ -18,7 +18,9 @@ use rtid::experiments::torque_curve::{self, TorqueTest};
 use rtid::model::{presets, Params};
 
 fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/real/emps").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/real/emps")
+        .join(name)
 }
 
 /// The published EMPS model as an rtid parameter file.
@@ -93,7 +95,9 @@ fn the_emps_controller_law_reproduces_the_recorded_output() {
     let mut late = p.clone();
     late.controller.output_delay_periods = 1.0;
     let one_late = law_rms(&late, &trace);
-    eprintln!("controller law: {at_sample:.4} V RMS at the sample, {one_late:.4} V one sample late");
+    eprintln!(
+        "controller law: {at_sample:.4} V RMS at the sample, {one_late:.4} V one sample late"
+    );
     assert!(one_late > 1.3 * at_sample, "{one_late} V");
 }
 
@@ -136,13 +140,19 @@ fn a_virtual_trace_of_the_worm_preset_replays_with_zero_error() {
     assert!(trace.position.iter().any(|&x| x > 0.049), "the table moved");
     let run = replay(&p, &trace).unwrap();
     let e = simulation_error(&trace, &run).unwrap();
-    assert_eq!((e.position_rms, e.position_max, e.force_rms), (0.0, 0.0, 0.0));
+    assert_eq!(
+        (e.position_rms, e.position_max, e.force_rms),
+        (0.0, 0.0, 0.0)
+    );
     assert_eq!(Some(run.controller_output), trace.controller_output);
     // Another model does not replay it: the comparison can fail.
     let mut stiffer = p.clone();
     stiffer.kw *= 1.5;
     let other = simulation_error(&trace, &replay(&stiffer, &trace).unwrap()).unwrap();
-    assert!(other.force_rms > 0.0 && other.position_max > 0.0, "{other:?}");
+    assert!(
+        other.force_rms > 0.0 && other.position_max > 0.0,
+        "{other:?}"
+    );
 }
 
 #[test]
@@ -228,4 +238,3 @@ fn the_friction_law_of_the_worm_torque_curve_is_the_friction_at_the_motor() {
     );
     assert!((fit.coulomb.value / at_motor - 1.0).abs() < 0.05, "{fit:?}");
 }
-

@@ -34,9 +34,9 @@ use rayon::prelude::*;
 
 use crate::input::Sine;
 use crate::model::drive::{idx::*, Drive, NSTATE};
-use crate::model::rest::{rest_state, Preload};
 use crate::model::lanes::Lanes;
 use crate::model::modes::LinearModel;
+use crate::model::rest::{rest_state, Preload};
 use crate::model::Params;
 use crate::sim::{default_step, LaneSimulation, SimError};
 

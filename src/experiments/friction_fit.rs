@@ -115,7 +115,9 @@ pub enum FrictionFitError {
     },
     #[error(transparent)]
     NotUniform(#[from] NotUniform),
-    #[error("cutoff_hz = {cutoff_hz} Hz must lie between 0 and the Nyquist frequency {nyquist_hz} Hz")]
+    #[error(
+        "cutoff_hz = {cutoff_hz} Hz must lie between 0 and the Nyquist frequency {nyquist_hz} Hz"
+    )]
     Cutoff { cutoff_hz: f64, nyquist_hz: f64 },
     #[error("decimate = 0: keep at least one sample in one (1 decimates nothing)")]
     Decimate,
@@ -133,7 +135,9 @@ pub enum FrictionFitError {
 
 /// A time base that is not a uniform sampling.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("time_s is not uniformly sampled: the step to row {row} is {step} s, the mean step {period} s")]
+#[error(
+    "time_s is not uniformly sampled: the step to row {row} is {step} s, the mean step {period} s"
+)]
 pub struct NotUniform {
     pub row: usize,
     pub step: f64,
@@ -202,7 +206,11 @@ pub fn fit_friction_law(
     let keep: Vec<usize> = (options.trim.max(1)..n.saturating_sub(options.trim.max(1)))
         .step_by(options.decimate)
         .filter(|&k| columns[1][k].abs() >= options.min_speed)
-        .filter(|&k| options.max_acceleration.map_or(true, |a| columns[0][k].abs() <= a))
+        .filter(|&k| {
+            options
+                .max_acceleration
+                .map_or(true, |a| columns[0][k].abs() <= a)
+        })
         .collect();
     let with_inertia = options.max_acceleration.is_none();
     let used: Vec<&Vec<f64>> = columns.iter().skip(usize::from(!with_inertia)).collect();
@@ -229,7 +237,10 @@ pub fn fit_torque_curve(
 }
 
 /// Checks equal lengths, finite values and a uniform time base; the sample period.
-fn check_record(time_s: &[f64], series: &[(&'static str, &[f64])]) -> Result<f64, FrictionFitError> {
+fn check_record(
+    time_s: &[f64],
+    series: &[(&'static str, &[f64])],
+) -> Result<f64, FrictionFitError> {
     const NEEDED: usize = 8;
     if time_s.len() < NEEDED {
         return Err(FrictionFitError::TooShort {

@@ -189,7 +189,13 @@ impl Drive {
         let [tm, wm, tw, ww, xw, vw, tt, wt] = *y;
         // A body without inertia of its own (the motor of direct_drive, the axial
         // unit of two_mass) has 1/J = 0 and no kinetic energy of its own.
-        let kinetic = |v: f64, inv_j: f64| if inv_j > 0.0 { 0.5 * v * v / inv_j } else { 0.0 };
+        let kinetic = |v: f64, inv_j: f64| {
+            if inv_j > 0.0 {
+                0.5 * v * v / inv_j
+            } else {
+                0.0
+            }
+        };
         let mut e = kinetic(wm, self.inv_jm)
             + kinetic(vw, self.inv_mw)
             + 0.5 * wt * wt / self.inv_jt

@@ -504,4 +504,45 @@ mod tests {
         assert!(max_rate(&p).is_err());
         assert!(frequency_response(&p, &[100.0]).is_err());
     }
+
+    #[test]
+    fn two_mass_modes_are_the_textbook_pair() {
+        let p = preset("two-mass");
+        let m = modes(&p).unwrap();
+        let held = (p.kw / p.jt).sqrt() / (2.0 * PI);
+        let free = (p.kw * (1.0 / p.jm + 1.0 / p.jt)).sqrt() / (2.0 * PI);
+        assert_hz(&m.clamped_hz, &[held], 1e-9 * held, "held");
+        assert_hz(&m.free_hz, &[free], 1e-9 * free, "free");
+        // The FdiTools bench: 53.5–53.9 Hz and 76.2 Hz.
+        assert!((held - 53.97).abs() < 0.01 && (free - 76.33).abs() < 0.01);
+        // Motor free: motor and table swing against each other, momentum zero.
+        let shape = &m.free_shapes[0];
+        assert!((p.jm * shape[0] + p.jt * shape[1]).abs() < 1e-9);
+        // The linear gain of table over motor peaks at the held mode.
+        let mut light = p.clone();
+        scale_damping(&mut light, 0.01);
+        let freqs: Vec<f64> = (0..=2000).map(|i| 40.0 + 0.01 * i as f64).collect();
+        let g = gain_db(&light, &freqs);
+        let peak = (1..g.len() - 1)
+            .filter(|&i| g[i] > g[i - 1] && g[i] > g[i + 1])
+            .map(|i| freqs[i])
+            .collect::<Vec<_>>();
+        assert_eq!(peak.len(), 1, "{peak:?}");
+        assert!((peak[0] - held).abs() < 0.02, "{peak:?} vs {held}");
+    }
+
+    #[test]
+    fn the_direct_drive_has_only_its_rigid_body_mode() {
+        let p = preset("direct-drive");
+        let m = modes(&p).unwrap();
+        assert!(m.clamped_hz.is_empty() && m.free_hz.is_empty(), "{m:?}");
+        assert_eq!(m.free_dofs, ["theta_t"]);
+        // Table and motor are one: the gain is 0 dB at every frequency.
+        for h in frequency_response(&p, &[1.0, 100.0, 1000.0]).unwrap() {
+            assert!((h.norm() - 1.0).abs() < 1e-12 && h.im.abs() < 1e-12, "{h}");
+        }
+        // The only rate is the viscous decay Ct/Jt.
+        let rate = max_rate(&p).unwrap();
+        assert!((rate - p.ct / p.jt).abs() < 1e-12 * rate, "{rate}");
+    }
 }

@@ -229,7 +229,10 @@ mod tests {
         for name in ["worm-gear", "roller-gear-cam"] {
             let p = presets::load(name).unwrap();
             let v = serde_json::to_value(&p).unwrap();
-            assert!(v.get("axis").is_none() && v.get("Tload").is_none(), "{name}");
+            assert!(
+                v.get("axis").is_none() && v.get("Tload").is_none(),
+                "{name}"
+            );
             let back: Params = serde_json::from_value(v).unwrap();
             assert_eq!(back, p, "{name}");
         }

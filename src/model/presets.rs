@@ -17,7 +17,10 @@ const PRESETS: &[(&str, &str)] = &[
         "direct-drive",
         include_str!("../../fixtures/presets/direct-drive.json"),
     ),
-    ("two-mass", include_str!("../../fixtures/presets/two-mass.json")),
+    (
+        "two-mass",
+        include_str!("../../fixtures/presets/two-mass.json"),
+    ),
 ];
 
 /// The preset names, for help texts and error messages.

@@ -32,8 +32,7 @@ pub use replay::{replay, simulation_error, Misfit, Replay};
 pub use virtual_trace::{virtual_trace, MoveTo, TrapezoidalMoves};
 
 use super::friction_fit::{
-    fit_friction_law, uniform_period, FrictionFit, FrictionFitError, FrictionFitOptions,
-    NotUniform,
+    fit_friction_law, uniform_period, FrictionFit, FrictionFitError, FrictionFitOptions, NotUniform,
 };
 use crate::sim::SimError;
 

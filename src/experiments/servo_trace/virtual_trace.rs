@@ -56,7 +56,11 @@ impl TrapezoidalMoves {
             })
         };
         if !(self.acceleration > 0.0 && self.acceleration.is_finite()) {
-            return bad("acceleration", self.acceleration, "must be positive and finite");
+            return bad(
+                "acceleration",
+                self.acceleration,
+                "must be positive and finite",
+            );
         }
         if !(self.dwell_s >= 0.0 && self.dwell_s.is_finite()) {
             return bad("dwell_s", self.dwell_s, "must be finite and not negative");
@@ -74,7 +78,10 @@ impl TrapezoidalMoves {
 
     /// The whole profile's duration, s.
     pub fn duration(&self) -> f64 {
-        self.segments().map(|(.., time)| time + self.dwell_s).sum::<f64>() + self.dwell_s
+        self.segments()
+            .map(|(.., time)| time + self.dwell_s)
+            .sum::<f64>()
+            + self.dwell_s
     }
 
     /// The reference at `t` s (0 before the first move; the last target after the
