@@ -1,5 +1,6 @@
-//! Integration steps per second of one trajectory, per preset, open and closed loop.
-//! `cargo bench --bench kernel`; figures in docs/performance.md.
+//! Integration steps per second of one trajectory, per preset (every topology: the
+//! worm's spur gear, the cam's direct, the direct drive, the two-mass drive), open and
+//! closed loop. `cargo bench --bench kernel`; figures in docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rtid::input::{Move, Sine};
@@ -12,7 +13,7 @@ const DURATION: f64 = 0.2;
 
 fn kernel(c: &mut Criterion) {
     let mut group = c.benchmark_group("kernel");
-    for name in ["worm-gear", "roller-gear-cam"] {
+    for name in ["worm-gear", "roller-gear-cam", "direct-drive", "two-mass"] {
         let p = presets::load(name).unwrap();
         let dt = rtid::sim::default_step(&p).unwrap();
         let steps = (DURATION / dt).round() as u64;

@@ -4,14 +4,17 @@
 //!     cargo build --release --example kernel_profile
 //!     valgrind --tool=callgrind target/release/examples/kernel_profile worm-gear 0.2
 //!     target/release/examples/kernel_profile worm-gear 2 lanes=8
+//!     target/release/examples/kernel_profile worm-gear 2 closed
 //!
 //! Arguments: preset name, simulated seconds (default 2), then NAME=VALUE overrides
-//! of parameters, and `lanes=L` (1, 2, 4 or 8). Runs the frequency-response test's
-//! ±5 N·m open-loop sine at dt = 1e-5 s: at 230 Hz through `Simulation` for one
+//! of parameters, `lanes=L` (1, 2, 4 or 8) and `closed`. Runs the frequency-response
+//! test's ±5 N·m open-loop sine at dt = 1e-5 s: at 230 Hz through `Simulation` for one
 //! lane; for `L` lanes, `L` trajectories at 230, 240, … Hz advanced together by a
-//! `Kernel<L>` (no divergence check, no recorder).
+//! `Kernel<L>` (no divergence check, no recorder). With `closed`, the kernel bench's
+//! closed-loop run instead: the servo moving the table (or carriage) by 10° (0.1745
+//! rad or m) through `Simulation::run_closed_loop`, one lane.
 
-use rtid::input::{Sine, TorqueInput};
+use rtid::input::{Move, Sine, TorqueInput};
 use rtid::model::{presets, Drive, Kernel, NSTATE};
 use rtid::recorder::NullRecorder;
 use rtid::sim::Simulation;
@@ -35,7 +38,7 @@ fn lanes<const L: usize>(d: &Drive, seconds: f64) -> (f64, f64, u64) {
                 motor[s][l] = m[s];
             }
         }
-        kernel.step(d, &mut y, &motor, &[0.0; L], DT);
+        kernel.step(d, &mut y, &motor, &[d.tload(); L], DT);
     }
     let wall = started.elapsed().as_secs_f64();
     std::hint::black_box(y);
@@ -48,7 +51,12 @@ fn main() -> anyhow::Result<()> {
     let seconds: f64 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(2.0);
     let mut p = presets::load(&name)?;
     let mut width = 1;
+    let mut closed = false;
     for a in args {
+        if a == "closed" {
+            closed = true;
+            continue;
+        }
         let (k, v) = a
             .split_once('=')
             .ok_or_else(|| anyhow::anyhow!("{a}: NAME=VALUE"))?;
@@ -58,7 +66,19 @@ fn main() -> anyhow::Result<()> {
             p.set(k, v.parse()?)?;
         }
     }
-    let (steps, wall, events) = if width == 1 {
+    let (steps, wall, events) = if closed {
+        let mut sim = Simulation::new(&p, DT)?;
+        let mut controller = sim.controller(&p)?;
+        let step = Move {
+            from: 0.0,
+            to: 10f64.to_radians(),
+            speed: None,
+        };
+        let started = std::time::Instant::now();
+        sim.run_closed_loop(&mut controller, &step, seconds, &mut NullRecorder)?;
+        let wall = started.elapsed().as_secs_f64();
+        (sim.time() / sim.dt(), wall, sim.contact_events())
+    } else if width == 1 {
         let mut sim = Simulation::new(&p, DT)?;
         let started = std::time::Instant::now();
         sim.run_open_loop(&mut Sine::new(230.0, 5.0, 0.0), seconds, &mut NullRecorder)?;

@@ -1,22 +1,34 @@
-//! The discrete servo controller of the paper's Fig. 6 (MODEL.md §4).
+//! The discrete servo controller (MODEL.md §1.1 "Servo as real drives have it", §4;
+//! the paper's Fig. 6).
 //!
-//! Every period Tc the controller samples the encoders and computes a torque command
-//! that the D/A converter holds until the next sample:
+//! Every period Tc the controller samples the encoders and computes an output u that
+//! the D/A converter holds until the next sample (zero-order hold); the drive turns it
+//! into torque (force) T = drive_gain·u:
 //!
 //! ```text
 //! θm,meas = Q_m(θm(t − delay))                 motor encoder: dead time, then counts
 //! θt,meas = Q_t(θt(t))                         table encoder, 0.0001° by default
 //! e   = θref/(Rg·Rw) − θm,meas                 semi-closed loop (motor radians)
 //! e   = (θref − θt,meas)/(Rg·Rw)               full-closed loop (motor radians)
-//! ω*  = clamp(Kpp·e, ±speed_limit)             P position loop
+//! Ie += Tc·e                                   only with Kpi > 0 (position PI)
+//! ω*  = clamp(Kpp·e + Kpi·Ie, ±speed_limit)    position loop
 //! ω   = (θm,meas[k] − θm,meas[k−1]) / Tc       backward difference (1 − z⁻¹)/Tc
 //! I  += Tc·(ω* − ω)                            integrator Tc·z/(z − 1)
-//! T   = clamp(Kvp·(ω* − ω) + Kvi·I, ±torque_limit)
+//! u   = clamp(Kvp·(ω* − ω) + Kvi·I + a_k, ±torque_limit)   a_k: the added signal
+//! T   = drive_gain·u                           applied at sample k, or at k + 1 with
+//!                                              output_delay_periods = 1
 //! ```
 //!
-//! The integrator stops while the output is saturated in the direction the error
-//! pushes (conditional integration), so a long move at the torque or speed limit
-//! does not wind it up. Gains ([`Gains`], `Copy`) are kept apart from the state that
+//! On a linear axis read m for rad. `torque_limit` is the output's limit in the
+//! output's own unit (N·m for a torque command, V or A with a drive gain). With the
+//! defaults (Kpi = 0, drive_gain = 1, no delay, nothing added) this is the controller
+//! of the paper's presets, computed exactly as before. The EMPS benchmark's law,
+//! u_k = kv·(kp·(r_k − q_k) − (q_k − q_{k−1})/Ts), is Kpi = Kvi = 0, Kpp = kp, Kvp = kv
+//! (A. Janot, M. Gautier, M. Brunot, "Data Set and Reference Models of EMPS", 2019).
+//!
+//! The integrators stop while their output is saturated in the direction the error
+//! pushes (conditional integration), so a long move at the torque or speed limit does
+//! not wind them up. Gains ([`Gains`], `Copy`) are kept apart from the state that
 //! `update(&mut self, …)` changes.
 
 use crate::model::params::{LoopMode, Params};
@@ -41,15 +53,22 @@ pub enum ControllerError {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gains {
     pub kpp: f64,
+    /// Position loop integral gain, 1/s² (0: P position loop).
+    pub kpi: f64,
     pub kvp: f64,
     pub kvi: f64,
     /// Control period, s.
     pub tc: f64,
+    /// Limit of the output, in the output's unit.
     pub torque_limit: f64,
     pub speed_limit: f64,
-    /// Motor encoder quantum, rad (0: none).
+    /// Torque (force) per unit of output.
+    pub drive_gain: f64,
+    /// Whether u_k is applied one sample late (at k + 1).
+    pub one_sample_late: bool,
+    /// Motor encoder quantum, rad or m (0: none).
     pub motor_quantum: f64,
-    /// Table encoder quantum, rad (0: none).
+    /// Table encoder quantum, rad or m (0: none).
     pub table_quantum: f64,
     pub loop_mode: LoopMode,
     /// Table turns per motor turn, Rg·Rw.
@@ -73,16 +92,15 @@ impl Gains {
         }
         Ok(Gains {
             kpp: c.kpp,
+            kpi: c.kpi,
             kvp: c.kvp,
             kvi: c.kvi,
             tc: c.tc,
             torque_limit: c.torque_limit,
             speed_limit: c.speed_limit,
-            motor_quantum: if c.motor_encoder_counts > 0.0 {
-                std::f64::consts::TAU / c.motor_encoder_counts
-            } else {
-                0.0
-            },
+            drive_gain: c.drive_gain,
+            one_sample_late: c.output_delay_periods == 1.0,
+            motor_quantum: c.motor_quantum(),
             table_quantum: c.table_encoder_resolution,
             loop_mode: c.loop_mode,
             ratio: p.ratio(),
@@ -102,14 +120,20 @@ pub fn quantise(angle: f64, quantum: f64) -> f64 {
     }
 }
 
-/// The controller's memory: integrator, last velocity sample, the encoder delay line
-/// and the torque the D/A holds.
+/// The controller's memory: integrators, last velocity sample, the encoder delay line,
+/// the output the D/A holds (and the one waiting a sample), and the signal added to
+/// the output.
 #[derive(Clone, Debug)]
 pub struct Controller {
     gains: Gains,
     integral: f64,
+    position_integral: f64,
     previous_motor: f64,
+    table_reading: f64,
+    output: f64,
+    pending: f64,
     torque: f64,
+    added: f64,
     history: [f64; HISTORY],
     head: usize,
 }
@@ -117,15 +141,33 @@ pub struct Controller {
 impl Controller {
     /// A controller at rest, its encoders reading the given true angles.
     pub fn new(gains: Gains, motor_angle: f64, table_angle: f64) -> Self {
-        let _ = table_angle;
         Controller {
             gains,
             integral: 0.0,
+            position_integral: 0.0,
             previous_motor: quantise(motor_angle, gains.motor_quantum),
+            table_reading: quantise(table_angle, gains.table_quantum),
+            output: 0.0,
+            pending: 0.0,
             torque: 0.0,
+            added: 0.0,
             history: [motor_angle; HISTORY],
             head: 0,
         }
+    }
+
+    /// Starts in motion (call right after [`Controller::new`]): the motor has been
+    /// turning at `motor_velocity` (rad/s or m/s) up to the angle the controller was
+    /// created at, so the delay line and the previous reading, one period before the
+    /// first sample, see that motion (for a replay that starts while the axis moves).
+    pub fn start_moving(&mut self, motor_velocity: f64) {
+        let g = self.gains;
+        let now = self.history[self.head];
+        for back in 0..HISTORY {
+            self.history[(self.head + HISTORY - back) % HISTORY] =
+                now - (back + 1) as f64 * g.tc * motor_velocity;
+        }
+        self.previous_motor = quantise(self.delayed_motor_angle(), g.motor_quantum);
     }
 
     /// The settings.
@@ -133,40 +175,97 @@ impl Controller {
         &self.gains
     }
 
-    /// The torque command currently held by the D/A, N·m.
+    /// The torque (force) the drive applies now, N·m or N: drive_gain × the output
+    /// the D/A holds.
     pub fn torque(&self) -> f64 {
         self.torque
     }
 
-    /// The last motor encoder reading (delayed and quantised), rad.
+    /// The output the D/A holds now, in the controller's unit (N·m or N for a torque
+    /// command, V or A with a drive gain), the added signal included.
+    pub fn output(&self) -> f64 {
+        self.output
+    }
+
+    /// The last motor encoder reading (delayed and quantised), rad or m.
     pub fn motor_reading(&self) -> f64 {
         self.previous_motor
     }
 
-    /// One control period: samples the true motor and table angles, returns the new
-    /// torque command for the reference table angle `reference` (rad).
+    /// The last table encoder reading (quantised), rad or m.
+    pub fn table_reading(&self) -> f64 {
+        self.table_reading
+    }
+
+    /// Sets the signal added to the output from the next sample on (test pulses,
+    /// dither), in the output's unit; 0 adds nothing. The sum is saturated.
+    pub fn set_added(&mut self, added: f64) {
+        self.added = added;
+    }
+
+    /// One control period: samples the true motor and table angles, returns the
+    /// torque (force) applied from now on for the reference table angle `reference`
+    /// (rad or m).
     pub fn update(&mut self, reference: f64, motor_angle: f64, table_angle: f64) -> f64 {
-        let g = &self.gains;
+        let g = self.gains;
         self.head = (self.head + 1) % HISTORY;
         self.history[self.head] = motor_angle;
         let motor = quantise(self.delayed_motor_angle(), g.motor_quantum);
+        self.table_reading = quantise(table_angle, g.table_quantum);
         let error = match g.loop_mode {
             LoopMode::SemiClosed => reference / g.ratio - motor,
-            LoopMode::FullClosed => (reference - quantise(table_angle, g.table_quantum)) / g.ratio,
+            LoopMode::FullClosed => (reference - self.table_reading) / g.ratio,
         };
-        let speed_command = (g.kpp * error).clamp(-g.speed_limit, g.speed_limit);
+        let speed_command = self.position_loop(error);
         let speed = (motor - self.previous_motor) / g.tc;
         self.previous_motor = motor;
-        let speed_error = speed_command - speed;
+        let output = self.velocity_loop(speed_command - speed);
+        self.hold(output)
+    }
+
+    /// The velocity command for the position error `error`: Kpp·e, plus Kpi·Ie with a
+    /// position integrator, clamped to the speed limit.
+    fn position_loop(&mut self, error: f64) -> f64 {
+        let g = &self.gains;
+        if g.kpi == 0.0 {
+            return (g.kpp * error).clamp(-g.speed_limit, g.speed_limit);
+        }
+        let integral = self.position_integral + g.tc * error;
+        let unlimited = g.kpp * error + g.kpi * integral;
+        let command = unlimited.clamp(-g.speed_limit, g.speed_limit);
+        if command == unlimited || unlimited.signum() != error.signum() {
+            self.position_integral = integral;
+        }
+        command
+    }
+
+    /// The saturated output for the velocity error, the added signal included.
+    fn velocity_loop(&mut self, speed_error: f64) -> f64 {
+        let g = &self.gains;
         let integral = self.integral + g.tc * speed_error;
-        let unlimited = g.kvp * speed_error + g.kvi * integral;
-        let torque = unlimited.clamp(-g.torque_limit, g.torque_limit);
+        let law = g.kvp * speed_error + g.kvi * integral;
+        let unlimited = if self.added != 0.0 {
+            law + self.added
+        } else {
+            law
+        };
+        let output = unlimited.clamp(-g.torque_limit, g.torque_limit);
         // Conditional integration: hold the integrator while saturated the same way.
-        if torque == unlimited || unlimited.signum() != speed_error.signum() {
+        if output == unlimited || unlimited.signum() != speed_error.signum() {
             self.integral = integral;
         }
-        self.torque = torque;
-        torque
+        output
+    }
+
+    /// Puts `output` on the D/A now, or after one sample; returns the torque applied.
+    fn hold(&mut self, output: f64) -> f64 {
+        self.output = if self.gains.one_sample_late {
+            std::mem::replace(&mut self.pending, output)
+        } else {
+            output
+        };
+        self.torque = self.gains.drive_gain * self.output;
+        self.torque
     }
 
     /// The motor angle `encoder_delay` ago, interpolated between samples.
@@ -263,5 +362,89 @@ mod tests {
             Gains::new(&p),
             Err(ControllerError::DelayTooLong { .. })
         ));
+    }
+
+    /// The EMPS-like P/P law on an ideal encoder: u = Kvp·(Kpp·e − ω).
+    fn drive_with_gain(late: bool) -> Gains {
+        let mut p = presets::load("direct-drive").unwrap();
+        let c = &mut p.controller;
+        (c.kpp, c.kvp, c.kvi, c.tc) = (160.0, 240.0, 0.0, 1e-3);
+        (c.torque_limit, c.drive_gain) = (10.0, 35.0);
+        c.output_delay_periods = if late { 1.0 } else { 0.0 };
+        (c.motor_encoder_counts, c.table_encoder_resolution) = (0.0, 0.0);
+        Gains::new(&p).unwrap()
+    }
+
+    #[test]
+    fn the_output_is_saturated_in_its_own_unit_and_scaled_by_the_drive_gain() {
+        let g = drive_with_gain(false);
+        let mut c = Controller::new(g, 0.0, 0.0);
+        // 1e-4 m of error: 240·160·1e-4 = 3.84 V, 134.4 N.
+        let torque = c.update(1e-4, 0.0, 0.0);
+        assert!((c.output() - 3.84).abs() < 1e-12, "{}", c.output());
+        assert_eq!(torque, 35.0 * c.output());
+        // 1 mm: 38.4 V, saturated at 10 V = 350 N.
+        let mut c = Controller::new(g, 0.0, 0.0);
+        assert_eq!(c.update(1e-3, 0.0, 0.0), 350.0);
+        assert_eq!(c.output(), 10.0);
+    }
+
+    #[test]
+    fn one_sample_late_applies_each_output_a_period_later() {
+        let (now, late) = (drive_with_gain(false), drive_with_gain(true));
+        let (mut a, mut b) = (
+            Controller::new(now, 0.0, 0.0),
+            Controller::new(late, 0.0, 0.0),
+        );
+        let mut previous = 0.0;
+        for k in 0..20 {
+            let (r, q) = (1e-5 * k as f64, 0.7e-5 * k as f64);
+            a.update(r, q, q);
+            b.update(r, q, q);
+            assert_eq!(b.output(), previous, "sample {k}");
+            previous = a.output();
+        }
+    }
+
+    #[test]
+    fn the_added_signal_is_in_the_output_and_saturated_with_it() {
+        let g = drive_with_gain(false);
+        let mut plain = Controller::new(g, 0.0, 0.0);
+        let mut dithered = Controller::new(g, 0.0, 0.0);
+        dithered.set_added(0.25);
+        plain.update(1e-5, 0.0, 0.0);
+        dithered.update(1e-5, 0.0, 0.0);
+        assert!((dithered.output() - plain.output() - 0.25).abs() < 1e-15);
+        dithered.set_added(50.0);
+        dithered.update(1e-5, 0.0, 0.0);
+        assert_eq!(dithered.output(), 10.0);
+    }
+
+    #[test]
+    fn a_position_integrator_accumulates_the_error() {
+        let mut p = presets::load("direct-drive").unwrap();
+        p.controller.kpi = 400.0;
+        (p.controller.motor_encoder_counts, p.controller.kvi) = (0.0, 0.0);
+        let g = Gains::new(&p).unwrap();
+        let mut c = Controller::new(g, 0.0, 0.0);
+        let e = 1e-4;
+        let first = c.update(e, 0.0, 0.0);
+        let second = c.update(e, 0.0, 0.0);
+        // ω* grows by Kpi·Tc·e per period; the output by Kvp times that.
+        assert!(
+            (second - first - g.kvp * g.kpi * g.tc * e).abs() < 1e-9,
+            "{first} {second}"
+        );
+    }
+
+    #[test]
+    fn a_moving_start_sees_the_motion_in_its_first_velocity_sample() {
+        let g = drive_with_gain(false);
+        let mut c = Controller::new(g, 0.5, 0.5);
+        c.start_moving(0.01);
+        // At the first sample the motor is where it was made: the backward difference
+        // is the velocity, 0.01 m/s, and the reference matches the position.
+        c.update(0.5, 0.5, 0.5);
+        assert!((c.output() + g.kvp * 0.01).abs() < 1e-9, "{}", c.output());
     }
 }

@@ -92,15 +92,16 @@ pub struct Simulation {
 
 impl Simulation {
     /// A table at rest at zero angles, integrated with step `dt` (checked against the
-    /// model's stiffest mode).
+    /// model's stiffest mode), with no external load but its `Tload`.
     pub fn new(params: &Params, dt: f64) -> Result<Self, SimError> {
+        let drive = checked_drive(params, dt)?;
         Ok(Simulation {
-            drive: checked_drive(params, dt)?,
+            drive,
             dt,
             steps: 0,
             y: [[0.0]; NSTATE],
             kernel: Kernel::default(),
-            load: 0.0,
+            load: drive.tload(),
         })
     }
 
@@ -129,18 +130,18 @@ impl Simulation {
         self.y.map(|s| s[0])
     }
 
-    /// Sets the state. In the direct topology the shaft follows the motor.
+    /// Sets the state. Slots the topology does not integrate follow the ones it does
+    /// ([`Drive::mirror`]: in the direct and two-mass topologies the shaft follows the
+    /// motor, in direct_drive motor and shaft follow the table).
     pub fn set_state(&mut self, mut y: [f64; NSTATE]) {
-        if !self.drive.spur {
-            y[THETA_W] = y[THETA_M];
-            y[OMEGA_W] = y[OMEGA_M];
-        }
+        self.drive.mirror(&mut y);
         self.y = y.map(|v| [v]);
     }
 
-    /// Sets the external table torque Tload (e.g. a brake), N·m.
+    /// Sets an external table torque (e.g. a brake), N·m (N on a linear axis); the
+    /// parameter `Tload` adds to it.
     pub fn set_load(&mut self, torque: f64) {
-        self.load = torque;
+        self.load = torque + self.drive.tload();
     }
 
     /// Whether motor, shaft and table stuck in the last step.
@@ -170,21 +171,50 @@ impl Simulation {
         duration: f64,
         recorder: &mut R,
     ) -> Result<(), SimError> {
+        // The drive's form is chosen once, outside the step loop (kernel.rs,
+        // `Kernel::step_meshed`).
+        if self.drive.form == crate::model::drive::Form::Rigid {
+            self.open_loop::<true, I, R>(input, duration, recorder)
+        } else {
+            self.open_loop::<false, I, R>(input, duration, recorder)
+        }
+    }
+
+    fn open_loop<const RIGID: bool, I: TorqueInput, R: Recorder>(
+        &mut self,
+        input: &mut I,
+        duration: f64,
+        recorder: &mut R,
+    ) -> Result<(), SimError> {
         let n = (duration / self.dt).round() as u64;
         if self.steps == 0 {
             recorder.record(0.0, &self.state(), input.step_torques(0.0, self.dt)[0]);
         }
         for _ in 0..n {
             let motor = input.step_torques(self.time(), self.dt);
-            self.advance(&motor.map(|m| [m]))?;
+            self.advance::<RIGID>(&motor.map(|m| [m]))?;
             recorder.record(self.time(), &self.state(), motor[2]);
         }
         Ok(())
     }
 
     /// Runs `duration` seconds under `controller`, which follows `trajectory` (table
-    /// angle command, rad) and updates every control period, holding its torque.
+    /// angle command, rad or m) and updates every control period, holding its output.
     pub fn run_closed_loop<T: Trajectory + ?Sized, R: Recorder>(
+        &mut self,
+        controller: &mut Controller,
+        trajectory: &T,
+        duration: f64,
+        recorder: &mut R,
+    ) -> Result<(), SimError> {
+        if self.drive.form == crate::model::drive::Form::Rigid {
+            self.closed_loop::<true, T, R>(controller, trajectory, duration, recorder)
+        } else {
+            self.closed_loop::<false, T, R>(controller, trajectory, duration, recorder)
+        }
+    }
+
+    fn closed_loop<const RIGID: bool, T: Trajectory + ?Sized, R: Recorder>(
         &mut self,
         controller: &mut Controller,
         trajectory: &T,
@@ -204,7 +234,7 @@ impl Simulation {
                 controller.update(trajectory.angle(t), self.y[THETA_M][0], self.y[THETA_T][0]);
             }
             let u = controller.torque();
-            self.advance(&[[u]; 3])?;
+            self.advance::<RIGID>(&[[u]; 3])?;
             recorder.record(self.time(), &self.state(), u);
         }
         Ok(())
@@ -212,9 +242,13 @@ impl Simulation {
 
     /// One step, then the divergence check.
     #[inline]
-    fn advance(&mut self, motor: &[[f64; 1]; 3]) -> Result<(), SimError> {
-        self.kernel
-            .step(&self.drive, &mut self.y, motor, &[self.load], self.dt);
+    fn advance<const RIGID: bool>(&mut self, motor: &[[f64; 1]; 3]) -> Result<(), SimError> {
+        let (d, y, load) = (&self.drive, &mut self.y, &[self.load]);
+        if RIGID {
+            self.kernel.step_rigid(d, y, motor, load, self.dt);
+        } else {
+            self.kernel.step_meshed(d, y, motor, load, self.dt);
+        }
         self.steps += 1;
         if diverged(&self.y).is_none() {
             Ok(())
@@ -289,13 +323,14 @@ impl<const L: usize> LaneSimulation<L> {
     /// `L` tables at rest at zero angles, integrated with step `dt` (checked as by
     /// [`Simulation::new`]).
     pub fn new(params: &Params, dt: f64) -> Result<Self, SimError> {
+        let drive = checked_drive(params, dt)?;
         Ok(LaneSimulation {
-            drive: checked_drive(params, dt)?,
+            drive,
             dt,
             steps: [0; L],
             y: [[0.0; L]; NSTATE],
             kernel: Kernel::default(),
-            load: [0.0; L],
+            load: [drive.tload(); L],
         })
     }
 
@@ -309,21 +344,18 @@ impl<const L: usize> LaneSimulation<L> {
         &self.drive
     }
 
-    /// Starts a new run in lane `l` at t = 0 from state `y` (in the direct topology
-    /// the shaft follows the motor) under the external table torque `load` (N·m), as
-    /// a new [`Simulation`] with [`Simulation::set_state`] and
-    /// [`Simulation::set_load`] would.
+    /// Starts a new run in lane `l` at t = 0 from state `y` (slots the topology does
+    /// not integrate follow, [`Drive::mirror`]) under the external table torque `load`
+    /// (N·m; `Tload` adds to it), as a new [`Simulation`] with
+    /// [`Simulation::set_state`] and [`Simulation::set_load`] would.
     pub fn start(&mut self, l: usize, mut y: [f64; NSTATE], load: f64) {
-        if !self.drive.spur {
-            y[THETA_W] = y[THETA_M];
-            y[OMEGA_W] = y[OMEGA_M];
-        }
+        self.drive.mirror(&mut y);
         for (i, v) in y.into_iter().enumerate() {
             self.y[i][l] = v;
         }
         self.kernel.reset_lane(l);
         self.steps[l] = 0;
-        self.load[l] = load;
+        self.load[l] = load + self.drive.tload();
     }
 
     /// Simulated time of lane `l`, s.

@@ -192,3 +192,41 @@ fn a_batched_sweep_equals_lone_points() {
         assert_eq!(*q, alone, "{} Hz", q.frequency_hz);
     }
 }
+
+#[test]
+fn lanes_of_the_direct_drive_and_two_mass_topologies_equal_lone_simulations() {
+    // Two-mass with backlash in the coupling, fluctuation and a constant load: contact
+    // events, stick and phase resynchronisations in different lanes.
+    let mut two_mass = presets::load("two-mass").unwrap();
+    two_mass.theta_bw = 2e-4;
+    two_mass.w = 1e-4;
+    two_mass.tload = 2e-3;
+    let cases: [Case; 8] = std::array::from_fn(|l| Case {
+        hz: 20.0 + 9.0 * l as f64,
+        amplitude: if l == 3 { 4e-3 } else { 0.02 + 0.01 * l as f64 },
+        offset: 0.0,
+        load: if l == 5 { -3e-3 } else { 0.0 },
+        y0: [0.0; NSTATE],
+    });
+    let lone = compare(&two_mass, &cases, 20_000);
+    let events: Vec<u64> = lone.iter().map(|r| r.events).collect();
+    assert!(events.iter().filter(|&&e| e > 0).count() >= 4, "{events:?}");
+    // The direct drive with unbalance and load: stick below the friction band.
+    let mut direct = presets::load("direct-drive").unwrap();
+    direct.unbalance_mass = 10.0;
+    direct.unbalance_radius = 0.01;
+    direct.tload = 0.3;
+    let cases: [Case; 8] = std::array::from_fn(|l| Case {
+        hz: 2.0 + 3.0 * l as f64,
+        amplitude: 0.5 + 1.5 * l as f64,
+        offset: 0.0,
+        load: if l == 2 { 0.4 } else { 0.0 },
+        y0: [0.0; NSTATE],
+    });
+    let lone = compare(&direct, &cases, 20_000);
+    let stuck: Vec<usize> = lone.iter().map(|r| r.stuck_steps).collect();
+    assert!(
+        stuck.iter().any(|&s| s > 0) && stuck.windows(2).any(|w| w[0] != w[1]),
+        "{stuck:?}"
+    );
+}

@@ -54,6 +54,8 @@ pub mod butterworth;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
+use super::torque_curve::TorqueCurve;
+use crate::io::experiment_file::sample_period;
 use butterworth::Butterworth;
 
 /// Order of the decimation filter (MATLAB's `decimate` uses an 8th-order prototype).
@@ -223,6 +225,15 @@ pub fn identify(
         decimation_cutoff_hz,
         settings: *settings,
     })
+}
+
+/// The law fitted to a torque curve (paper §4.2): the table angle is the motion, the
+/// motor torque the effort, so M and Fv are referred to the table and Fc is the
+/// friction seen at the motor, fm + fw·Rg + ft·Rg·Rw — what `torque_curve::evaluate`
+/// estimates from the reversal windows, here from the whole curve.
+pub fn of_torque_curve(curve: &TorqueCurve, settings: &IdimSettings) -> Result<IdimFit, IdimError> {
+    let period = sample_period(&curve.time).unwrap_or(f64::NAN);
+    identify(period, &curve.table_angle, &curve.motor_torque, settings)
 }
 
 fn setting(name: &'static str, value: f64, reason: &'static str) -> IdimError {

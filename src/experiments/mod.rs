@@ -1,4 +1,6 @@
-//! The paper's five tests (MODEL.md §5): virtual experiments and the evaluation of their measured data.
+//! The paper's five tests (MODEL.md §5): virtual experiments and the evaluation of their
+//! measured data; servo traces of any axis (replay, simulation error, virtual traces) and
+//! the friction law fitted to any recorded motion.
 
 pub mod compare;
 pub mod extrema;
@@ -16,6 +18,7 @@ pub mod nonlinear_distortion;
 pub mod periodic_estimate;
 pub mod periodic_record;
 pub mod positioning;
+pub mod servo_trace;
 pub mod spectrum;
 pub mod stepped_sine;
 pub mod torque_curve;

@@ -17,6 +17,7 @@ use crate::input::Move;
 use crate::io::experiment_file::{Data, Kind, Manifest};
 use crate::model::idx::THETA_T;
 use crate::model::params::{LoopMode, Params};
+use crate::model::rest::{rest_state, Preload};
 use crate::recorder::NullRecorder;
 use crate::sim::{SimError, Simulation};
 
@@ -108,11 +109,7 @@ pub fn run(
     let stops = test.cycle();
     // Start at rest at the first stop, controller aligned with it.
     let start = stops[0].0;
-    let mut y = sim.state();
-    y[crate::model::idx::THETA_M] = start / p.ratio();
-    y[crate::model::idx::THETA_W] = start / p.rw;
-    y[THETA_T] = start;
-    sim.set_state(y);
+    sim.set_state(rest_state(&p, start, Preload::None));
     let mut controller = sim.controller(&p)?;
     let noise = Normal::new(0.0, test.noise.max(0.0)).expect("σ ≥ 0 is a valid normal");
     let mut rng = rand::rngs::StdRng::seed_from_u64(test.seed);

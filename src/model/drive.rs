@@ -1,12 +1,20 @@
 //! [`Drive`]: the validated parameters compiled into the constants the kernel reads
 //! (inverse inertias, merged bodies of the direct topology, flags for the optional
 //! terms). A plain `Copy` struct, built once per simulation.
+//!
+//! The four topologies share one state layout ([`idx`], 8 slots). The kernel has three
+//! forms of the equations ([`Form`]): the spur-gear drive; the drive with the motor on
+//! the driving shaft (`direct`, and `two_mass`, which is that form with Rw = 1 and no
+//! axial degree of freedom: 1/r = Kb = Cb = 1/Mw = 0, so xw stays 0); and the single
+//! rigid body of `direct_drive`.
 
 use super::backlash::{dead_zone, mesh_torque};
 use super::params::{ParamError, Params, Topology, GRAVITY};
 
-/// Index of each state in the kernel's state vector. For the direct topology the
-/// shaft slots mirror the motor (θw ≡ θm).
+/// Index of each state in the kernel's state vector. Slots a topology does not
+/// integrate mirror the ones it does ([`Drive::mirror`]): the shaft follows the motor
+/// in the `direct` and `two_mass` topologies (θw ≡ θm), motor and shaft follow the table
+/// in `direct_drive` (θm ≡ θw ≡ θt); xw stays 0 without an axial bearing.
 pub mod idx {
     /// Motor angle θm, rad.
     pub const THETA_M: usize = 0;
@@ -29,11 +37,27 @@ pub mod idx {
 /// Number of states.
 pub const NSTATE: usize = 8;
 
+/// Which equations the kernel integrates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Form {
+    /// Motor, spur mesh, driving shaft, drive mesh, axial bearing, table (`spur_gear`).
+    Spur,
+    /// Motor with the driving shaft, drive mesh, axial bearing, table (`direct`,
+    /// `two_mass`).
+    Shaft,
+    /// One rigid body: motor and table (`direct_drive`).
+    Rigid,
+}
+
 /// The model's constants in the form the kernel uses them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Drive {
     /// Whether a spur-gear stage separates motor and driving shaft (4 DOF).
     pub spur: bool,
+    /// The drive train.
+    pub topology: Topology,
+    /// The equations the kernel integrates.
+    pub form: Form,
     pub(crate) inv_jm: f64,
     pub(crate) inv_jw: f64,
     pub(crate) inv_jt: f64,
@@ -62,6 +86,8 @@ pub struct Drive {
     /// m·g·e of the unbalance, N·m.
     pub(crate) mge: f64,
     pub(crate) psi: f64,
+    /// Constant external table torque Tload, N·m (N).
+    pub(crate) tload: f64,
 }
 
 impl Drive {
@@ -69,18 +95,28 @@ impl Drive {
     pub fn new(p: &Params) -> Result<Self, ParamError> {
         p.validate()?;
         let spur = p.topology == Topology::SpurGear;
-        // Direct drive: the shaft is part of the motor body.
+        let form = match p.topology {
+            Topology::SpurGear => Form::Spur,
+            Topology::Direct | Topology::TwoMass => Form::Shaft,
+            Topology::DirectDrive => Form::Rigid,
+        };
+        // Direct drive: the shaft is part of the motor body (for two_mass the
+        // shaft's parameters do not apply and hold 0).
         let (jm, cm, fm) = if spur {
             (p.jm, p.cm, p.fm)
         } else {
             (p.jm + p.jw, p.cm + p.cw, p.fm + p.fw)
         };
+        // Without an axial bearing (two_mass, direct_drive) xw stays 0: 1/Mw = 0.
+        let axial = matches!(form, Form::Spur) || p.topology == Topology::Direct;
         Ok(Drive {
             spur,
-            inv_jm: 1.0 / jm,
+            topology: p.topology,
+            form,
+            inv_jm: if form == Form::Rigid { 0.0 } else { 1.0 / jm },
             inv_jw: if spur { 1.0 / p.jw } else { 0.0 },
             inv_jt: 1.0 / p.jt,
-            inv_mw: 1.0 / p.mw,
+            inv_mw: if axial { 1.0 / p.mw } else { 0.0 },
             cm,
             cw: if spur { p.cw } else { 0.0 },
             cb: p.cb,
@@ -93,7 +129,7 @@ impl Drive {
             kb: p.kb,
             rg: p.rg.unwrap_or(1.0),
             rw: p.rw,
-            inv_r: 1.0 / p.r,
+            inv_r: if axial { 1.0 / p.r } else { 0.0 },
             bg: p.theta_bg.unwrap_or(0.0),
             bw: p.theta_bw,
             fluct: p.w != 0.0,
@@ -103,7 +139,37 @@ impl Drive {
             unbalance: p.unbalance_mass > 0.0,
             mge: p.unbalance_mass * GRAVITY * p.unbalance_radius,
             psi: p.unbalance_phase,
+            tload: p.tload,
         })
+    }
+
+    /// Sets the slots this topology does not integrate from the ones it does (see
+    /// [`idx`]).
+    pub fn mirror(&self, y: &mut [f64; NSTATE]) {
+        use idx::*;
+        match self.form {
+            Form::Spur => {}
+            Form::Shaft => {
+                y[THETA_W] = y[THETA_M];
+                y[OMEGA_W] = y[OMEGA_M];
+            }
+            Form::Rigid => {
+                for (pos, vel) in [(THETA_M, OMEGA_M), (THETA_W, OMEGA_W)] {
+                    y[pos] = y[THETA_T];
+                    y[vel] = y[OMEGA_T];
+                }
+            }
+        }
+        if self.inv_mw == 0.0 {
+            y[X_W] = 0.0;
+            y[V_W] = 0.0;
+        }
+    }
+
+    /// The constant external table torque `Tload`, N·m (N): what a caller of the
+    /// kernel adds to its external loads.
+    pub fn tload(&self) -> f64 {
+        self.tload
     }
 
     /// Total drive ratio, table turns per motor turn.
@@ -117,12 +183,21 @@ impl Drive {
     }
 
     /// Total mechanical energy (kinetic + mesh and bearing springs + unbalance
-    /// potential), J. Conserved by the equations without damping, friction and
+    /// potential), J (rotary axis; the same in N·m = J on a linear one). Conserved by the equations without damping, friction and
     /// input; the kernel's energy test measures its drift.
     pub fn energy(&self, y: &[f64; NSTATE]) -> f64 {
         let [tm, wm, tw, ww, xw, vw, tt, wt] = *y;
-        let mut e = 0.5 * wm * wm / self.inv_jm
-            + 0.5 * vw * vw / self.inv_mw
+        // A body without inertia of its own (the motor of direct_drive, the axial
+        // unit of two_mass) has 1/J = 0 and no kinetic energy of its own.
+        let kinetic = |v: f64, inv_j: f64| {
+            if inv_j > 0.0 {
+                0.5 * v * v / inv_j
+            } else {
+                0.0
+            }
+        };
+        let mut e = kinetic(wm, self.inv_jm)
+            + kinetic(vw, self.inv_mw)
             + 0.5 * wt * wt / self.inv_jt
             + 0.5 * self.kb * xw * xw;
         let shaft = if self.spur {

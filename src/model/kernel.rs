@@ -18,7 +18,17 @@
 //! Jt·ωt' = Tw − Ct·ωt − m·g·e·sin(θt + ψ) + Tload − friction_t
 //! ```
 //!
-//! Friction is the stick/slip clamp of friction.rs.
+//! Friction is the stick/slip clamp of friction.rs. Tload is the lane's external
+//! table torque, which includes the drive's constant `Tload` parameter (added by
+//! the caller, see [`Kernel::step`]).
+//!
+//! The `two_mass` topology is the direct form with Rw = 1 and no axial degree of
+//! freedom (1/r = Kb = Cb = 1/Mw = 0 in the compiled drive, so xw stays 0): the
+//! coupling Tk is Tw, and Jm·ωm' = Tm − Cm·ωm − (1 + e')·Tk − friction_m. The
+//! `direct_drive` topology is one rigid body integrated by its own short step
+//! (`rigid_rk4`): Jt·ωt' = Tm − Ct·ωt − m·g·e·sin(θt + ψ) + Tload − friction_t, the
+//! motor and shaft slots mirroring the table. On a linear axis the same equations
+//! hold in m, N, kg.
 //!
 //! **Lanes.** The common path of a step has no per-lane control flow: the dead
 //! zones, the contact clamp, the friction decision and the stop at a velocity
@@ -51,7 +61,7 @@
 
 use super::backlash::mesh_torque_lanes;
 use super::drive::{idx::*, taylor_sin_cos, Drive, NSTATE, PHASE_RESYNC, SMALL_ANGLE};
-use super::friction::{decide_lanes, stop_at_reversal_lanes};
+use super::friction::{decide_lanes, stop_at_reversal, stop_at_reversal_lanes, Friction};
 use super::lanes::Lanes;
 
 /// The state of `L` lanes: `y[i][l]` is state `i` (see [`idx`](super::drive::idx)) of lane `l`.
@@ -291,9 +301,32 @@ impl<const L: usize> Kernel<L> {
     ///
     /// `motor[s][l]` is lane `l`'s motor torque at the step's start (`s = 0`), middle
     /// (`s = 1`) and end (`s = 2`); `load[l]` the external table torque, held over the
-    /// step.
+    /// step, **including** the drive's constant `Tload` ([`Drive::tload`]: the
+    /// simulations add it to their loads, so the kernel never spends an addition on
+    /// it).
     #[inline]
     pub fn step(
+        &mut self,
+        d: &Drive,
+        y: &mut States<L>,
+        motor: &[[f64; L]; 3],
+        load: &[f64; L],
+        h: f64,
+    ) {
+        if d.form == crate::model::drive::Form::Rigid {
+            self.step_rigid(d, y, motor, load, h);
+        } else {
+            self.step_meshed(d, y, motor, load, h);
+        }
+    }
+
+    /// [`Kernel::step`] for a drive with meshes (`spur_gear`, `direct`, `two_mass`).
+    /// A loop over steps of one drive calls this (or [`Kernel::step_rigid`]) directly,
+    /// the choice made once outside the loop: with the rigid form's branch inside the
+    /// loop the compiler allocated the meshed forms' registers worse (measured: 24
+    /// more instructions per step on the roller-gear cam, 5 %, mostly spills).
+    #[inline]
+    pub fn step_meshed(
         &mut self,
         d: &Drive,
         y: &mut States<L>,
@@ -306,6 +339,19 @@ impl<const L: usize> Kernel<L> {
         } else {
             self.step_with_events::<false>(d, y, motor, load, h);
         }
+    }
+
+    /// [`Kernel::step`] for the single rigid body of `direct_drive`.
+    #[inline]
+    pub fn step_rigid(
+        &mut self,
+        d: &Drive,
+        y: &mut States<L>,
+        motor: &[[f64; L]; 3],
+        load: &[f64; L],
+        h: f64,
+    ) {
+        rigid_rk4(d, &mut self.lanes, y, motor, load, h);
     }
 
     /// Whether motor, shaft and table of lane `l` were stuck during the last step.
@@ -517,6 +563,68 @@ fn quadratic(m: &[f64; 3], s: f64) -> f64 {
 #[inline(never)]
 fn unbalance_torque(d: &Drive, table_angle: f64) -> f64 {
     -d.mge * (table_angle + d.psi).sin()
+}
+
+/// One classical RK4 step of the single rigid body of `direct_drive` (motor rotor and
+/// table, slots θt, ωt; motor and shaft slots mirror them):
+///
+/// ```text
+/// Jt·ωt' = Tm − Ct·ωt − friction_t − m·g·e·sin(θt + ψ) + Tload
+/// ```
+///
+/// with the stick/slip decision of friction.rs at the step's first stage and the stop
+/// at a velocity reversal, as for the table of the other forms. No mesh, so no
+/// contact events. Written lane by lane with the scalar friction law, out of line:
+/// built from the lane-wise helpers of the other forms, its mere presence changed how
+/// the compiler allocated registers in their step (measured: 24 more instructions
+/// per step on the roller-gear cam, mostly spills). Each lane is computed alone, so
+/// lanes equal lone runs.
+#[inline(never)]
+fn rigid_rk4<const L: usize>(
+    d: &Drive,
+    st: &mut LaneState<L>,
+    y: &mut States<L>,
+    motor: &[[f64; L]; 3],
+    load: &[f64; L],
+    h: f64,
+) {
+    for l in 0..L {
+        let (t1, w1) = (y[THETA_T][l], y[OMEGA_T][l]);
+        let m = [motor[0][l], motor[1][l], motor[2][l]];
+        let torque = |t: f64, w: f64, m: f64| m - d.ct * w + rigid_unbalance(d, t) + load[l];
+        let first = torque(t1, w1, m[0]);
+        let friction = Friction::decide(first, w1, d.fc[2]);
+        let accel = |t: f64| friction.net(t) * d.inv_jt;
+        let a1 = accel(first);
+        let (t2, w2) = (t1 + 0.5 * h * w1, w1 + 0.5 * h * a1);
+        let a2 = accel(torque(t2, w2, m[1]));
+        let (t3, w3) = (t1 + 0.5 * h * w2, w1 + 0.5 * h * a2);
+        let a3 = accel(torque(t3, w3, m[1]));
+        let (t4, w4) = (t1 + h * w3, w1 + h * a3);
+        let a4 = accel(torque(t4, w4, m[2]));
+        let sixth = h * (1.0 / 6.0);
+        let angle = t1 + sixth * (w1 + 2.0 * (w2 + w3) + w4);
+        let mut speed = w1 + sixth * (a1 + 2.0 * (a2 + a3) + a4);
+        stop_at_reversal(w1, &mut speed, d.fc[2]);
+        for (pos, vel) in [(THETA_M, OMEGA_M), (THETA_W, OMEGA_W), (THETA_T, OMEGA_T)] {
+            y[pos][l] = angle;
+            y[vel][l] = speed;
+        }
+        // Motor and shaft are the table: they stick when it does.
+        for b in 0..3 {
+            st.free[b][l] = friction.free;
+        }
+    }
+}
+
+/// Tu = −m·g·e·sin(θt + ψ) on the rigid body (0 without unbalance).
+#[inline(always)]
+fn rigid_unbalance(d: &Drive, table_angle: f64) -> f64 {
+    if d.unbalance {
+        unbalance_torque(d, table_angle)
+    } else {
+        0.0
+    }
 }
 
 /// `y + a·k`, lane-wise.

@@ -1,5 +1,6 @@
-//! The rotary-table model: parameters, presets, the compiled drive, the laws of its
-//! meshes and friction, the simulation kernel and modal analysis.
+//! The axis-drive model: parameters (their registry and file form), presets, the
+//! compiled drive, the laws of its meshes and friction, the simulation kernel, states
+//! at rest and modal analysis.
 
 pub mod backlash;
 pub mod drive;
@@ -9,8 +10,11 @@ pub mod lanes;
 pub mod linear_response;
 pub mod modes;
 pub mod params;
+pub mod params_json;
 pub mod presets;
+pub mod registry;
+pub mod rest;
 
 pub use drive::{idx, Drive, NSTATE};
 pub use kernel::{Kernel, States};
-pub use params::{ControllerParams, LoopMode, ParamError, Params, Topology};
+pub use params::{Axis, ControllerParams, LoopMode, ParamError, Params, Topology};

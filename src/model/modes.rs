@@ -5,8 +5,9 @@
 //!
 //! Linearisation: no backlash (θb = 0), no Coulomb friction, no gear fluctuation
 //! (W = 0), no unbalance. Generalized coordinates q = [θm, θw, xw, θt] (spur gear,
-//! rad, rad, m, rad) or [θm, xw, θt] (direct drive: the shaft is part of the motor
-//! body, θw ≡ θm). The potential of MODEL.md §2,
+//! rad, rad, m, rad), [θm, xw, θt] (direct: the shaft is part of the motor body,
+//! θw ≡ θm), [θm, θt] (two_mass) or [θt] (direct_drive: motor and table one body). The
+//! potential of MODEL.md §2,
 //!
 //! ```text
 //! V = ½Kg·(Rg·θm − θw)² + ½Kw·(Rw·θw + xw/r − θt)² + ½Kb·xw²
@@ -16,7 +17,14 @@
 //! M = diag(Jm, Jw, Mw, Jt)                    (direct: diag(Jm + Jw, Mw, Jt))
 //! C = diag(Cm, Cw, Cb, Ct) + Cig·a·aᵀ + Ciw·b·bᵀ
 //!                                             (direct: diag(Cm + Cw, Cb, Ct) + Ciw·b·bᵀ)
+//! two_mass:     b = [1, −1]   M = diag(Jm, Jt)   K = Kw·b·bᵀ   C = diag(Cm, Ct) + Ciw·b·bᵀ
+//! direct_drive: M = [Jt]      K = [0]            C = [Ct]
 //! ```
+//!
+//! The two-mass drive's modes are the textbook pair: motor free √(Kw·(1/Jm + 1/Jt)),
+//! motor held √(Kw/Jt) (the antiresonance of the motor's response and the peak of
+//! table over motor). The direct drive has only its rigid-body mode: no natural
+//! frequency, motor held or free, and a table/motor ratio of exactly 1.
 //!
 //! gives M·q'' + C·q' + K·q = F, the equations the kernel integrates once the meshes
 //! are in contact. "Clamped" below means the motor held (θm ≡ 0: its row and column
@@ -78,6 +86,23 @@ impl LinearModel {
                     rigid_modes: 1,
                 }
             }
+            Topology::TwoMass => {
+                let b = outer(&[1.0, -1.0]);
+                LinearModel {
+                    m: diag(&[p.jm, p.jt]),
+                    c: diag(&[p.cm, p.ct]) + p.ciw * &b,
+                    k: p.kw * b,
+                    dofs: vec!["theta_m", "theta_t"],
+                    rigid_modes: 1,
+                }
+            }
+            Topology::DirectDrive => LinearModel {
+                m: diag(&[p.jt]),
+                c: diag(&[p.ct]),
+                k: DMatrix::zeros(1, 1),
+                dofs: vec!["theta_t"],
+                rigid_modes: 1,
+            },
             Topology::Direct => {
                 let b = outer(&[p.rw, inv_r, -1.0]);
                 let c = outer(&[0.0, 1.0, 0.0]);
@@ -103,9 +128,18 @@ impl LinearModel {
         self.dofs.iter().position(|d| *d == name)
     }
 
-    /// The model with the motor held (θm ≡ 0): row and column of θm removed.
+    /// The model with the motor held (θm ≡ 0): row and column of θm removed. For the
+    /// direct drive, whose table is the motor, nothing is left to move: an empty model.
     pub fn motor_held(&self) -> LinearModel {
-        let i = self.index("theta_m").expect("every topology has theta_m");
+        let Some(i) = self.index("theta_m") else {
+            return LinearModel {
+                m: DMatrix::zeros(0, 0),
+                c: DMatrix::zeros(0, 0),
+                k: DMatrix::zeros(0, 0),
+                dofs: Vec::new(),
+                rigid_modes: 0,
+            };
+        };
         LinearModel {
             m: self.m.clone().remove_row(i).remove_column(i),
             c: self.c.clone().remove_row(i).remove_column(i),
@@ -128,6 +162,9 @@ impl LinearModel {
     /// Solves K·φ = ω²·M·φ as the symmetric problem (L⁻¹·K·L⁻¹)·v = ω²·v with
     /// L = M^½ (M is diagonal), φ = L⁻¹·v.
     pub fn natural_modes(&self) -> (Vec<f64>, Vec<Vec<f64>>) {
+        if self.n_dof() == 0 {
+            return (Vec::new(), Vec::new());
+        }
         let inv_sqrt_m = self.m.diagonal().map(|m| 1.0 / m.sqrt());
         let l_inv = DMatrix::from_diagonal(&inv_sqrt_m);
         let a = &l_inv * &self.k * &l_inv;
@@ -224,10 +261,9 @@ pub fn max_rate(p: &Params) -> Result<f64, ParamError> {
 pub fn frequency_response(p: &Params, freqs_hz: &[f64]) -> Result<Vec<Complex<f64>>, ParamError> {
     let model = LinearModel::new(p)?;
     let n = model.n_dof();
-    let (im, it) = (
-        model.index("theta_m").expect("theta_m"),
-        model.index("theta_t").expect("theta_t"),
-    );
+    // The direct drive's one coordinate is both motor and table angle.
+    let it = model.index("theta_t").expect("every topology has theta_t");
+    let im = model.index("theta_m").unwrap_or(it);
     let mut f = DVector::from_element(n, Complex::new(0.0, 0.0));
     f[im] = Complex::new(1.0, 0.0);
     let ratio = p.ratio();
@@ -356,6 +392,8 @@ mod tests {
                     DVector::from_vec(vec![1.0, rg, 0.0, rg * p.rw])
                 }
                 Topology::Direct => DVector::from_vec(vec![1.0, 0.0, p.rw]),
+                Topology::TwoMass => DVector::from_vec(vec![1.0, 1.0]),
+                Topology::DirectDrive => DVector::from_vec(vec![1.0]),
             };
             assert!((&free.k * &r).norm() < 1e-9 * free.k.norm());
             let mr = r.dot(&(&free.m * &r));
@@ -465,5 +503,46 @@ mod tests {
         ));
         assert!(max_rate(&p).is_err());
         assert!(frequency_response(&p, &[100.0]).is_err());
+    }
+
+    #[test]
+    fn two_mass_modes_are_the_textbook_pair() {
+        let p = preset("two-mass");
+        let m = modes(&p).unwrap();
+        let held = (p.kw / p.jt).sqrt() / (2.0 * PI);
+        let free = (p.kw * (1.0 / p.jm + 1.0 / p.jt)).sqrt() / (2.0 * PI);
+        assert_hz(&m.clamped_hz, &[held], 1e-9 * held, "held");
+        assert_hz(&m.free_hz, &[free], 1e-9 * free, "free");
+        // The FdiTools bench: 53.5–53.9 Hz and 76.2 Hz.
+        assert!((held - 53.97).abs() < 0.01 && (free - 76.33).abs() < 0.01);
+        // Motor free: motor and table swing against each other, momentum zero.
+        let shape = &m.free_shapes[0];
+        assert!((p.jm * shape[0] + p.jt * shape[1]).abs() < 1e-9);
+        // The linear gain of table over motor peaks at the held mode.
+        let mut light = p.clone();
+        scale_damping(&mut light, 0.01);
+        let freqs: Vec<f64> = (0..=2000).map(|i| 40.0 + 0.01 * i as f64).collect();
+        let g = gain_db(&light, &freqs);
+        let peak = (1..g.len() - 1)
+            .filter(|&i| g[i] > g[i - 1] && g[i] > g[i + 1])
+            .map(|i| freqs[i])
+            .collect::<Vec<_>>();
+        assert_eq!(peak.len(), 1, "{peak:?}");
+        assert!((peak[0] - held).abs() < 0.02, "{peak:?} vs {held}");
+    }
+
+    #[test]
+    fn the_direct_drive_has_only_its_rigid_body_mode() {
+        let p = preset("direct-drive");
+        let m = modes(&p).unwrap();
+        assert!(m.clamped_hz.is_empty() && m.free_hz.is_empty(), "{m:?}");
+        assert_eq!(m.free_dofs, ["theta_t"]);
+        // Table and motor are one: the gain is 0 dB at every frequency.
+        for h in frequency_response(&p, &[1.0, 100.0, 1000.0]).unwrap() {
+            assert!((h.norm() - 1.0).abs() < 1e-12 && h.im.abs() < 1e-12, "{h}");
+        }
+        // The only rate is the viscous decay Ct/Jt.
+        let rate = max_rate(&p).unwrap();
+        assert!((rate - p.ct / p.jt).abs() < 1e-12 * rate, "{rate}");
     }
 }

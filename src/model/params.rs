@@ -1,17 +1,25 @@
-//! The physical parameters of a rotary table and its servo controller (MODEL.md §2–4).
+//! The physical parameters of a CNC axis drive and its servo controller (MODEL.md
+//! §1.1, §2–4).
 //!
-//! One serde type, [`Params`], holds everything in SI units (rad, N·m, s, kg, m). Its
-//! JSON field names are the paper's symbols in ASCII (`Jm`, `Kw`, `theta_bw`, …), the
-//! same names `--set` and `--fit` take on the command line. [`PARAMS`] lists every name
-//! with its unit and meaning; [`Params::validate`] checks each value against the
-//! physical constraint of its kind and names the offending field.
+//! One type, [`Params`], holds everything in SI units: on a rotary axis rad, N·m,
+//! kg·m²; on a linear axis m, N, kg for the same names (MODEL.md §1.1). Its JSON field
+//! names are the paper's symbols in ASCII (`Jm`, `Kw`, `theta_bw`, …), the same names
+//! `--set` and `--fit` take on the command line. The registry ([`PARAMS`]) lists every
+//! name with its units, meaning and the topologies it applies to; [`Params::validate`]
+//! checks each value against the physical constraint of its kind and names the
+//! offending field. A parameter that does not apply to the topology (or axis) is
+//! absent from files, holds its registry's `unused` value in memory, and is refused
+//! by [`Params::set`] and [`Params::validate`] with an error naming it. The JSON form
+//! is `params_json.rs`.
 
 use std::collections::BTreeMap;
 use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
-/// Which drive train the table has.
+pub use super::registry::{spec, Applies, Constraint, ParamSpec, PARAMS};
+
+/// Which drive train the axis has (MODEL.md §1, §1.1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Topology {
@@ -22,6 +30,12 @@ pub enum Topology {
     /// (θm, xw, θt). The roller-gear-cam table. The shaft's inertia `Jw`, viscous
     /// damping `Cw` and friction `fw` (if given) add to the motor's.
     Direct,
+    /// One body, motor rotor and table (or carriage): 1 DOF (θt = θm, ratio 1). A
+    /// direct-drive table, or the rigid core of a feed axis.
+    DirectDrive,
+    /// Motor and table (or load) joined by a torsional coupling (`Kw`, `Ciw`,
+    /// `theta_bw`, ratio 1, no axial DOF): 2 DOF (θm, θt).
+    TwoMass,
 }
 
 impl fmt::Display for Topology {
@@ -29,6 +43,29 @@ impl fmt::Display for Topology {
         f.write_str(match self {
             Topology::SpurGear => "spur_gear",
             Topology::Direct => "direct",
+            Topology::DirectDrive => "direct_drive",
+            Topology::TwoMass => "two_mass",
+        })
+    }
+}
+
+/// Whether the axis turns or slides (MODEL.md §1.1). The equations are the same; the
+/// units of positions, loads and inertias differ.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Axis {
+    /// rad, N·m, kg·m².
+    #[default]
+    Rotary,
+    /// m, N, kg (the `direct_drive` and `two_mass` topologies only).
+    Linear,
+}
+
+impl fmt::Display for Axis {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Axis::Rotary => "rotary",
+            Axis::Linear => "linear",
         })
     }
 }
@@ -68,477 +105,178 @@ impl fmt::Display for LoopMode {
     }
 }
 
-/// The discrete P/PI servo controller of the paper's Fig. 6 (MODEL.md §4).
+/// The discrete cascade servo (MODEL.md §1.1, §4; paper Fig. 6): position P or PI →
+/// velocity P or PI, the output saturated in its own unit and turned into torque (or
+/// force) by the drive gain.
 ///
 /// Gains act on motor-side quantities: the position error is expressed in motor
-/// radians (a table error is divided by Rg·Rw), the velocity in motor rad/s.
+/// radians (a table error is divided by Rg·Rw; metres on a linear axis), the velocity
+/// in motor rad/s (m/s). The output unit is N·m (N) for a torque command
+/// (`drive_gain` = 1, the default), else the drive's input unit (V, A).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ControllerParams {
     /// Position loop proportional gain, 1/s (velocity command per position error).
     #[serde(rename = "Kpp")]
     pub kpp: f64,
-    /// Velocity loop proportional gain, N·m·s/rad.
+    /// Position loop integral gain, 1/s² (integrator Tc·z/(z−1); 0: P position loop).
+    #[serde(rename = "Kpi", default, skip_serializing_if = "is_zero")]
+    pub kpi: f64,
+    /// Velocity loop proportional gain, output unit·s/rad (N·m·s/rad for a torque
+    /// command; per m/s on a linear axis).
     #[serde(rename = "Kvp")]
     pub kvp: f64,
-    /// Velocity loop integral gain, N·m/rad (integrator Tc·z/(z−1)).
+    /// Velocity loop integral gain, output unit/rad (integrator Tc·z/(z−1)).
     #[serde(rename = "Kvi")]
     pub kvi: f64,
     /// Control period, s. Must be a whole number of integration steps.
     #[serde(rename = "Tc")]
     pub tc: f64,
-    /// Motor torque limit, N·m (the amplifier's peak torque).
+    /// Limit of the controller output in its own unit (N·m or N for a torque
+    /// command: the amplifier's peak torque; V or A with a `drive_gain`).
     pub torque_limit: f64,
-    /// Limit of the velocity command, motor rad/s (the drive's maximum speed).
+    /// Limit of the velocity command, motor rad/s (m/s on a linear axis).
     pub speed_limit: f64,
-    /// Motor encoder resolution, counts per motor revolution (0: no quantisation).
+    /// Torque (N·m) or force (N) per unit of controller output: the amplifier's gain
+    /// (V→N, A→N·m); 1 for a torque command.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub drive_gain: f64,
+    /// Control periods between sampling and applying the output: 0, the law
+    /// evaluated at the sample (u_k from the samples at k, applied at k); 1, one
+    /// sample late (u_k applied at k+1).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub output_delay_periods: f64,
+    /// Motor encoder resolution, counts per motor revolution (0: ideal, or given by
+    /// `motor_encoder_resolution`); rotary axes only.
+    #[serde(default, skip_serializing_if = "is_zero")]
     pub motor_encoder_counts: f64,
-    /// Table encoder resolution, rad (0.0001° = 1.745e-6 rad; 0: no quantisation).
+    /// Motor (loop) encoder resolution, rad or m per count (0: ideal, or given by
+    /// `motor_encoder_counts`). A linear axis gives its encoder this way.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub motor_encoder_resolution: f64,
+    /// Table encoder resolution, rad or m (0.0001° = 1.745e-6 rad; 0: no quantisation).
     pub table_encoder_resolution: f64,
     /// Semi-closed or full-closed loop.
     #[serde(rename = "loop", default)]
     pub loop_mode: LoopMode,
 }
 
-/// Every parameter of the model, SI units. Field docs give the unit; MODEL.md §3 the
-/// paper's values. See [`PARAMS`] for the names used in files and on the command line.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Params {
-    /// Short name of this parameter set (a preset name, or free text).
-    #[serde(default)]
-    pub name: String,
-    /// Drive train: `spur_gear` (4 DOF) or `direct` (3 DOF).
-    pub topology: Topology,
-    /// Motor inertia, kg·m² (direct topology: motor + cam).
-    #[serde(rename = "Jm")]
-    pub jm: f64,
-    /// Spur gears + driving shaft inertia, kg·m² (direct: added to `Jm`, may be 0).
-    #[serde(rename = "Jw", default)]
-    pub jw: f64,
-    /// Table + driven part inertia, kg·m².
-    #[serde(rename = "Jt")]
-    pub jt: f64,
-    /// Mass of the driving unit moving axially, kg.
-    #[serde(rename = "Mw")]
-    pub mw: f64,
-    /// Motor viscous damping, N·m·s/rad.
-    #[serde(rename = "Cm")]
-    pub cm: f64,
-    /// Driving shaft viscous damping, N·m·s/rad.
-    #[serde(rename = "Cw", default)]
-    pub cw: f64,
-    /// Axial viscous damping of the driving unit, N·s/m.
-    #[serde(rename = "Cb")]
-    pub cb: f64,
-    /// Table viscous damping, N·m·s/rad.
-    #[serde(rename = "Ct")]
-    pub ct: f64,
-    /// Internal damping of the spur-gear mesh (motor–shaft), N·m·s/rad; spur gear only.
-    #[serde(rename = "Cig", default, skip_serializing_if = "Option::is_none")]
-    pub cig: Option<f64>,
-    /// Internal damping of the drive mesh (shaft–table), N·m·s/rad.
-    #[serde(rename = "Ciw")]
-    pub ciw: f64,
-    /// Motor Coulomb friction torque, N·m.
-    #[serde(rename = "fm")]
-    pub fm: f64,
-    /// Driving shaft Coulomb friction torque, N·m.
-    #[serde(rename = "fw", default)]
-    pub fw: f64,
-    /// Table Coulomb friction torque, N·m.
-    #[serde(rename = "ft")]
-    pub ft: f64,
-    /// Spur-gear torsional stiffness, N·m/rad in driving-shaft units; spur gear only.
-    #[serde(rename = "Kg", default, skip_serializing_if = "Option::is_none")]
-    pub kg: Option<f64>,
-    /// Drive torsional stiffness, N·m/rad in table units.
-    #[serde(rename = "Kw")]
-    pub kw: f64,
-    /// Axial bearing stiffness of the driving unit, N/m.
-    #[serde(rename = "Kb")]
-    pub kb: f64,
-    /// Spur-gear ratio (shaft turns per motor turn); spur gear only.
-    #[serde(rename = "Rg", default, skip_serializing_if = "Option::is_none")]
-    pub rg: Option<f64>,
-    /// Drive ratio (table turns per shaft turn).
-    #[serde(rename = "Rw")]
-    pub rw: f64,
-    /// Radius of the driven part (wheel pitch radius), m.
-    #[serde(rename = "r")]
-    pub r: f64,
-    /// Spur-gear backlash half-width, rad in shaft units; spur gear only.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub theta_bg: Option<f64>,
-    /// Drive backlash half-width, rad in table units (total free play 2·theta_bw).
-    #[serde(default)]
-    pub theta_bw: f64,
-    /// Gear-fluctuation amplitude, rad in table units.
-    #[serde(rename = "W", default)]
-    pub w: f64,
-    /// Gear-fluctuation cycles per driving-shaft revolution.
-    #[serde(default = "one")]
-    pub fluct_order: f64,
-    /// Gear-fluctuation phase, rad.
-    #[serde(default)]
-    pub fluct_phase: f64,
-    /// Unbalance mass on a vertical table, kg (0: none).
-    #[serde(default)]
-    pub unbalance_mass: f64,
-    /// Radius of the unbalance mass, m.
-    #[serde(default)]
-    pub unbalance_radius: f64,
-    /// Angular position of the unbalance mass at θt = 0, rad.
-    #[serde(default)]
-    pub unbalance_phase: f64,
-    /// Dead time of the motor encoder signal, s.
-    #[serde(default)]
-    pub encoder_delay: f64,
-    /// Servo controller settings.
-    pub controller: ControllerParams,
-    /// Where each value comes from, and which ones are uncertain (free text per name).
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
-    pub notes: BTreeMap<String, String>,
+impl ControllerParams {
+    /// The motor encoder's quantum, rad (m on a linear axis): its resolution, or one
+    /// revolution over its counts; 0 for an ideal encoder.
+    pub fn motor_quantum(&self) -> f64 {
+        if self.motor_encoder_resolution > 0.0 {
+            self.motor_encoder_resolution
+        } else if self.motor_encoder_counts > 0.0 {
+            std::f64::consts::TAU / self.motor_encoder_counts
+        } else {
+            0.0
+        }
+    }
 }
 
 fn one() -> f64 {
     1.0
 }
 
+fn is_one(v: &f64) -> bool {
+    *v == 1.0
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+/// Every parameter of the model, SI units (rad, N·m, kg·m² on a rotary axis; m, N, kg
+/// on a linear one). Field docs give the unit; MODEL.md §3 the paper's values. See
+/// [`PARAMS`] for the names used in files and on the command line, and which
+/// topologies each applies to; a parameter that does not apply holds the registry's
+/// `unused` value (0, or 1 for `Rw` and `fluct_order`). Files: `params_json.rs`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(
+    try_from = "super::params_json::ParamsJson",
+    into = "super::params_json::ParamsJson"
+)]
+pub struct Params {
+    /// Short name of this parameter set (a preset name, or free text).
+    pub name: String,
+    /// Drive train: `spur_gear` (4 DOF), `direct` (3 DOF), `direct_drive` (1 DOF) or
+    /// `two_mass` (2 DOF).
+    pub topology: Topology,
+    /// Rotary (default) or linear.
+    pub axis: Axis,
+    /// Motor inertia, kg·m² (direct topology: motor + cam).
+    pub jm: f64,
+    /// Spur gears + driving shaft inertia, kg·m² (direct: added to `Jm`, may be 0).
+    pub jw: f64,
+    /// Table + driven part inertia, kg·m² (direct_drive: with the rotor; linear: the
+    /// carriage mass, kg).
+    pub jt: f64,
+    /// Mass of the driving unit moving axially, kg.
+    pub mw: f64,
+    /// Motor viscous damping, N·m·s/rad (N·s/m).
+    pub cm: f64,
+    /// Driving shaft viscous damping, N·m·s/rad.
+    pub cw: f64,
+    /// Axial viscous damping of the driving unit, N·s/m.
+    pub cb: f64,
+    /// Table viscous damping, N·m·s/rad (N·s/m).
+    pub ct: f64,
+    /// Internal damping of the spur-gear mesh (motor–shaft), N·m·s/rad; spur gear only.
+    pub cig: Option<f64>,
+    /// Internal damping of the drive mesh (shaft–table; two_mass: the coupling),
+    /// N·m·s/rad (N·s/m).
+    pub ciw: f64,
+    /// Motor Coulomb friction torque, N·m (N).
+    pub fm: f64,
+    /// Driving shaft Coulomb friction torque, N·m.
+    pub fw: f64,
+    /// Table Coulomb friction torque, N·m (N).
+    pub ft: f64,
+    /// Spur-gear torsional stiffness, N·m/rad in driving-shaft units; spur gear only.
+    pub kg: Option<f64>,
+    /// Drive torsional stiffness, N·m/rad in table units (two_mass: the coupling;
+    /// N/m on a linear axis).
+    pub kw: f64,
+    /// Axial bearing stiffness of the driving unit, N/m.
+    pub kb: f64,
+    /// Spur-gear ratio (shaft turns per motor turn); spur gear only.
+    pub rg: Option<f64>,
+    /// Drive ratio (table turns per shaft turn); 1 for direct_drive and two_mass.
+    pub rw: f64,
+    /// Radius of the driven part (wheel pitch radius), m.
+    pub r: f64,
+    /// Spur-gear backlash half-width, rad in shaft units; spur gear only.
+    pub theta_bg: Option<f64>,
+    /// Drive backlash half-width, rad in table units (total free play 2·theta_bw; m
+    /// on a linear two_mass axis).
+    pub theta_bw: f64,
+    /// Gear-fluctuation amplitude, rad in table units.
+    pub w: f64,
+    /// Gear-fluctuation cycles per driving-shaft (two_mass: motor) revolution.
+    pub fluct_order: f64,
+    /// Gear-fluctuation phase, rad.
+    pub fluct_phase: f64,
+    /// Unbalance mass on a vertical table, kg (0: none).
+    pub unbalance_mass: f64,
+    /// Radius of the unbalance mass, m.
+    pub unbalance_radius: f64,
+    /// Angular position of the unbalance mass at θt = 0, rad.
+    pub unbalance_phase: f64,
+    /// Dead time of the motor encoder signal, s.
+    pub encoder_delay: f64,
+    /// Constant external table torque, N·m (force on a linear axis, N), positive in
+    /// the positive sense of motion: gravity on an inclined axis, a cable carrier, the
+    /// negated offset force OF of the EMPS model (MODEL.md §1.1).
+    pub tload: f64,
+    /// Servo controller settings.
+    pub controller: ControllerParams,
+    /// Where each value comes from, and which ones are uncertain (free text per name).
+    pub notes: BTreeMap<String, String>,
+}
+
 /// Standard gravity, m/s².
 pub const GRAVITY: f64 = 9.80665;
-
-/// The physical constraint a parameter's value must satisfy.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Constraint {
-    /// > 0 (inertias, stiffnesses, radii, periods).
-    Positive,
-    /// ≥ 0 (damping, friction, backlash, amplitudes).
-    NonNegative,
-    /// ≠ 0 (gear ratios).
-    NonZero,
-    /// Any finite value (phases).
-    Finite,
-}
-
-/// Which topology a parameter belongs to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Applies {
-    /// Both topologies.
-    Always,
-    /// Only with a spur-gear stage.
-    SpurGearOnly,
-}
-
-/// One entry of the parameter registry.
-pub struct ParamSpec {
-    /// Name in files and on the command line.
-    pub name: &'static str,
-    /// SI unit.
-    pub unit: &'static str,
-    /// What it is.
-    pub meaning: &'static str,
-    /// The check [`Params::validate`] applies.
-    pub constraint: Constraint,
-    /// Topologies it applies to.
-    pub applies: Applies,
-    get: fn(&Params) -> Option<f64>,
-    set: fn(&mut Params, f64),
-}
-
-impl ParamSpec {
-    /// The value in `p`, `None` when it does not apply to `p`'s topology.
-    pub fn get(&self, p: &Params) -> Option<f64> {
-        (self.get)(p)
-    }
-}
-
-macro_rules! spec {
-    ($name:literal, $unit:literal, $meaning:literal, $c:ident, $a:ident, $($field:ident).+) => {
-        ParamSpec {
-            name: $name,
-            unit: $unit,
-            meaning: $meaning,
-            constraint: Constraint::$c,
-            applies: Applies::$a,
-            get: |p| Some(p.$($field).+),
-            set: |p, v| p.$($field).+ = v,
-        }
-    };
-    ($name:literal, $unit:literal, $meaning:literal, $c:ident, opt $field:ident) => {
-        ParamSpec {
-            name: $name,
-            unit: $unit,
-            meaning: $meaning,
-            constraint: Constraint::$c,
-            applies: Applies::SpurGearOnly,
-            get: |p| p.$field,
-            set: |p, v| p.$field = Some(v),
-        }
-    };
-}
-
-/// Every named parameter, in the order of MODEL.md §3, then the controller's.
-pub const PARAMS: &[ParamSpec] = &[
-    spec!(
-        "Jm",
-        "kg·m²",
-        "motor inertia (direct: motor + cam)",
-        Positive,
-        Always,
-        jm
-    ),
-    spec!(
-        "Jw",
-        "kg·m²",
-        "spur gears + driving shaft inertia",
-        NonNegative,
-        Always,
-        jw
-    ),
-    spec!(
-        "Jt",
-        "kg·m²",
-        "table + driven part inertia",
-        Positive,
-        Always,
-        jt
-    ),
-    spec!(
-        "Mw",
-        "kg",
-        "driving unit mass (axial)",
-        Positive,
-        Always,
-        mw
-    ),
-    spec!(
-        "Cm",
-        "N·m·s/rad",
-        "motor viscous damping",
-        NonNegative,
-        Always,
-        cm
-    ),
-    spec!(
-        "Cw",
-        "N·m·s/rad",
-        "driving shaft viscous damping",
-        NonNegative,
-        Always,
-        cw
-    ),
-    spec!(
-        "Cb",
-        "N·s/m",
-        "axial viscous damping",
-        NonNegative,
-        Always,
-        cb
-    ),
-    spec!(
-        "Ct",
-        "N·m·s/rad",
-        "table viscous damping",
-        NonNegative,
-        Always,
-        ct
-    ),
-    spec!("Cig", "N·m·s/rad", "internal damping of the spur-gear mesh", NonNegative, opt cig),
-    spec!(
-        "Ciw",
-        "N·m·s/rad",
-        "internal damping of the drive mesh",
-        NonNegative,
-        Always,
-        ciw
-    ),
-    spec!(
-        "fm",
-        "N·m",
-        "motor Coulomb friction",
-        NonNegative,
-        Always,
-        fm
-    ),
-    spec!(
-        "fw",
-        "N·m",
-        "driving shaft Coulomb friction",
-        NonNegative,
-        Always,
-        fw
-    ),
-    spec!(
-        "ft",
-        "N·m",
-        "table Coulomb friction",
-        NonNegative,
-        Always,
-        ft
-    ),
-    spec!("Kg", "N·m/rad", "spur-gear torsional stiffness (shaft units)", Positive, opt kg),
-    spec!(
-        "Kw",
-        "N·m/rad",
-        "drive torsional stiffness (table units)",
-        Positive,
-        Always,
-        kw
-    ),
-    spec!("Kb", "N/m", "axial bearing stiffness", Positive, Always, kb),
-    spec!("Rg", "-", "spur-gear ratio (shaft turns per motor turn)", NonZero, opt rg),
-    spec!(
-        "Rw",
-        "-",
-        "drive ratio (table turns per shaft turn)",
-        NonZero,
-        Always,
-        rw
-    ),
-    spec!("r", "m", "radius of the driven part", Positive, Always, r),
-    spec!("theta_bg", "rad", "spur-gear backlash half-width (shaft units)", NonNegative, opt theta_bg),
-    spec!(
-        "theta_bw",
-        "rad",
-        "drive backlash half-width (table units)",
-        NonNegative,
-        Always,
-        theta_bw
-    ),
-    spec!(
-        "W",
-        "rad",
-        "gear-fluctuation amplitude (table units)",
-        NonNegative,
-        Always,
-        w
-    ),
-    spec!(
-        "fluct_order",
-        "-",
-        "fluctuation cycles per shaft revolution",
-        Positive,
-        Always,
-        fluct_order
-    ),
-    spec!(
-        "fluct_phase",
-        "rad",
-        "fluctuation phase",
-        Finite,
-        Always,
-        fluct_phase
-    ),
-    spec!(
-        "unbalance_mass",
-        "kg",
-        "unbalance mass on a vertical table",
-        NonNegative,
-        Always,
-        unbalance_mass
-    ),
-    spec!(
-        "unbalance_radius",
-        "m",
-        "radius of the unbalance mass",
-        NonNegative,
-        Always,
-        unbalance_radius
-    ),
-    spec!(
-        "unbalance_phase",
-        "rad",
-        "angle of the unbalance mass at θt = 0",
-        Finite,
-        Always,
-        unbalance_phase
-    ),
-    spec!(
-        "encoder_delay",
-        "s",
-        "dead time of the motor encoder",
-        NonNegative,
-        Always,
-        encoder_delay
-    ),
-    spec!(
-        "Kpp",
-        "1/s",
-        "position loop gain",
-        NonNegative,
-        Always,
-        controller.kpp
-    ),
-    spec!(
-        "Kvp",
-        "N·m·s/rad",
-        "velocity loop proportional gain",
-        NonNegative,
-        Always,
-        controller.kvp
-    ),
-    spec!(
-        "Kvi",
-        "N·m/rad",
-        "velocity loop integral gain",
-        NonNegative,
-        Always,
-        controller.kvi
-    ),
-    spec!("Tc", "s", "control period", Positive, Always, controller.tc),
-    spec!(
-        "torque_limit",
-        "N·m",
-        "motor torque limit",
-        Positive,
-        Always,
-        controller.torque_limit
-    ),
-    spec!(
-        "speed_limit",
-        "rad/s",
-        "velocity command limit (motor)",
-        Positive,
-        Always,
-        controller.speed_limit
-    ),
-    spec!(
-        "motor_encoder_counts",
-        "1/rev",
-        "motor encoder counts per revolution (0: ideal)",
-        NonNegative,
-        Always,
-        controller.motor_encoder_counts
-    ),
-    spec!(
-        "table_encoder_resolution",
-        "rad",
-        "table encoder resolution (0: ideal)",
-        NonNegative,
-        Always,
-        controller.table_encoder_resolution
-    ),
-];
-
-/// Looks a parameter up by name (exact, case-sensitive: `Kw` and `kw` differ in spirit).
-pub fn spec(name: &str) -> Result<&'static ParamSpec, ParamError> {
-    PARAMS
-        .iter()
-        .find(|s| s.name == name)
-        .ok_or_else(|| ParamError::Unknown {
-            name: name.to_string(),
-            suggestion: suggest(name),
-        })
-}
-
-fn suggest(name: &str) -> String {
-    let lower = name.to_ascii_lowercase();
-    match PARAMS.iter().find(|s| s.name.to_ascii_lowercase() == lower) {
-        Some(s) => format!(" (did you mean `{}`?)", s.name),
-        None => String::new(),
-    }
-}
 
 /// A parameter value that breaks its physical constraint, or an unknown name.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -567,13 +305,29 @@ pub enum ParamError {
         name: &'static str,
         meaning: &'static str,
     },
+    #[error("parameter {name} = {value} must be 0 or 1 ({meaning})")]
+    NotZeroOrOne {
+        name: &'static str,
+        value: f64,
+        meaning: &'static str,
+    },
     #[error("parameter {name} is required by the spur_gear topology ({meaning})")]
     Missing {
         name: &'static str,
         meaning: &'static str,
     },
-    #[error("parameter {name} does not apply to the direct topology (it has no spur-gear stage)")]
+    #[error("missing field `{name}`: the {topology} topology requires it ({meaning})")]
+    Required {
+        name: &'static str,
+        topology: Topology,
+        meaning: &'static str,
+    },
+    #[error("parameter {name} does not apply to this drive's topology")]
     NotApplicable { name: &'static str },
+    #[error("parameter {name} does not apply to a {axis} axis")]
+    NotForAxis { name: &'static str, axis: Axis },
+    #[error("a linear axis needs the direct_drive or two_mass topology, not {topology}")]
+    LinearTopology { topology: Topology },
     #[error("parameter {name} = {value}: {reason}")]
     Inconsistent {
         name: &'static str,
@@ -583,44 +337,55 @@ pub enum ParamError {
 }
 
 impl Params {
-    /// Sets one named parameter (for `--set` and the optimiser). Does not validate.
+    /// Sets one named parameter (for `--set` and the optimiser). Does not validate
+    /// the value; refuses a parameter that does not apply to this topology or axis.
     pub fn set(&mut self, name: &str, value: f64) -> Result<(), ParamError> {
         let s = spec(name)?;
-        if s.applies == Applies::SpurGearOnly && self.topology == Topology::Direct {
-            return Err(ParamError::NotApplicable { name: s.name });
-        }
-        (s.set)(self, value);
+        applicable(s, self)?;
+        s.store(self, value);
         Ok(())
     }
 
-    /// Reads one named parameter; `Ok(None)` if it does not apply to this topology.
+    /// Reads one named parameter; `Ok(None)` if it does not apply to this topology
+    /// or axis.
     pub fn get(&self, name: &str) -> Result<Option<f64>, ParamError> {
         Ok(spec(name)?.get(self))
     }
 
-    /// Total drive ratio, table turns per motor turn (Rg·Rw; Rw for the direct drive).
+    /// Total drive ratio, table turns per motor turn (Rg·Rw; Rw for the direct drive;
+    /// 1 for direct_drive and two_mass).
     pub fn ratio(&self) -> f64 {
         self.rg.unwrap_or(1.0) * self.rw
     }
 
-    /// Checks every value against its constraint; the first violation is returned.
+    /// Checks every value against its constraint and topology; the first violation is
+    /// returned.
     pub fn validate(&self) -> Result<(), ParamError> {
+        if self.axis == Axis::Linear
+            && !matches!(self.topology, Topology::DirectDrive | Topology::TwoMass)
+        {
+            return Err(ParamError::LinearTopology {
+                topology: self.topology,
+            });
+        }
         for s in PARAMS {
-            let value = match (s.get(self), s.applies, self.topology) {
-                (Some(_), Applies::SpurGearOnly, Topology::Direct) => {
-                    return Err(ParamError::NotApplicable { name: s.name })
-                }
-                (None, _, Topology::SpurGear) => {
+            match (applicable(s, self), s.raw(self)) {
+                (Err(e), Some(v)) if v != s.unused || s.optional => return Err(e),
+                (Err(_), _) => continue,
+                (Ok(()), None) => {
                     return Err(ParamError::Missing {
                         name: s.name,
                         meaning: s.meaning,
                     })
                 }
-                (None, _, _) => continue,
-                (Some(v), _, _) => v,
-            };
-            check(s, value)?;
+                (Ok(()), Some(v)) => check(s, v, self.axis)?,
+            }
         }
+        self.check_consistency()
+    }
+
+    /// The checks that involve two parameters.
+    fn check_consistency(&self) -> Result<(), ParamError> {
         if self.topology == Topology::SpurGear && self.jw <= 0.0 {
             let s = spec("Jw").expect("Jw is registered");
             return Err(ParamError::NotPositive {
@@ -637,32 +402,62 @@ impl Params {
                 reason: "an unbalance mass needs a radius > 0".into(),
             });
         }
+        let c = &self.controller;
+        if c.motor_encoder_counts > 0.0 && c.motor_encoder_resolution > 0.0 {
+            return Err(ParamError::Inconsistent {
+                name: "motor_encoder_resolution",
+                value: c.motor_encoder_resolution,
+                reason: "give the motor encoder either as motor_encoder_counts or as \
+                         motor_encoder_resolution, not both"
+                    .into(),
+            });
+        }
         Ok(())
     }
 }
 
-fn check(s: &ParamSpec, value: f64) -> Result<(), ParamError> {
+/// `Ok` if `s` applies to `p`'s topology and axis, else the error naming it.
+fn applicable(s: &ParamSpec, p: &Params) -> Result<(), ParamError> {
+    if !s.applies.to(p.topology) {
+        Err(ParamError::NotApplicable { name: s.name })
+    } else if s.rotary_only && p.axis == Axis::Linear {
+        Err(ParamError::NotForAxis {
+            name: s.name,
+            axis: p.axis,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+fn check(s: &ParamSpec, value: f64, axis: Axis) -> Result<(), ParamError> {
     if !value.is_finite() {
         return Err(ParamError::NotFinite {
             name: s.name,
             value,
         });
     }
+    let unit = s.unit_for(axis);
     match s.constraint {
         Constraint::Positive if value <= 0.0 => Err(ParamError::NotPositive {
             name: s.name,
             value,
-            unit: s.unit,
+            unit,
             meaning: s.meaning,
         }),
         Constraint::NonNegative if value < 0.0 => Err(ParamError::Negative {
             name: s.name,
             value,
-            unit: s.unit,
+            unit,
             meaning: s.meaning,
         }),
         Constraint::NonZero if value == 0.0 => Err(ParamError::Zero {
             name: s.name,
+            meaning: s.meaning,
+        }),
+        Constraint::ZeroOrOne if value != 0.0 && value != 1.0 => Err(ParamError::NotZeroOrOne {
+            name: s.name,
+            value,
             meaning: s.meaning,
         }),
         _ => Ok(()),

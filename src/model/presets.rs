@@ -13,6 +13,14 @@ const PRESETS: &[(&str, &str)] = &[
         "roller-gear-cam",
         include_str!("../../fixtures/presets/roller-gear-cam.json"),
     ),
+    (
+        "direct-drive",
+        include_str!("../../fixtures/presets/direct-drive.json"),
+    ),
+    (
+        "two-mass",
+        include_str!("../../fixtures/presets/two-mass.json"),
+    ),
 ];
 
 /// The preset names, for help texts and error messages.

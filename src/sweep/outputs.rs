@@ -85,6 +85,8 @@ impl Output {
         let held_modes = match topology {
             Topology::SpurGear => 3,
             Topology::Direct => 2,
+            Topology::TwoMass => 1,
+            Topology::DirectDrive => 0,
         };
         let numbered = |stem: &str| {
             (1..=held_modes)
@@ -325,6 +327,8 @@ fn n_held(topology: Topology) -> usize {
     match topology {
         Topology::SpurGear => 3,
         Topology::Direct => 2,
+        Topology::TwoMass => 1,
+        Topology::DirectDrive => 0,
     }
 }
 

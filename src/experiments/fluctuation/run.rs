@@ -5,8 +5,9 @@ use std::f64::consts::TAU;
 
 use super::FluctuationTest;
 use crate::controller::quantise;
-use crate::model::idx::{THETA_M, THETA_T, THETA_W};
+use crate::model::idx::{THETA_M, THETA_T};
 use crate::model::params::Params;
+use crate::model::rest::{rest_state, Preload};
 use crate::model::NSTATE;
 use crate::recorder::Recorder;
 use crate::sim::{SimError, Simulation};
@@ -96,11 +97,7 @@ fn run_reference(
     let p = test_params(params, test);
     let mut sim = Simulation::with_default_step(&p)?;
     let start = reference(0.0);
-    let mut y = sim.state();
-    y[THETA_M] = start / p.ratio();
-    y[THETA_W] = start / p.rw;
-    y[THETA_T] = start;
-    sim.set_state(y);
+    sim.set_state(rest_state(&p, start, Preload::None));
     let mut controller = sim.controller(&p)?;
     let every = ((test.sample_period / sim.dt()).round() as u64).max(1);
     let samples = (duration / sim.dt()) as usize / every as usize + 2;

@@ -11,6 +11,7 @@ use super::sines::Sines;
 use super::{FrequencyTest, Point, LANES};
 use crate::model::drive::{idx::*, Drive, NSTATE};
 use crate::model::modes::LinearModel;
+use crate::model::rest::{rest_state, Preload};
 use crate::model::Params;
 use crate::sim::{default_step, LaneSimulation, SimError};
 
@@ -84,21 +85,10 @@ pub(crate) fn initial_state(p: &Params, omega: f64, test: &FrequencyTest) -> [f6
         y[OMEGA_W] = y[OMEGA_M];
     }
     // Static twist of the preload (positive flanks loaded), and of the backlash.
-    let tw = test.preload_nm;
-    if tw != 0.0 || p.theta_bw > 0.0 || p.theta_bg.unwrap_or(0.0) > 0.0 {
-        let side = if tw < 0.0 { -1.0 } else { 1.0 };
-        let xw = -tw / (p.r * p.kb);
-        let dw = tw / p.kw + side * p.theta_bw;
-        let shaft = (dw - xw / p.r) / p.rw;
-        y[X_W] += xw;
-        if spur {
-            let tg = tw * p.rw;
-            let dg = tg / p.kg.unwrap_or(f64::INFINITY) + side * p.theta_bg.unwrap_or(0.0);
-            y[THETA_W] += shaft;
-            y[THETA_M] += (dg + shaft) / p.rg.unwrap_or(1.0);
-        } else {
-            y[THETA_M] += shaft;
-            y[THETA_W] = y[THETA_M];
+    if test.preload_nm != 0.0 || p.theta_bw > 0.0 || p.theta_bg.unwrap_or(0.0) > 0.0 {
+        let twist = rest_state(p, 0.0, Preload::Torque(test.preload_nm));
+        for i in [THETA_M, THETA_W, X_W] {
+            y[i] += twist[i];
         }
     }
     y
