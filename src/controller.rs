@@ -1,4 +1,4 @@
-//! The discrete servo controller (MODEL.md §1.1 "Servo as real drives have it", §4;
+//! The discrete servo controller (docs/model.md §1 "Servo as real drives have it", §4;
 //! the paper's Fig. 6).
 //!
 //! Every period Tc the controller samples the encoders and computes an output u that

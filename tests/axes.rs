@@ -1,5 +1,5 @@
 //! The direct-drive and two-mass topologies, the linear axis, the constant load Tload
-//! and the servo as real drives have it, stated as physics (MODEL.md §1.1): the
+//! and the servo as real drives have it, stated as physics (docs/model.md §1): the
 //! two-mass drive oscillates at √(Kw·(1/Jm + 1/Jt)) and keeps its energy; a direct
 //! drive under half its friction does not creep and above it accelerates at
 //! (T − fc)/J; Tload moves the servo's equilibrium by Tload over the servo's

@@ -101,7 +101,7 @@ fn table_3_rows_of_both_presets() {
         assert_eq!(s.mechanism.as_deref(), Some(p.name.as_str()));
         assert_eq!(s.sources.len(), 3, "{:?}", s.sources);
 
-        // Resonances of the linear response: the motor-held modes (MODEL.md §5.1).
+        // Resonances of the linear response: the motor-held modes (docs/experiments.md (frequency response)).
         let res = s.resonances_hz.as_ref().unwrap();
         assert!(!res.is_empty() && res.len() <= 3, "{res:?}");
         assert!(res.windows(2).all(|w| w[0] < w[1]), "{res:?}");

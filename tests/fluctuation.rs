@@ -1,5 +1,5 @@
-//! The virtual rotational-fluctuation and unbalance tests on both presets (MODEL.md
-//! §5.4, §5.5), and how evaluation fails. The full default conditions are run (one
+//! The virtual rotational-fluctuation and unbalance tests on both presets
+//! (docs/experiments.md, fluctuation and unbalance), and how evaluation fails. The full default conditions are run (one
 //! revolution each way, 180°/min and 360°/min): about 7 s and 3 s of CPU per preset.
 
 use rtid::experiments::fluctuation::{
@@ -32,7 +32,7 @@ fn worm_fluctuates_at_72_cycles_per_revolution_and_the_roller_does_not() {
     // the table follows e(θw) quasi-statically: amplitude W, peak-to-peak 2W.
     assert!((top.amplitude - w_arcsec).abs() < 0.1 * w_arcsec, "{top:?}");
     assert!((w.pp_arcsec - 2.0 * w_arcsec).abs() < 0.2 * w_arcsec);
-    // The gap between the CW and CCW curves is the lost motion (MODEL.md §5.4).
+    // The gap between the CW and CCW curves is the lost motion (docs/experiments.md (rotational fluctuation)).
     let lost = (2.0 * worm.theta_bw + 2.0 * worm.theta_bg.unwrap() * worm.rw) * ARCSEC_PER_RAD;
     let gap = w.gap_arcsec.unwrap();
     assert!(

@@ -1,4 +1,4 @@
-//! The virtual frequency-response test (MODEL.md §5.1).
+//! The virtual frequency-response test (docs/experiments.md (frequency response)).
 
 use rtid::experiments::frequency_response::{linear, sweep, FrequencyTest};
 use rtid::model::{presets, Params};

@@ -1,4 +1,4 @@
-//! The frequency response estimated from raw time series (MODEL.md §5.1, recorded as a
+//! The frequency response estimated from raw time series (docs/experiments.md (frequency response), recorded as a
 //! `frequency_response_time` file) against the exact linear response.
 
 use rtid::experiments::frequency_response::linear;

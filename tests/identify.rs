@@ -130,6 +130,10 @@ fn ciw_and_cig_from_the_peak_amplitudes_within_5_percent() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "slow-tests"),
+    ignore = "slow tier (20–40 s): --features slow-tests"
+)]
 fn motor_friction_and_viscous_damping_from_the_torque_curve_within_5_percent() {
     // The motor's Coulomb friction and viscous damping (the table's are divided by
     // Rg·Rw = 1/90 at the motor and hardly show; see docs/validation.md), started
@@ -365,6 +369,10 @@ fn unbalance_config(specs: Vec<ExperimentSpec>, base: Params, fit: &[&str]) -> C
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "slow-tests"),
+    ignore = "slow tier (20–40 s): --features slow-tests"
+)]
 fn table_friction_from_the_unbalance_step_within_5_percent_from_50_percent_off() {
     // The step of the unbalance test stands where m·g·e·sin(θt + ψ) overcomes
     // ft + Ct·ω: the table friction the torque curve cannot see.
@@ -396,6 +404,10 @@ fn the_unbalance_experiment_fits_ft_by_default() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "slow-tests"),
+    ignore = "slow tier (20–40 s): --features slow-tests"
+)]
 fn motor_and_table_friction_together_from_the_torque_curve_and_the_unbalance_step() {
     // The answer: fm from the torque curve (the unbalance step hardly moves
     // with it), ft from the unbalance step (the torque curve hardly moves with it);

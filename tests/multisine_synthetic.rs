@@ -2,7 +2,7 @@
 //! a random-odd, random-phase multisine current i (5–200 Hz, 1 Hz lines, 9 periods of
 //! 1 s at 1 kHz, 1 A rms) drives a torque T = i + a·i³ (a torque constant that stiffens
 //! slightly: a Hammerstein system), the motor angle is θm = G·T with G the two-mass
-//! motor response (MODEL.md §1.1; antiresonance 54 Hz, resonance 76 Hz), plus noise.
+//! motor response (docs/model.md §1; antiresonance 54 Hz, resonance 76 Hz), plus noise.
 //!
 //! The truth is the best linear approximation (Pintelon & Schoukens 2012, ch. 3): for
 //! a multisine of line amplitude A and power σ² = mean(i²), the part of i³ coherent with

@@ -1,4 +1,4 @@
-//! The virtual ISO 230-2 positioning test on both presets (MODEL.md §5.3).
+//! The virtual ISO 230-2 positioning test on both presets (docs/experiments.md (positioning)).
 
 use rtid::experiments::iso230::{evaluate, ARCSEC_PER_RAD};
 use rtid::experiments::positioning::{run, PositioningTest};

@@ -1,4 +1,4 @@
-//! The virtual friction-torque test (paper §4.2, MODEL.md §5.2) on both presets: the
+//! The virtual friction-torque test (paper §4.2, docs/experiments.md (friction torque curve)) on both presets: the
 //! torque it records is the physics of the drive as seen by the motor.
 
 use std::f64::consts::TAU;

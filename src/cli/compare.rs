@@ -18,7 +18,7 @@ as \"—\". Rows, in the paper's order:
   frequency response    resonances, Hz: the 3 largest peaks of frequency_response.json \
 (or a resonance file's peaks_hz)
   torsional stiffness   not measured by an experiment file (identified by fitting the \
-model, MODEL.md §6): always \"—\"
+model, docs/identification.md): always \"—\"
   friction torque       Coulomb friction at the motor, N·m, from torque_curve.json (half \
 the torque jump at the velocity reversals)
   mean reversal B̄, repeatability R, accuracy A   ISO 230-2, arc-sec, from \

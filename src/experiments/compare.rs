@@ -98,8 +98,11 @@ pub enum CompareError {
     NotJson { path: PathBuf, message: String },
     #[error(transparent)]
     File(#[from] ExperimentFileError),
-    #[error("{path}: cannot evaluate: {message}")]
-    Evaluate { path: PathBuf, message: String },
+    #[error("{path}: cannot evaluate: {source}")]
+    Evaluate {
+        path: PathBuf,
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
 }
 
 /// Whether the JSON file at `path` is an experiment manifest (an object with `kind`).
@@ -143,7 +146,7 @@ pub fn summarize(dir: &Path) -> Result<Summary, CompareError> {
             }
         }
         s.sources.push(path.clone());
-        add(&mut s, &exp).map_err(|message| CompareError::Evaluate { path, message })?;
+        add(&mut s, &exp).map_err(|source| CompareError::Evaluate { path, source })?;
     }
     if !mechanisms.is_empty() {
         s.mechanism = Some(mechanisms.join(", "));
@@ -158,9 +161,12 @@ pub fn summarize(dir: &Path) -> Result<Summary, CompareError> {
     Ok(s)
 }
 
+/// Why one experiment could not be evaluated (each evaluator's own error).
+type BoxedError = Box<dyn std::error::Error + Send + Sync>;
+
 /// Evaluates one experiment into the rows it fills (if not filled already). The
 /// fluctuation gap is parked in `backlash_arcsec` until [`summarize`] decides.
-fn add(s: &mut Summary, exp: &Experiment) -> Result<(), String> {
+fn add(s: &mut Summary, exp: &Experiment) -> Result<(), BoxedError> {
     match &exp.data {
         Data::FrequencyResponse {
             frequency_hz,
@@ -183,21 +189,18 @@ fn add(s: &mut Summary, exp: &Experiment) -> Result<(), String> {
         Data::TorqueCurve { .. } if s.friction_torque_nm.is_none() => {
             let curve = torque_curve::from_data(&exp.data).ok_or("not a torque curve")?;
             let test = torque_curve::TorqueTest::from_conditions(&exp.manifest.conditions);
-            let report = torque_curve::evaluate(&curve, &test).map_err(|e| e.to_string())?;
+            let report = torque_curve::evaluate(&curve, &test)?;
             s.friction_torque_nm = report.friction_nm;
         }
         Data::Positioning { .. } if s.b_mean_arcsec.is_none() => {
             let readings = positioning::from_data(&exp.data).ok_or("not positioning data")?;
-            let axis = iso230::evaluate(&readings)
-                .map_err(|e| e.to_string())?
-                .axis
-                .in_arcsec();
+            let axis = iso230::evaluate(&readings)?.axis.in_arcsec();
             s.b_mean_arcsec = Some(axis.b_mean.abs());
             s.r_arcsec = Some(axis.r);
             s.a_arcsec = Some(axis.a);
         }
         Data::Fluctuation { .. } if s.fluctuation.is_none() => {
-            let e = fluctuation::evaluate_experiment(exp).map_err(|e| e.to_string())?;
+            let e = fluctuation::evaluate_experiment(exp)?;
             let top = e.dominant.first();
             let amplitude = top.map_or(0.0, |p| p.amplitude);
             s.fluctuation = Some(Fluctuation {
@@ -210,7 +213,7 @@ fn add(s: &mut Summary, exp: &Experiment) -> Result<(), String> {
             }
         }
         Data::Unbalance { .. } if s.unbalance.is_none() => {
-            let e = fluctuation::evaluate_experiment(exp).map_err(|e| e.to_string())?;
+            let e = fluctuation::evaluate_experiment(exp)?;
             let step = e.step.size_arcsec.abs();
             s.unbalance = Some(Unbalance {
                 step_arcsec: step,

@@ -2,7 +2,7 @@
 //! and table angle over time): stepped-sine demodulation ([`super::stepped_sine`]) or
 //! the H1 estimate with Welch averaging ([`super::welch`]), then the resonances.
 //!
-//! Both give the paper's gain, table angle over motor angle × ratio (MODEL.md §5.1),
+//! Both give the paper's gain, table angle over motor angle × ratio (docs/experiments.md (frequency response)),
 //! with ratio = Rg·Rw from `conditions.ratio` or the preset named in `mechanism`. H1
 //! also gives the compliance table angle / motor torque. Bins whose coherence is below
 //! `min_coherence` are kept in the result but flagged and left out of the peak search
@@ -239,7 +239,7 @@ fn random_error_db(coherence: f64, segments: usize) -> f64 {
 }
 
 /// The runs of consecutive kept bins, as (frequency, gain) curves.
-pub fn kept_runs(bins: &[Bin]) -> Vec<Vec<(f64, f64)>> {
+pub(crate) fn kept_runs(bins: &[Bin]) -> Vec<Vec<(f64, f64)>> {
     let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
     let mut open = false;
     for b in bins {

@@ -4,7 +4,7 @@
 //! motor angle and table angle at a fixed rate. Evaluated by
 //! `frequency_response_estimate.rs`.
 //!
-//! Motor torque `preload·Rg·Rw + excitation`, table brake `−preload` (MODEL.md §5.1).
+//! Motor torque `preload·Rg·Rw + excitation`, table brake `−preload` (docs/experiments.md (frequency response)).
 //! The run starts at rest, with the flanks loaded by the preload (or at the edge of
 //! the gap without one). Readings: the motor angle quantised to the motor encoder, the
 //! table angle to the table encoder (0.0001° in the presets) plus optional Gaussian

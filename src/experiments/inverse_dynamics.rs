@@ -4,7 +4,7 @@
 //! F = M·q'' + Fv·q' + Fc·sign(q') + OF
 //! ```
 //!
-//! i.e. MODEL.md §1.1's direct drive M·q'' = F − Fv·q' − Fc·sign(q') − OF with the
+//! i.e. docs/model.md §1's direct drive M·q'' = F − Fv·q' − Fc·sign(q') − OF with the
 //! drive's effort F (N or N·m) on the left: M the mass or inertia (kg or kg·m²), Fv the
 //! viscous coefficient (N·s/m or N·m·s/rad), Fc the Coulomb friction (N or N·m) and OF
 //! a constant offset effort (N or N·m; on EMPS, OF = −3.16 N). The regression's

@@ -1,5 +1,5 @@
 //! Accuracy and repeatability of positioning of a rotary axis after ISO 230-2 — the
-//! evaluation of the paper's third test (MODEL.md §5.3, paper §4.3 and Table 2).
+//! evaluation of the paper's third test (docs/experiments.md (positioning), paper §4.3 and Table 2).
 //!
 //! The paper cites ISO 230-2:1997. The quantities below are defined identically in the
 //! 1997, 2006 and 2014 editions; each is given by the name of its entry in the

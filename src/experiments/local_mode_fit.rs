@@ -300,7 +300,7 @@ mod tests {
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
 
-    /// Motor angle over torque of a two-mass drive (MODEL.md §1.1): zero pair at
+    /// Motor angle over torque of a two-mass drive (docs/model.md §1): zero pair at
     /// √(k/Jl), pole pair at √(k(1/Jm + 1/Jl)), both lightly damped.
     fn motor(f: f64) -> Complex<f64> {
         let (jm, jl, k, c) = (1.1e-3, 1.0e-3, 115.0, 0.012);

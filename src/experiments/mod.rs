@@ -1,4 +1,4 @@
-//! The paper's five tests (MODEL.md §5): virtual experiments and the evaluation of their
+//! The paper's five tests (docs/experiments.md): virtual experiments and the evaluation of their
 //! measured data; servo traces of any axis (replay, simulation error, virtual traces) and
 //! the friction law fitted to any recorded motion.
 

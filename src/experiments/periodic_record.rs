@@ -135,7 +135,7 @@ impl PeriodSpectra {
     }
 
     /// The highest line strictly below fs/2: (N − 1)/2.
-    pub fn top_line(&self) -> usize {
+    pub(crate) fn top_line(&self) -> usize {
         (self.n - 1) / 2
     }
 
@@ -150,7 +150,7 @@ impl PeriodSpectra {
     }
 
     /// The sample variance of that mean, Σ|X_p − X̄|² / (P·(P − 1)), unit².
-    pub fn mean_variance(&self, k: usize) -> f64 {
+    pub(crate) fn mean_variance(&self, k: usize) -> f64 {
         let (p, m) = (self.periods() as f64, self.mean(k));
         self.line(k).map(|x| (x - m).norm_sqr()).sum::<f64>() / (p * (p - 1.0))
     }
@@ -219,7 +219,7 @@ impl PeriodicRecord {
     }
 
     /// Line spacing fs/N, Hz.
-    pub fn spacing_hz(&self) -> f64 {
+    pub(crate) fn spacing_hz(&self) -> f64 {
         self.sample_rate_hz / self.samples_per_period as f64
     }
 
@@ -314,7 +314,7 @@ pub const MIN_PERIOD_CORRELATION: f64 = 0.5;
 /// the mean-removed signal comes within 10 % of its largest value there, climbed to
 /// its local maximum. Taking the first such lag, not the largest, picks the period
 /// rather than a multiple of it, whose correlation is as high.
-pub fn detect_period(u: &[f64]) -> Result<usize, PeriodicError> {
+pub(crate) fn detect_period(u: &[f64]) -> Result<usize, PeriodicError> {
     let n = u.len();
     if n < 8 {
         return Err(PeriodicError::TooShort(n));
@@ -431,7 +431,7 @@ const LEVEL_FLOOR_DB: f64 = 200.0;
 /// The excited lines of a reference: its mean spectrum's levels |X̄_k|² (dB, lines
 /// 1 … below fs/2) sorted, cut at the largest drop between consecutive levels, which
 /// must reach `min_gap_db`; the lines above the cut are the excited ones.
-pub fn detect_lines(
+pub(crate) fn detect_lines(
     reference: &PeriodSpectra,
     min_gap_db: f64,
 ) -> Result<Vec<usize>, PeriodicError> {

@@ -1,5 +1,5 @@
 //! The positioning accuracy and repeatability test as a virtual experiment (paper
-//! §4.3, MODEL.md §5.3): the ISO 230-2 standard test cycle run by the servo on the
+//! §4.3, docs/experiments.md (positioning)): the ISO 230-2 standard test cycle run by the servo on the
 //! model, read by the table encoder at the end of each dwell.
 //!
 //! Cycle, per run: start `overrun` below the first target, approach every target in
@@ -21,7 +21,7 @@ use crate::model::rest::{rest_state, Preload};
 use crate::recorder::NullRecorder;
 use crate::sim::{SimError, Simulation};
 
-/// Conditions of the test (defaults: MODEL.md §5.3).
+/// Conditions of the test (defaults: docs/experiments.md (positioning)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PositioningTest {
     /// Target table angles, rad (default every 30° from 0° to 360°).

@@ -1,8 +1,8 @@
-//! The friction-torque test as a virtual experiment (paper §4.2, Fig. 9; MODEL.md
-//! §5.2): the servo, in full-closed loop by default, moves the table harmonically,
+//! The friction-torque test as a virtual experiment (paper §4.2, Fig. 9;
+//! docs/experiments.md, friction torque curve): the servo, in full-closed loop by default, moves the table harmonically,
 //! θref(t) = A·sin(2πt/T) with A = 30°, T = 3 s, and the motor torque command over
 //! time is the measured curve. Coulomb friction and viscous damping are fitted to it
-//! (MODEL.md §6); [`simulate_torque`] is the model side of that fit.
+//! (docs/identification.md); [`simulate_torque`] is the model side of that fit.
 //!
 //! The run starts at rest at zero angle, where the command already moves at full
 //! speed: the first `run_in_periods` (default 1) absorb that start-up transient and
@@ -30,7 +30,7 @@ use crate::model::NSTATE;
 use crate::recorder::{NullRecorder, Recorder};
 use crate::sim::{SimError, Simulation};
 
-/// Conditions of the test (defaults: MODEL.md §5.2 and §7).
+/// Conditions of the test (defaults: docs/experiments.md (friction torque curve) and docs/experiment-files.md).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TorqueTest {
     /// Amplitude of the commanded table motion, rad (default 30°).

@@ -1,5 +1,5 @@
 //! What the resonance and antiresonance of a two-mass drive's motor response determine
-//! (MODEL.md §1.1, two-mass topology), in closed form.
+//! (docs/model.md §1, two-mass topology), in closed form.
 //!
 //! Motor Jm and load Jl joined by a spring k (damper c), torque T on the motor:
 //!
@@ -19,7 +19,7 @@
 //! These are undamped frequencies; a peak or notch of damping ratio ζ lies within ~ζ²
 //! of them (0.04 % at ζ = 0.02). Without the torque constant (current → torque) only
 //! these ratios are determined, never Jm, Jl or k themselves. The transfer functions
-//! are the Laplace transforms of MODEL.md §1.1's two-mass equations (Rw = 1, no
+//! are the Laplace transforms of docs/model.md §1's two-mass equations (Rw = 1, no
 //! backlash, no friction).
 
 use serde::Serialize;

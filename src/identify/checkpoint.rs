@@ -211,13 +211,13 @@ impl Checkpointer {
     }
 
     /// A copy of the current checkpoint.
-    pub fn snapshot(&self) -> Checkpoint {
+    pub(crate) fn snapshot(&self) -> Checkpoint {
         self.lock().clone()
     }
 
     /// Records a finished (or interrupted) start and writes the file. A failure to
     /// write is not fatal here: the final write reports it.
-    pub fn save_start(&self, record: &StartRecord, evaluations: usize) {
+    pub(crate) fn save_start(&self, record: &StartRecord, evaluations: usize) {
         let mut c = self.lock();
         c.starts.retain(|s| s.index != record.index);
         c.starts.push(record.clone());
@@ -228,7 +228,7 @@ impl Checkpointer {
     }
 
     /// Stage `k` begins from `best` (the search's result): its starts start afresh.
-    pub fn enter_stage(&self, k: usize, best: &[f64], evaluations: usize) {
+    pub(crate) fn enter_stage(&self, k: usize, best: &[f64], evaluations: usize) {
         let mut c = self.lock();
         c.stage = k;
         c.stage0_best = Some(best.to_vec());

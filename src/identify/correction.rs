@@ -79,7 +79,7 @@ pub struct Outcome {
 /// `linear` and `nonlinear` must be the same objectives at the two fidelities (same
 /// residual layout). `settings` are those of the linear sub-searches (one start each).
 /// Leaves the result as the monitor's best point, with its nonlinear cost.
-pub fn polish(
+pub(crate) fn polish(
     space: &ParamSpace,
     linear: &dyn Objective,
     nonlinear: &dyn Objective,

@@ -125,7 +125,7 @@ impl Plan {
     /// What the result says of the model: `linear`, `nonlinear`, `linear, then
     /// nonlinear`; `nonlinear time simulation` when no objective depends on the
     /// frequency-response model (a torque curve is always simulated).
-    pub fn fidelity_label(&self) -> String {
+    pub(crate) fn fidelity_label(&self) -> String {
         if !self.declared.frequency_response {
             return "nonlinear time simulation".into();
         }
@@ -134,10 +134,5 @@ impl Plan {
             .map(|s| s.fidelity.name())
             .collect::<Vec<_>>()
             .join(", then ")
-    }
-
-    /// The fidelity of the last stage (the objectives of the result).
-    pub fn last_fidelity(&self) -> Fidelity {
-        self.stages.last().map_or(Fidelity::Linear, |s| s.fidelity)
     }
 }

@@ -47,7 +47,7 @@ impl Monitor {
     }
 
     /// Adds evaluations done elsewhere (a resumed checkpoint).
-    pub fn add_evaluations(&self, n: usize) {
+    pub(crate) fn add_evaluations(&self, n: usize) {
         self.evaluations.fetch_add(n, Ordering::Relaxed);
     }
 
@@ -56,7 +56,7 @@ impl Monitor {
     }
 
     /// Offers a point; kept if it is the best so far.
-    pub fn offer(&self, cost: f64, values: &[f64]) {
+    pub(crate) fn offer(&self, cost: f64, values: &[f64]) {
         if let Ok(mut b) = self.best.lock() {
             if cost.is_finite() && b.as_ref().map_or(true, |b| cost < b.cost) {
                 *b = Some(Best {
@@ -68,7 +68,7 @@ impl Monitor {
     }
 
     /// Forgets the best point (between stages whose costs differ in kind).
-    pub fn reset_best(&self) {
+    pub(crate) fn reset_best(&self) {
         if let Ok(mut b) = self.best.lock() {
             *b = None;
         }
@@ -90,7 +90,7 @@ impl Monitor {
 
     /// An evaluation budget: stop after `n` evaluations (for tests of the interrupt
     /// path and for `--max-evaluations`).
-    pub fn check_budget(&self, limit: Option<usize>) {
+    pub(crate) fn check_budget(&self, limit: Option<usize>) {
         if limit.is_some_and(|n| self.evaluations() >= n) {
             self.stop();
         }
@@ -157,7 +157,7 @@ impl<'a> Problem<'a> {
         if self.monitor.stopped() {
             return Err(ObjectiveError::Interrupted);
         }
-        let values = self.space.from_solver(x);
+        let values = self.space.physical(x);
         let r = self
             .space
             .params(&values)
@@ -182,7 +182,7 @@ impl<'a> Problem<'a> {
 
     /// Forward-difference Jacobian of the residuals in solver coordinates, the columns
     /// in parallel; `r0` are the residuals at `x`.
-    pub fn jacobian_at(
+    pub(crate) fn jacobian_at(
         &self,
         x: &DVector<f64>,
         r0: &[f64],

@@ -61,7 +61,7 @@ impl StartRecord {
     }
 
     /// The cost, +∞ when there is none.
-    pub fn cost_or_infinity(&self) -> f64 {
+    pub(crate) fn cost_or_infinity(&self) -> f64 {
         self.cost.unwrap_or(f64::INFINITY)
     }
 }
@@ -121,7 +121,7 @@ fn one_start(
     };
     let out = solvers::run(settings.method, problem, space.to_solver(&from), limits);
     let result =
-        (!out.x.is_empty()).then(|| space.from_solver(&nalgebra::DVector::from_vec(out.x.clone())));
+        (!out.x.is_empty()).then(|| space.physical(&nalgebra::DVector::from_vec(out.x.clone())));
     StartRecord {
         index,
         initial,

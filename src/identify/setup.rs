@@ -8,7 +8,7 @@ use crate::objectives::{Fidelity, Joint, ObjectiveKind, SetupError, Smoothness, 
 
 /// The objectives `spec` feeds at `stage`, each with its weight (the experiment's
 /// times the objective's relative one).
-pub fn selection(
+pub(crate) fn selection(
     spec: &ExperimentSpec,
     stage: Stage,
 ) -> Result<Vec<(ObjectiveKind, f64)>, SetupError> {
@@ -74,7 +74,7 @@ pub fn build(
 /// The parameters fitted when none are named: what the primary objectives of the
 /// search (those at full relative weight, not tie-breakers) determine, in registry
 /// order, each once.
-pub fn default_fit(specs: &[ExperimentSpec], p: &Params) -> Result<Vec<String>, SetupError> {
+pub(crate) fn default_fit(specs: &[ExperimentSpec], p: &Params) -> Result<Vec<String>, SetupError> {
     let mut primary: Vec<ObjectiveKind> = Vec::new();
     for spec in specs {
         for (kind, weight) in selection(spec, Stage::Search)? {
@@ -106,7 +106,7 @@ pub struct Declared {
 }
 
 /// The declared properties of the objectives `specs` feed at `stage`.
-pub fn declared(specs: &[ExperimentSpec], stage: Stage) -> Result<Declared, SetupError> {
+pub(crate) fn declared(specs: &[ExperimentSpec], stage: Stage) -> Result<Declared, SetupError> {
     let mut d = Declared {
         rough: false,
         frequency_response: false,

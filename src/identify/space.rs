@@ -170,7 +170,7 @@ impl ParamSpace {
         })
     }
 
-    pub fn dim(&self) -> usize {
+    pub(crate) fn dim(&self) -> usize {
         self.names.len()
     }
 
@@ -185,7 +185,7 @@ impl ParamSpace {
     }
 
     /// Solver coordinates of physical values.
-    pub fn to_solver(&self, values: &[f64]) -> DVector<f64> {
+    pub(crate) fn to_solver(&self, values: &[f64]) -> DVector<f64> {
         DVector::from_iterator(
             self.dim(),
             self.bounds.iter().zip(values).map(|(b, &v)| {
@@ -196,7 +196,7 @@ impl ParamSpace {
     }
 
     /// Physical values of solver coordinates (always inside the bounds).
-    pub fn from_solver(&self, x: &DVector<f64>) -> Vec<f64> {
+    pub(crate) fn physical(&self, x: &DVector<f64>) -> Vec<f64> {
         self.bounds
             .iter()
             .zip(x.iter())
@@ -228,7 +228,7 @@ impl ParamSpace {
     }
 
     /// Names of parameters within 0.1 % (of the unit range) of a bound, and which.
-    pub fn at_bounds(&self, values: &[f64]) -> Vec<(&'static str, Side)> {
+    pub(crate) fn at_bounds(&self, values: &[f64]) -> Vec<(&'static str, Side)> {
         self.names
             .iter()
             .zip(&self.bounds)
@@ -266,10 +266,10 @@ mod tests {
         let s = space(&["Kw", "theta_bw"], &[("theta_bw", 0.0, 2e-4)]).unwrap();
         assert!(s.bounds[0].log() && !s.bounds[1].log());
         let v = vec![4.4e5, 1.3e-4];
-        let back = s.from_solver(&s.to_solver(&v));
+        let back = s.physical(&s.to_solver(&v));
         assert!((back[0] / v[0] - 1.0).abs() < 1e-12 && (back[1] - v[1]).abs() < 1e-15);
         for x in [-1e3, -2.0, 0.0, 7.0, 1e3] {
-            let v = s.from_solver(&DVector::from_vec(vec![x, x]));
+            let v = s.physical(&DVector::from_vec(vec![x, x]));
             assert!(
                 v[0] >= 3.1e4 * (1.0 - 1e-12) && v[0] <= 3.1e6 * (1.0 + 1e-12),
                 "{v:?}"

@@ -55,7 +55,7 @@ pub fn at_optimum(
 }
 
 /// [`at_optimum`] when the residuals `r0` at `values` are known already.
-pub fn with_residuals(
+pub(crate) fn with_residuals(
     space: &ParamSpace,
     objective: &dyn Objective,
     values: &[f64],

@@ -1,4 +1,4 @@
-//! Experiment files (MODEL.md §7): a JSON manifest plus, for every kind but `resonance`,
+//! Experiment files (docs/experiment-files.md): a JSON manifest plus, for every kind but `resonance`,
 //! one CSV file beside it, read into typed data in SI units (angles in rad, lengths in
 //! m, time in s, torque in N·m, force in N, frequency in Hz, gain in dB) and written
 //! back atomically.
@@ -37,7 +37,7 @@ use serde_json::{Map, Value};
 /// experiment's `contact_loss_drive`.
 pub type Columns = BTreeMap<String, Vec<f64>>;
 
-/// Which experiment a file holds (MODEL.md §5 and §7).
+/// Which experiment a file holds (docs/experiments.md and docs/experiment-files.md).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Kind {
@@ -62,7 +62,7 @@ pub enum Kind {
 }
 
 impl Kind {
-    /// Every kind, in the order of MODEL.md §7, then the kinds added since.
+    /// Every kind, in the order of docs/experiment-files.md, then the kinds added since.
     pub const ALL: [Kind; 8] = [
         Kind::FrequencyResponse,
         Kind::Resonance,
@@ -136,15 +136,17 @@ impl fmt::Display for Direction {
 }
 
 impl std::str::FromStr for Direction {
-    type Err = String;
+    type Err = crate::names::UnknownName;
     /// `up`/`ccw` or `down`/`cw`, in any case.
-    fn from_str(s: &str) -> Result<Self, String> {
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s.trim().to_ascii_lowercase().as_str() {
             "up" | "ccw" => Ok(Direction::Up),
             "down" | "cw" => Ok(Direction::Down),
-            _ => Err(format!(
-                "`{s}` is not a direction (expected up, down, ccw or cw)"
-            )),
+            _ => Err(crate::names::UnknownName {
+                what: "direction",
+                given: s.to_string(),
+                expected: "up, down, ccw or cw".into(),
+            }),
         }
     }
 }

@@ -1,4 +1,4 @@
-//! Gear meshes with free play (MODEL.md §2): a dead zone of half-width `b` that
+//! Gear meshes with free play (docs/model.md §2): a dead zone of half-width `b` that
 //! transmits stiffness plus internal damping only while the teeth touch, and never
 //! pulls while they separate.
 //!
@@ -10,7 +10,7 @@ use super::lanes::Lanes;
 
 /// The dead-zone deflection: δ − b above the gap, δ + b below it, 0 inside.
 #[inline(always)]
-pub fn dead_zone(delta: f64, b: f64) -> f64 {
+pub(crate) fn dead_zone(delta: f64, b: f64) -> f64 {
     // One level of select at a time: compiles to blends, not branches.
     let below = if delta < -b { delta + b } else { 0.0 };
     if delta > b {
@@ -28,7 +28,7 @@ pub fn dead_zone(delta: f64, b: f64) -> f64 {
 /// it does not pull), and 0 inside the gap. With `b = 0` (a preloaded mesh, both
 /// flanks engaged) it is the linear spring-damper k·δ + c·rate in both directions.
 #[inline(always)]
-pub fn mesh_torque(k: f64, c: f64, b: f64, delta: f64, rate: f64) -> f64 {
+pub(crate) fn mesh_torque(k: f64, c: f64, b: f64, delta: f64, rate: f64) -> f64 {
     if b == 0.0 {
         return k * delta + c * rate;
     }
@@ -49,7 +49,7 @@ fn contact_torque(dz: f64, t: f64) -> f64 {
 
 /// [`mesh_torque`] for each lane (`k`, `c`, `b` shared by all lanes).
 #[inline(always)]
-pub fn mesh_torque_lanes<const L: usize>(
+pub(crate) fn mesh_torque_lanes<const L: usize>(
     k: f64,
     c: f64,
     b: f64,

@@ -1,4 +1,4 @@
-//! Coulomb friction with true stick (MODEL.md §2), treated as a clamp: a body at
+//! Coulomb friction with true stick (docs/model.md §2), treated as a clamp: a body at
 //! rest stays at rest while the torque needed to hold it, which is the sum of every
 //! other torque on it (the model's mass matrix is diagonal), lies within ±fc; it
 //! slides with fc opposing its motion otherwise.
@@ -30,7 +30,7 @@ impl Friction {
     /// and its Coulomb friction `fc`, whether it sticks, and against which friction
     /// torque it slides otherwise (breaking away from rest: opposing `t`).
     #[inline(always)]
-    pub fn decide(t: f64, w: f64, fc: f64) -> Self {
+    pub(crate) fn decide(t: f64, w: f64, fc: f64) -> Self {
         Friction {
             torque: decided_torque(t, w, fc),
             free: decided_free(t, w, fc),
@@ -39,7 +39,7 @@ impl Friction {
 
     /// The net torque on the body (0 while stuck).
     #[inline(always)]
-    pub fn net(self, t: f64) -> f64 {
+    pub(crate) fn net(self, t: f64) -> f64 {
         (t - self.torque) * self.free
     }
 
@@ -77,7 +77,11 @@ fn decided_free(t: f64, w: f64, fc: f64) -> f64 {
 
 /// [`Friction::decide`] for each lane: (friction torques, free flags).
 #[inline(always)]
-pub fn decide_lanes<const L: usize>(t: Lanes<L>, w: Lanes<L>, fc: f64) -> (Lanes<L>, Lanes<L>) {
+pub(crate) fn decide_lanes<const L: usize>(
+    t: Lanes<L>,
+    w: Lanes<L>,
+    fc: f64,
+) -> (Lanes<L>, Lanes<L>) {
     (
         t.zip(w, |t, w| decided_torque(t, w, fc)),
         t.zip(w, |t, w| decided_free(t, w, fc)),
@@ -86,7 +90,7 @@ pub fn decide_lanes<const L: usize>(t: Lanes<L>, w: Lanes<L>, fc: f64) -> (Lanes
 
 /// [`stop_at_reversal`] for each lane.
 #[inline(always)]
-pub fn stop_at_reversal_lanes<const L: usize>(
+pub(crate) fn stop_at_reversal_lanes<const L: usize>(
     w_before: Lanes<L>,
     w_after: Lanes<L>,
     fc: f64,
@@ -101,7 +105,7 @@ pub fn stop_at_reversal_lanes<const L: usize>(
 /// After a step: a sliding body (with friction) whose velocity changed sign is put
 /// to rest, so that the next step decides between sticking and reversing.
 #[inline(always)]
-pub fn stop_at_reversal(w_before: f64, w_after: &mut f64, fc: f64) {
+pub(crate) fn stop_at_reversal(w_before: f64, w_after: &mut f64, fc: f64) {
     if fc > 0.0 && w_before * *w_after < 0.0 {
         *w_after = 0.0;
     }

@@ -1,4 +1,4 @@
-//! The simulation kernel: the equations of motion of MODEL.md §2 and a classical
+//! The simulation kernel: the equations of motion of docs/model.md §2 and a classical
 //! fourth-order Runge–Kutta step, for `L` independent trajectories advanced in
 //! lockstep ("lanes", structure of arrays: state `i` of lane `l` is `y[i][l]`).
 //! `L = 1` is one trajectory; wider lanes let the compiler vectorise independent
@@ -326,7 +326,7 @@ impl<const L: usize> Kernel<L> {
     /// loop the compiler allocated the meshed forms' registers worse (measured: 24
     /// more instructions per step on the roller-gear cam, 5 %, mostly spills).
     #[inline]
-    pub fn step_meshed(
+    pub(crate) fn step_meshed(
         &mut self,
         d: &Drive,
         y: &mut States<L>,
@@ -343,7 +343,7 @@ impl<const L: usize> Kernel<L> {
 
     /// [`Kernel::step`] for the single rigid body of `direct_drive`.
     #[inline]
-    pub fn step_rigid(
+    pub(crate) fn step_rigid(
         &mut self,
         d: &Drive,
         y: &mut States<L>,
@@ -365,7 +365,7 @@ impl<const L: usize> Kernel<L> {
     }
 
     /// Forgets lane `l`'s memory, as for a new trajectory (a fresh `Kernel` lane).
-    pub fn reset_lane(&mut self, l: usize) {
+    pub(crate) fn reset_lane(&mut self, l: usize) {
         self.lanes.set_lane(l, &LaneState::default());
     }
 

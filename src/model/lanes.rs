@@ -17,7 +17,7 @@ pub struct Lanes<const L: usize>(pub [f64; L]);
 impl<const L: usize> Lanes<L> {
     /// The same value in every lane.
     #[inline(always)]
-    pub fn splat(x: f64) -> Self {
+    pub(crate) fn splat(x: f64) -> Self {
         Lanes([x; L])
     }
 
@@ -39,17 +39,6 @@ impl<const L: usize> Lanes<L> {
         let mut out = self.0;
         for l in 0..L {
             out[l] = f(out[l], b.0[l]);
-        }
-        Lanes(out)
-    }
-
-    /// `f` applied lane by lane to `self`, `b` and `c`.
-    #[inline(always)]
-    #[allow(clippy::needless_range_loop)]
-    pub fn zip3(self, b: Self, c: Self, f: impl Fn(f64, f64, f64) -> f64) -> Self {
-        let mut out = self.0;
-        for l in 0..L {
-            out[l] = f(out[l], b.0[l], c.0[l]);
         }
         Lanes(out)
     }

@@ -16,7 +16,7 @@ use super::params::{ParamError, Params};
 /// Which ratio of the response.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Channel {
-    /// Table over motor angle × Rg·Rw (the paper's gain, MODEL.md §5.1): 1 at low
+    /// Table over motor angle × Rg·Rw (the paper's gain, docs/experiments.md (frequency response)): 1 at low
     /// frequency, peaks at the motor-held modes.
     TableOverMotor,
     /// Motor angle over motor torque (the compliance seen by the motor), rad/(N·m):
@@ -99,7 +99,7 @@ mod tests {
     fn the_motor_compliance_dips_at_the_held_mode() {
         let p = presets::load("roller-gear-cam").unwrap();
         let r = LinearResponse::new(&p, Channel::MotorOverTorque).unwrap();
-        // Motor held: 166.9 Hz (MODEL.md §3); the compliance has its antiresonance there.
+        // Motor held: 166.9 Hz (docs/model.md §11); the compliance has its antiresonance there.
         let g = |hz: f64| r.gain_db(hz);
         assert!(g(166.9) < g(150.0) - 20.0 && g(166.9) < g(185.0) - 20.0);
     }

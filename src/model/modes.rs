@@ -1,13 +1,13 @@
-//! Modal analysis of the linearised drive (MODEL.md §2, §3): mass, damping and
+//! Modal analysis of the linearised drive (docs/model.md §2, §11): mass, damping and
 //! stiffness matrices, natural frequencies and mode shapes with the motor held and
 //! free, the fastest rate of the damped system (for the kernel's step size) and the
-//! exact linear frequency response of the paper's test (MODEL.md §5.1).
+//! exact linear frequency response of the paper's test (docs/experiments.md (frequency response)).
 //!
 //! Linearisation: no backlash (θb = 0), no Coulomb friction, no gear fluctuation
 //! (W = 0), no unbalance. Generalized coordinates q = [θm, θw, xw, θt] (spur gear,
 //! rad, rad, m, rad), [θm, xw, θt] (direct: the shaft is part of the motor body,
 //! θw ≡ θm), [θm, θt] (two_mass) or [θt] (direct_drive: motor and table one body). The
-//! potential of MODEL.md §2,
+//! potential of docs/model.md §2,
 //!
 //! ```text
 //! V = ½Kg·(Rg·θm − θw)² + ½Kw·(Rw·θw + xw/r − θt)² + ½Kb·xw²
@@ -252,7 +252,7 @@ pub fn max_rate(p: &Params) -> Result<f64, ParamError> {
         .fold(0.0, |m: f64, l| m.max(l.norm())))
 }
 
-/// The linear frequency response of the paper's test (MODEL.md §5.1): for a unit motor
+/// The linear frequency response of the paper's test (docs/experiments.md (frequency response)): for a unit motor
 /// torque at each frequency of `freqs_hz` (Hz, > 0), the complex ratio
 /// X_θt / (X_θm·Rg·Rw) of table to motor amplitude; its gain is 20·log10|·| dB. It
 /// tends to 1 at low frequency and peaks near the clamped (motor-held) modes. A

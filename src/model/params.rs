@@ -1,8 +1,8 @@
-//! The physical parameters of a CNC axis drive and its servo controller (MODEL.md
-//! §1.1, §2–4).
+//! The physical parameters of a CNC axis drive and its servo controller
+//! (docs/model.md §1, §2, §6).
 //!
 //! One type, [`Params`], holds everything in SI units: on a rotary axis rad, N·m,
-//! kg·m²; on a linear axis m, N, kg for the same names (MODEL.md §1.1). Its JSON field
+//! kg·m²; on a linear axis m, N, kg for the same names (docs/model.md §1). Its JSON field
 //! names are the paper's symbols in ASCII (`Jm`, `Kw`, `theta_bw`, …), the same names
 //! `--set` and `--fit` take on the command line. The registry ([`PARAMS`]) lists every
 //! name with its units, meaning and the topologies it applies to; [`Params::validate`]
@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 pub use super::registry::{spec, Applies, Constraint, ParamSpec, PARAMS};
 
-/// Which drive train the axis has (MODEL.md §1, §1.1).
+/// Which drive train the axis has (docs/model.md §1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Topology {
@@ -49,7 +49,7 @@ impl fmt::Display for Topology {
     }
 }
 
-/// Whether the axis turns or slides (MODEL.md §1.1). The equations are the same; the
+/// Whether the axis turns or slides (docs/model.md §1). The equations are the same; the
 /// units of positions, loads and inertias differ.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
@@ -70,7 +70,7 @@ impl fmt::Display for Axis {
     }
 }
 
-/// Feedback arrangement of the position loop (MODEL.md §4).
+/// Feedback arrangement of the position loop (docs/model.md §6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum LoopMode {
@@ -105,7 +105,7 @@ impl fmt::Display for LoopMode {
     }
 }
 
-/// The discrete cascade servo (MODEL.md §1.1, §4; paper Fig. 6): position P or PI →
+/// The discrete cascade servo (docs/model.md §1, §6; paper Fig. 6): position P or PI →
 /// velocity P or PI, the output saturated in its own unit and turned into torque (or
 /// force) by the drive gain.
 ///
@@ -188,7 +188,7 @@ fn is_zero(v: &f64) -> bool {
 }
 
 /// Every parameter of the model, SI units (rad, N·m, kg·m² on a rotary axis; m, N, kg
-/// on a linear one). Field docs give the unit; MODEL.md §3 the paper's values. See
+/// on a linear one). Field docs give the unit; docs/model.md §11 the paper's values. See
 /// [`PARAMS`] for the names used in files and on the command line, and which
 /// topologies each applies to; a parameter that does not apply holds the registry's
 /// `unused` value (0, or 1 for `Rw` and `fluct_order`). Files: `params_json.rs`.
@@ -267,7 +267,7 @@ pub struct Params {
     pub encoder_delay: f64,
     /// Constant external table torque, N·m (force on a linear axis, N), positive in
     /// the positive sense of motion: gravity on an inclined axis, a cable carrier, the
-    /// negated offset force OF of the EMPS model (MODEL.md §1.1).
+    /// negated offset force OF of the EMPS model (docs/model.md §1).
     pub tload: f64,
     /// Servo controller settings.
     pub controller: ControllerParams,

@@ -1,5 +1,5 @@
 //! The JSON form of [`Params`]: which fields a file must give, may give, or leaves
-//! out, by topology and axis (MODEL.md §1.1, §3).
+//! out, by topology and axis (docs/model.md §1, §11).
 //!
 //! A field that applies to the file's topology is required unless it has a default
 //! (`Jw`, `Cw`, `fw`, `theta_bw`, `W`, `fluct_order`, `fluct_phase`, the unbalance,

@@ -1,6 +1,6 @@
 //! The parameter registry: every named parameter with its SI unit on a rotary and on a
 //! linear axis, its meaning, the physical constraint its value must meet and the
-//! topologies and axes it applies to (MODEL.md §1.1, §3, §4). [`Params::set`],
+//! topologies and axes it applies to (docs/model.md §1, §6, §11). [`Params::set`],
 //! [`Params::get`], [`Params::validate`] and the file form read it.
 //!
 //! [`Params::set`]: super::params::Params::set
@@ -24,7 +24,7 @@ pub enum Constraint {
     ZeroOrOne,
 }
 
-/// Which topologies a parameter belongs to (MODEL.md §1.1, §3).
+/// Which topologies a parameter belongs to (docs/model.md §1, §11).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Applies {
     /// Every topology.
@@ -99,7 +99,7 @@ impl ParamSpec {
     }
 
     /// Whether it belongs to a drive of `topology` on an axis of kind `axis`.
-    pub fn applies_to(&self, topology: Topology, axis: Axis) -> bool {
+    pub(crate) fn applies_to(&self, topology: Topology, axis: Axis) -> bool {
         self.applies.to(topology) && !(self.rotary_only && axis == Axis::Linear)
     }
 
@@ -162,7 +162,7 @@ macro_rules! spec {
     };
 }
 
-/// Every named parameter, in the order of MODEL.md §3, then the load and the
+/// Every named parameter, in the order of docs/model.md §11, then the load and the
 /// controller's. Columns: name, unit (rotary, linear), meaning, constraint,
 /// topologies, rotary axes only, value where unused, field.
 #[rustfmt::skip]

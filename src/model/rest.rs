@@ -60,7 +60,7 @@ pub fn moving_state(p: &Params, table: f64, velocity: f64) -> [f64; NSTATE] {
 }
 
 /// The deflections of the motor, shaft and axial slots that carry `torque` to a
-/// table at 0 (MODEL.md §2 at rest: Tw = Kw·dz(δw), Tg = Tw·Rw, Kb·xw = −Tw/r). The
+/// table at 0 (docs/model.md §2 at rest: Tw = Kw·dz(δw), Tg = Tw·Rw, Kb·xw = −Tw/r). The
 /// gear fluctuation e(θw) is left out (W·N·θw is below 1e-7 rad for the presets).
 fn static_twist(p: &Params, torque: f64) -> [f64; NSTATE] {
     let mut y = [0.0; NSTATE];

@@ -89,7 +89,7 @@ impl GainCurve {
     }
 
     /// The model's gain at the measured frequencies, dB.
-    pub fn model_db(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+    pub(crate) fn model_db(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
         match self.fidelity {
             Fidelity::Linear => {
                 let lin = LinearResponse::new(p, Channel::TableOverMotor)?;

@@ -51,7 +51,7 @@ impl Joint {
 
     /// The joint residuals from each part's own: what [`Objective::residuals`] of the
     /// joint returns, without evaluating it again.
-    pub fn stack(&self, parts: &[Vec<f64>]) -> Vec<f64> {
+    pub(crate) fn stack(&self, parts: &[Vec<f64>]) -> Vec<f64> {
         self.parts
             .iter()
             .zip(parts)
@@ -63,7 +63,7 @@ impl Joint {
     }
 
     /// Each part's own (unweighted) residuals, for reports.
-    pub fn part_residuals(&self, p: &Params) -> Result<Vec<Vec<f64>>, ObjectiveError> {
+    pub(crate) fn part_residuals(&self, p: &Params) -> Result<Vec<Vec<f64>>, ObjectiveError> {
         self.parts
             .iter()
             .map(|part| part.objective.residuals(p))

@@ -64,7 +64,7 @@ pub fn peaks(source: &Source<'_>) -> Result<Vec<Peak>, SetupError> {
 /// The (frequency, gain) points of a gain curve that are measurements of the drive:
 /// points flagged `below_resolution` (the table did not move more than the encoder
 /// resolves) are left out. Empty for other kinds.
-pub fn valid_points(exp: &Experiment) -> impl Iterator<Item = (f64, f64)> + '_ {
+pub(crate) fn valid_points(exp: &Experiment) -> impl Iterator<Item = (f64, f64)> + '_ {
     let (f, g, flags) = match &exp.data {
         Data::FrequencyResponse {
             frequency_hz,

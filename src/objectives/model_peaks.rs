@@ -22,7 +22,7 @@ const SCAN_LIMIT: (f64, f64) = (-0.2, 0.1);
 const FINE: f64 = 0.005;
 
 /// The nonlinear gain (dB) at each frequency, in parallel.
-pub fn nonlinear_gains(
+pub(crate) fn nonlinear_gains(
     p: &Params,
     test: &FrequencyTest,
     freqs: &[f64],
@@ -37,7 +37,11 @@ pub fn nonlinear_gains(
 /// `guess_hz`: a scan in 2 % steps (extended while the maximum is on its edge), a
 /// parabola through the best scan point and its neighbours, then a parabola of
 /// half-width 0.5 % around that vertex.
-pub fn nonlinear_peak(p: &Params, test: &FrequencyTest, guess_hz: f64) -> Result<Peak, SimError> {
+pub(crate) fn nonlinear_peak(
+    p: &Params,
+    test: &FrequencyTest,
+    guess_hz: f64,
+) -> Result<Peak, SimError> {
     let mut offsets: Vec<f64> = SCAN.to_vec();
     let mut freqs: Vec<f64> = offsets.iter().map(|s| guess_hz * (1.0 + s)).collect();
     let mut gains = nonlinear_gains(p, test, &freqs)?;
@@ -86,7 +90,7 @@ pub const GRID_BAND: f64 = 0.03;
 /// irregularities. If the band holds fewer than three frequencies, or its highest
 /// point is on its edge (the peak moved out of it), the grid-free
 /// [`nonlinear_peak`] is used instead.
-pub fn nonlinear_peak_on_grid(
+pub(crate) fn nonlinear_peak_on_grid(
     p: &Params,
     test: &FrequencyTest,
     grid_hz: &[f64],

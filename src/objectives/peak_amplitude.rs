@@ -90,7 +90,7 @@ impl PeakAmplitude {
     }
 
     /// Locate the nonlinear model's peaks on the measured frequencies `grid_hz`.
-    pub fn on_grid(mut self, grid_hz: Vec<f64>) -> Self {
+    pub(crate) fn on_grid(mut self, grid_hz: Vec<f64>) -> Self {
         self.model.grid_hz = Some(grid_hz);
         self
     }

@@ -84,7 +84,7 @@ impl ResonanceMatch {
     }
 
     /// Locate the nonlinear model's peaks on the measured frequencies `grid_hz`.
-    pub fn on_grid(mut self, grid_hz: Vec<f64>) -> Self {
+    pub(crate) fn on_grid(mut self, grid_hz: Vec<f64>) -> Self {
         self.model.grid_hz = Some(grid_hz);
         self
     }

@@ -84,7 +84,7 @@ impl TorqueResidual {
     }
 
     /// The model's motor torque at the measured times, N·m.
-    pub fn model_nm(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+    pub(crate) fn model_nm(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
         Ok(simulate_torque(p, &self.test, &self.time_s)?)
     }
 }

@@ -159,7 +159,7 @@ impl UnbalanceStep {
 
     /// The model's step angle in each measured step's window, deg (`None`: no step
     /// there).
-    pub fn model_deg(&self, p: &Params) -> Result<Vec<Option<f64>>, ObjectiveError> {
+    pub(crate) fn model_deg(&self, p: &Params) -> Result<Vec<Option<f64>>, ObjectiveError> {
         self.steps
             .par_iter()
             .map(|st| self.model_step(p, st))

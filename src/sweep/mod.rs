@@ -74,7 +74,7 @@ pub enum SweepError {
 }
 
 /// The column suffix of a registry unit (`N·m/rad` → `nm_per_rad`).
-pub fn unit_suffix(unit: &str) -> String {
+pub(crate) fn unit_suffix(unit: &str) -> String {
     match unit {
         "-" => String::new(),
         "kg·m²" => "kg_m2".into(),
@@ -95,7 +95,7 @@ pub fn unit_suffix(unit: &str) -> String {
 }
 
 /// A factor's CSV column: its name and unit (`Kw_nm_per_rad`, `theta_bw_rad`, `Rw`).
-pub fn factor_column(name: &str) -> String {
+pub(crate) fn factor_column(name: &str) -> String {
     match params::spec(name).map(|s| unit_suffix(s.unit)) {
         Ok(suffix) if !suffix.is_empty() => format!("{name}_{suffix}"),
         _ => name.to_string(),
@@ -130,7 +130,7 @@ impl Sweep {
     }
 
     /// The sweep described by a file's `# config` line.
-    pub fn from_config(config: &str, path: &Path) -> Result<Sweep, SweepError> {
+    pub(crate) fn from_config(config: &str, path: &Path) -> Result<Sweep, SweepError> {
         serde_json::from_str(config).map_err(|e| SweepError::Config {
             path: path.display().to_string(),
             reason: e.to_string(),
@@ -143,7 +143,7 @@ impl Sweep {
     }
 
     /// Base value of each factor.
-    pub fn base_values(&self) -> Result<Vec<f64>, SweepError> {
+    pub(crate) fn base_values(&self) -> Result<Vec<f64>, SweepError> {
         self.factors
             .iter()
             .map(|f| {
@@ -189,7 +189,7 @@ impl Sweep {
     }
 
     /// The parameter set at design point `values`.
-    pub fn params_at(&self, values: &[f64]) -> Result<Params, params::ParamError> {
+    pub(crate) fn params_at(&self, values: &[f64]) -> Result<Params, params::ParamError> {
         let mut p = self.params.clone();
         for (f, &v) in self.factors.iter().zip(values) {
             p.set(&f.name, v)?;
@@ -351,7 +351,7 @@ pub fn write_final(
 }
 
 /// The name of the indices file of the sweep file `out` (`stem-indices.csv`).
-pub fn indices_path(out: &Path) -> std::path::PathBuf {
+pub(crate) fn indices_path(out: &Path) -> std::path::PathBuf {
     let stem = out
         .file_stem()
         .map_or("sweep".into(), |s| s.to_string_lossy());

@@ -359,7 +359,7 @@ mod tests {
         };
         let v = e.evaluate(&p).unwrap();
         assert_eq!(e.columns().len(), v.len());
-        // MODEL.md §3: motor held 186.5, 236.9 Hz. The gain peaks of the damped drive
+        // docs/model.md §11: motor held 186.5, 236.9 Hz. The gain peaks of the damped drive
         // lie within 2 % of them (measured: 186.9 and 234.2 Hz; the second mode is the
         // more damped one, Ciw acting on the shaft-table twist).
         let (r1, r2) = (v[0].unwrap(), v[1].unwrap());

@@ -264,7 +264,7 @@ impl Journal {
     }
 
     /// Appends one row and flushes it to the operating system.
-    pub fn append(&mut self, fields: &[String]) -> Result<(), StreamError> {
+    pub(crate) fn append(&mut self, fields: &[String]) -> Result<(), StreamError> {
         let path = self.path.clone();
         self.writer
             .write_record(fields)

@@ -1,4 +1,4 @@
-//! The rotational-fluctuation test (paper §4.4, MODEL.md §5.4) and the unbalance-mass
+//! The rotational-fluctuation test (paper §4.4, docs/experiments.md (rotational fluctuation)) and the unbalance-mass
 //! test (§4.5, §5.5) as virtual experiments, and the evaluation both share.
 //!
 //! Run: the servo (semi-closed loop by default) drives the table at constant speed
@@ -30,8 +30,10 @@ mod tests;
 
 pub use evaluate::{evaluate, evaluate_experiment, ratio, Evaluation, Pass};
 pub use record::{from_data, manifest, to_data};
-pub use run::{run, run_window, test_params, Record};
-pub use steps::{locate_step, pass_samples, PassSamples, Step};
+pub(crate) use run::run_window;
+pub use run::{run, Record};
+pub(crate) use steps::pass_samples;
+pub use steps::{locate_step, PassSamples, Step};
 
 use std::f64::consts::TAU;
 use std::path::PathBuf;
@@ -62,7 +64,7 @@ pub const DEFAULT_UNBALANCE: (f64, f64) = (10.0, 0.1);
 /// Dominant orders reported.
 pub const PEAKS: usize = 5;
 
-/// Conditions of the test (defaults: MODEL.md §5.4).
+/// Conditions of the test (defaults: docs/experiments.md (rotational fluctuation)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FluctuationTest {
     /// Table speed, rad/s (default 180°/min; 360°/min for unbalance).
@@ -97,7 +99,7 @@ impl Default for FluctuationTest {
 }
 
 impl FluctuationTest {
-    /// The unbalance test (MODEL.md §5.5): 360°/min with `mass` kg at `radius` m.
+    /// The unbalance test (docs/experiments.md (unbalance)): 360°/min with `mass` kg at `radius` m.
     pub fn unbalance(mass: f64, radius: f64) -> Self {
         FluctuationTest {
             speed: (360.0f64 / 60.0).to_radians(),

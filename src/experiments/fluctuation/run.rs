@@ -44,7 +44,7 @@ pub struct Record {
 }
 
 /// The parameters the test runs with: loop mode and unbalance set.
-pub fn test_params(params: &Params, test: &FluctuationTest) -> Params {
+pub(crate) fn test_params(params: &Params, test: &FluctuationTest) -> Params {
     let mut p = params.clone();
     p.controller.loop_mode = test.loop_mode;
     let (mass, radius) = test.unbalance.unwrap_or((0.0, 0.0));
@@ -67,7 +67,7 @@ pub fn run(
 /// for the test's dwell, then at the test's speed to `to`, recorded as [`run`] records
 /// (same servo, same encoders, same sampling). Start `from` a run-in before the angles
 /// of interest, so that the speed is steady there.
-pub fn run_window(
+pub(crate) fn run_window(
     params: &Params,
     test: &FluctuationTest,
     from: f64,

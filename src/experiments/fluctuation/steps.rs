@@ -42,7 +42,7 @@ impl PassSamples {
 }
 
 /// The passes of a record with at least 4 advancing samples each, in the order run.
-pub fn pass_samples(record: &Record, ratio: f64) -> Vec<PassSamples> {
+pub(crate) fn pass_samples(record: &Record, ratio: f64) -> Vec<PassSamples> {
     let table = &record.table_angle;
     let mut out = Vec::new();
     for (first, last, sense) in passes(table) {

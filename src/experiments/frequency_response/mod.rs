@@ -1,4 +1,4 @@
-//! The frequency-response test as a virtual experiment (paper §4.1, MODEL.md §5.1).
+//! The frequency-response test as a virtual experiment (paper §4.1, docs/experiments.md (frequency response)).
 //!
 //! Open loop, motor torque `preload·Rg·Rw + A·sin(2πft)`, table brake `−preload`.
 //! Every frequency is an independent nonlinear time simulation. They run in
@@ -42,7 +42,7 @@ use crate::sim::SimError;
 /// Frequencies advanced together by one worker (two AVX2 registers per state).
 pub const LANES: usize = 4;
 
-/// Conditions of the test (defaults: MODEL.md §5.1).
+/// Conditions of the test (defaults: docs/experiments.md (frequency response)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrequencyTest {
     /// Coarse grid, Hz (default 10, 20, …, 600).

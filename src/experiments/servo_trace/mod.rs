@@ -1,6 +1,6 @@
 //! Servo traces: recorded closed-loop runs of an axis, their replay on the model, the
 //! benchmark's simulation error, virtual traces of rtid's own presets, and the
-//! friction law fitted to any of them (MODEL.md §1.1).
+//! friction law fitted to any of them (docs/model.md §1).
 //!
 //! A [`ServoTrace`] is what a drive's oscilloscope records at its control period:
 //! time, the position reference, the loop encoder, optionally a second (table)

@@ -1,4 +1,4 @@
-//! The `conditions` of a manifest — how an experiment was run — with MODEL.md §7's
+//! The `conditions` of a manifest — how an experiment was run — with docs/experiment-files.md's
 //! defaults and the checks a frequency-response record and a servo trace need.
 
 use serde::{Deserialize, Serialize};
@@ -34,7 +34,7 @@ impl Excitation {
 }
 
 /// The `conditions` of a manifest: how the experiment was run. Every field is optional,
-/// in the unit its name carries; [`Conditions::with_defaults`] fills in MODEL.md §7's
+/// in the unit its name carries; [`Conditions::with_defaults`] fills in docs/experiment-files.md's
 /// defaults. Unknown keys are kept in `extra`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Conditions {
@@ -42,7 +42,7 @@ pub struct Conditions {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub torque_amplitude_nm: Option<f64>,
     /// Frequency response: brake torque on the table, balanced by a motor DC torque, that
-    /// keeps the flanks loaded (MODEL.md §5.1), N·m (default 0).
+    /// keeps the flanks loaded (docs/experiments.md (frequency response)), N·m (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub preload_nm: Option<f64>,
     /// Torque curve: amplitude of the commanded table motion, deg (default 30).
@@ -103,7 +103,7 @@ pub struct Conditions {
     pub transient_periods: Option<u32>,
     /// Servo trace: the drive gain, the effort (N for a force column, N·m for a torque
     /// column) per unit of controller output (V, A, N·m or N, as its column says):
-    /// MODEL.md §1.1's Kdrive. EMPS: 35.15 N/V.
+    /// docs/model.md §1's Kdrive. EMPS: 35.15 N/V.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub drive_gain: Option<f64>,
     /// Servo trace: the sample period of the control loop, s, where it differs from the
@@ -144,7 +144,7 @@ impl Conditions {
         *self == Conditions::default()
     }
 
-    /// A copy with MODEL.md §7's defaults for `kind` filled in where a value is absent
+    /// A copy with docs/experiment-files.md's defaults for `kind` filled in where a value is absent
     /// (the ratio excepted: it depends on the mechanism).
     pub fn with_defaults(&self, kind: Kind) -> Conditions {
         let mut c = self.clone();

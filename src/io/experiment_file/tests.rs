@@ -545,7 +545,7 @@ fn malformed_csv_files_name_file_line_and_column() {
         (tc, "time_s,motor_torque_nm,table_angle_deg,table_angle_rad\n0,1,0,0\n", "columns `table_angle_deg` and `table_angle_rad` give the same angle"),
         ("fluctuation", "time_s,motor_angle_deg\n0,1\n", "missing column `table_angle_deg` (or `table_angle_rad`, `table_angle_arcsec`) (header: time_s,motor_angle_deg)"),
         (pos, "target_deg,direction,run\n0,up,1\n", "missing column `measured_deg` (or `measured_rad`, `measured_arcsec`, `measured_m`, `measured_mm`, `measured_um`, `deviation_deg`, `deviation_rad`, `deviation_arcsec`, `deviation_m`, `deviation_mm`, `deviation_um`)"),
-        (pos, "target_deg,direction,run,measured_deg\n0,up,1,0\n0,sideways,1,0\n", "line 3, column `direction`: `sideways` is not a direction (expected up, down, ccw or cw)"),
+        (pos, "target_deg,direction,run,measured_deg\n0,up,1,0\n0,sideways,1,0\n", "line 3, column `direction`: unknown direction `sideways`: expected up, down, ccw or cw"),
         (pos, "target_deg,direction,run,measured_deg\n0,up,0,0\n", "line 2, column `run`: run 0: runs are numbered from 1"),
         (pos, "target_deg,direction,run,measured_deg\n0,up,-1,0\n", "line 2, column `run`: `-1` is not a run number"),
         (pos, "target_deg,direction,run,measured_deg\n0,up,1.5,0\n", "line 2, column `run`: `1.5` is not a run number"),

@@ -1,6 +1,6 @@
 //! The units an experiment file may carry in its column names, and what they say about
 //! the axis: angles and torques belong to a rotary axis, lengths and forces to a linear
-//! one (MODEL.md §1.1, "Linear axes"). The reader converts every position to SI (rad or
+//! one (docs/model.md §1, "Linear axes"). The reader converts every position to SI (rad or
 //! m) and keeps which of the two it was.
 
 use std::fmt;
@@ -18,7 +18,7 @@ pub(super) const UM: f64 = 1e-6;
 
 /// Whether an axis turns or slides: positions in rad and efforts in N·m, or positions in
 /// m and efforts in N (inertia in kg·m² or a mass in kg). The equations of motion are
-/// the same (MODEL.md §1.1).
+/// the same (docs/model.md §1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Axis {
@@ -116,7 +116,7 @@ pub(super) fn units_for(base: &str) -> &'static [PositionUnit] {
 
 /// The unit of a controller output (the command a servo amplifier receives): a voltage
 /// (an analog reference), a current (a current command), or the torque or force
-/// commanded directly (MODEL.md §1.1: "V, A, or 1 for a torque command").
+/// commanded directly (docs/model.md §1: "V, A, or 1 for a torque command").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CommandUnit {

@@ -117,7 +117,13 @@ impl Table {
         } else {
             self.numbers(deviation, Any)?
         };
-        let (direction, run) = (self.parse(d, |s| s.parse())?, self.parse(r, super::run)?);
+        let (direction, run) = (
+            self.parse(d, |s| {
+                s.parse()
+                    .map_err(|e: crate::names::UnknownName| e.to_string())
+            })?,
+            self.parse(r, super::run)?,
+        );
         let extra = self.extras();
         Ok(match axis {
             Axis::Rotary => Data::Positioning {
@@ -157,7 +163,7 @@ impl Table {
         Ok(deviation)
     }
 
-    /// Time, motor-shaft angle and table angle (rotary only: MODEL.md §5.4 evaluates
+    /// Time, motor-shaft angle and table angle (rotary only: docs/experiments.md (rotational fluctuation) evaluates
     /// θt − θm·Rg·Rw over the table angle).
     fn fluctuation(mut self, kind: Kind) -> Result<Data, Error> {
         let t = self.column("time_s")?;
