@@ -829,3 +829,54 @@ fn a_reader_that_closes_the_pipe_early_is_not_an_error() {
         out.status
     );
 }
+
+/// The EMPS estimation record evaluated as a new user would: the friction law by
+/// IDIM-LS, and the trace replayed on the published model (fixtures/real/emps) to the
+/// published simulation error (2.10 µm RMS, 12.6 µm max, 2.41 N RMS; Janot et al.
+/// 2019), with both plots written beside the output. A model of the wrong axis is one
+/// clear error.
+#[test]
+fn evaluate_replays_the_emps_servo_trace_on_its_published_model() {
+    let dir = tempdir();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/real/emps");
+    let trace = root.join("emps_estimation.json");
+    let (trace, axis) = (trace.to_str().unwrap(), root.join("axis.json"));
+    let plot = dir.path().join("emps.svg");
+    let v = rtid_json(
+        &[
+            "evaluate",
+            trace,
+            "--params",
+            axis.to_str().unwrap(),
+            "--json",
+            "--plot",
+            plot.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert_eq!(v["kind"], "servo_trace");
+    assert_eq!(v["axis"], "linear");
+    let e = &v["simulation_error"];
+    let near = |x: &serde_json::Value, want: f64, tol: f64| {
+        x.as_f64().is_some_and(|x| (x / want - 1.0).abs() < tol)
+    };
+    assert!(near(&e["position_rms"], 2.10e-6, 0.05), "{e}");
+    assert!(near(&e["position_max"], 12.6e-6, 0.10), "{e}");
+    assert!(near(&e["force_rms"], 2.41, 0.05), "{e}");
+    let idim = &v["inverse_dynamics"];
+    assert!(near(&idim["inertia"]["value"], 95.1089, 0.02), "{idim}");
+    assert!(near(&idim["coulomb"]["value"], 20.3935, 0.02), "{idim}");
+    assert!(plot.exists() && dir.path().join("emps-effort.svg").exists());
+    let out = rtid(
+        &[
+            "evaluate",
+            trace,
+            "--preset",
+            "worm-gear",
+            "--plot",
+            plot.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert_one_line_error(&out, &["emps_estimation.json", "linear axis", "rotary"]);
+}

@@ -5,8 +5,10 @@ use std::path::PathBuf;
 use anyhow::bail;
 
 use super::experiment::{
-    fluctuation, frequency_response, frequency_response_time, positioning, torque_curve,
+    fluctuation, frequency_response, frequency_response_time, positioning, servo_trace,
+    torque_curve,
 };
+use super::model_args::ModelArgs;
 use rtid::io::experiment_file::{self, Kind};
 
 pub const LONG_ABOUT: &str = "\
@@ -39,11 +41,13 @@ stand out of the random error). Plots: FILE.svg (gain) and FILE-coherence.svg.
   unbalance     as fluctuation; the step (largest change of the deviation across 0.5° of \
 table angle, and where) is the backlash crossed when the unbalance moment overcomes the \
 friction. Plots: FILE.svg (Fig. 14) and FILE-spectrum.svg.
+  servo_trace   a recorded closed-loop run (reference, loop encoder, drive effort; rotary or linear). The friction law F = M·a + Fv·v + Fc·sign(v) + OF by inverse-dynamic least squares (IDIM-LS), with standard errors; with --params or --preset, the trace replayed on that model through its sampled servo, closed loop, and the simulation error: position RMS and largest, force RMS (SI in --json; µm or arc-seconds and N or N·m in the table). Plots: FILE.svg (following error, measured and replayed) and FILE-effort.svg.
 
 Example:
   rtid evaluate runs/worm/positioning.json --json
   rtid evaluate runs/worm/torque_curve.json
-  rtid evaluate runs/worm/fluctuation.json";
+  rtid evaluate runs/worm/fluctuation.json
+  rtid evaluate fixtures/real/emps/emps_estimation.json --params fixtures/real/emps/axis.json";
 
 /// Arguments of `rtid evaluate`.
 #[derive(Debug, clap::Args)]
@@ -59,6 +63,9 @@ pub struct Args {
     pub plot: Option<PathBuf>,
     #[command(flatten)]
     pub estimate: frequency_response_time::EstimateArgs,
+    /// The model a servo trace is replayed on (servo traces only; optional).
+    #[command(flatten)]
+    pub model: ModelArgs,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -72,6 +79,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Kind::FrequencyResponse => frequency_response::report(&exp, &plot, a.json),
         Kind::TorqueCurve => torque_curve::report(&exp, &plot, a.json),
         Kind::Fluctuation | Kind::Unbalance => fluctuation::report(&exp, &plot, a.json),
+        Kind::ServoTrace => {
+            let model = a.model.given().then(|| a.model.load()).transpose()?;
+            servo_trace::report(&exp, &plot, a.json, model)
+        }
         Kind::FrequencyResponseTime => {
             frequency_response_time::report_with(&exp, &plot, a.json, &a.estimate.options())
         }

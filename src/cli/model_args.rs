@@ -23,6 +23,11 @@ pub struct ModelArgs {
 }
 
 impl ModelArgs {
+    /// Whether a parameter set was named (`--preset` or `--params`).
+    pub fn given(&self) -> bool {
+        self.preset.is_some() || self.params.is_some()
+    }
+
     /// The validated parameter set.
     pub fn load(&self) -> anyhow::Result<Params> {
         let mut p = match (&self.preset, &self.params) {

@@ -51,7 +51,7 @@ impl fmt::Display for Topology {
 
 /// Whether the axis turns or slides (docs/model.md §1). The equations are the same; the
 /// units of positions, loads and inertias differ.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum Axis {
     /// rad, N·m, kg·m².
@@ -61,12 +61,35 @@ pub enum Axis {
     Linear,
 }
 
-impl fmt::Display for Axis {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
+impl Axis {
+    /// `rotary` or `linear`.
+    pub fn name(self) -> &'static str {
+        match self {
             Axis::Rotary => "rotary",
             Axis::Linear => "linear",
-        })
+        }
+    }
+
+    /// The SI unit of a position on this axis: `rad` or `m`.
+    pub fn position_unit(self) -> &'static str {
+        match self {
+            Axis::Rotary => "rad",
+            Axis::Linear => "m",
+        }
+    }
+
+    /// The SI unit of a drive effort on this axis: `N·m` or `N`.
+    pub fn effort_unit(self) -> &'static str {
+        match self {
+            Axis::Rotary => "N·m",
+            Axis::Linear => "N",
+        }
+    }
+}
+
+impl fmt::Display for Axis {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
     }
 }
 

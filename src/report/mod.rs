@@ -7,5 +7,6 @@ pub mod frequency_response;
 pub mod frequency_response_time;
 pub mod identify;
 pub mod positioning;
+pub mod servo_trace;
 pub mod sweep;
 pub mod torque_curve;

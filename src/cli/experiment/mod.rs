@@ -7,6 +7,7 @@ pub mod fluctuation;
 pub mod frequency_response;
 pub mod frequency_response_time;
 pub mod positioning;
+pub mod servo_trace;
 pub mod torque_curve;
 pub mod unbalance;
 

@@ -16,49 +16,7 @@ pub(super) const MM: f64 = 1e-3;
 /// Metres per micrometre.
 pub(super) const UM: f64 = 1e-6;
 
-/// Whether an axis turns or slides: positions in rad and efforts in N·m, or positions in
-/// m and efforts in N (inertia in kg·m² or a mass in kg). The equations of motion are
-/// the same (docs/model.md §1).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Axis {
-    /// A rotary table: angles (rad), torques (N·m).
-    Rotary,
-    /// A linear axis: lengths (m), forces (N).
-    Linear,
-}
-
-impl Axis {
-    /// `rotary` or `linear`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Axis::Rotary => "rotary",
-            Axis::Linear => "linear",
-        }
-    }
-
-    /// The SI unit of a position on this axis: `rad` or `m`.
-    pub fn position_unit(self) -> &'static str {
-        match self {
-            Axis::Rotary => "rad",
-            Axis::Linear => "m",
-        }
-    }
-
-    /// The SI unit of a drive effort on this axis: `N·m` or `N`.
-    pub fn effort_unit(self) -> &'static str {
-        match self {
-            Axis::Rotary => "N·m",
-            Axis::Linear => "N",
-        }
-    }
-}
-
-impl fmt::Display for Axis {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+pub use crate::model::Axis;
 
 /// A position suffix of a column name: the axis it implies and SI units (rad or m) per
 /// unit written.
