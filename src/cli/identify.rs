@@ -493,6 +493,13 @@ fn detail(d: &Detail) -> String {
             )
         }
         Detail::Torque { rms_error_nm } => format!("  RMS error {rms_error_nm:.4} N·m"),
+        Detail::Trace {
+            force_rms,
+            position_rms,
+            position_max,
+        } => format!(
+            "  replay: force {force_rms:.4} RMS; position {position_rms:.4e} RMS, {position_max:.4e} max (SI)"
+        ),
     }
 }
 

@@ -144,7 +144,7 @@ impl fmt::Display for Warning {
                 "{a} and {b} are correlated {correlation:+.3}: the data cannot separate them (fix one, or add an experiment that moves them differently)"
             ),
             Warning::RoughCost => f.write_str(
-                "the standard errors of a fit to a closed-loop simulation (torque curve, unbalance test) count the residuals' scatter only: the quantised encoders make the cost rough, and on clean data that roughness, not the scatter, sets the error (fm −1.8 % against a 0.1 % standard error on the worm fixture) — read them as lower bounds",
+                "the standard errors of a fit to a closed-loop simulation (torque curve, unbalance test, servo trace) count the residuals' scatter only: the quantised encoders make the cost rough, and on clean data that roughness, not the scatter, sets the error (fm −1.8 % against a 0.1 % standard error on the worm fixture) — read them as lower bounds",
             ),
             Warning::NonlinearShift {
                 source,

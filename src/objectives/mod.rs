@@ -27,6 +27,7 @@ pub mod model_peaks;
 pub mod peak_amplitude;
 pub mod registry;
 pub mod resonance;
+pub mod servo_trace;
 pub mod torque_curve;
 pub mod unbalance_step;
 
@@ -113,6 +114,13 @@ pub enum Detail {
     },
     /// The RMS error of the motor torque, N·m.
     Torque { rms_error_nm: f64 },
+    /// The simulation error of a replayed servo trace: force (N or N·m) and position
+    /// (m or rad) RMS, and the largest position error.
+    Trace {
+        force_rms: f64,
+        position_rms: f64,
+        position_max: f64,
+    },
     /// The unbalance steps: direction, measured and model table angle (deg; `None`
     /// where the model shows no step).
     UnbalanceSteps {

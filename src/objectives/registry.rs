@@ -11,13 +11,14 @@ use crate::names::UnknownName;
 
 /// The objectives, in the order their residuals are stacked and their parameters
 /// listed.
-pub static REGISTRY: [&Definition; 6] = [
+pub static REGISTRY: [&Definition; 7] = [
     &super::resonance::DEFINITION,
     &super::peak_amplitude::DEFINITION,
     &super::gain_curve::DEFINITION,
     &super::gain_curve::NEAR_PEAKS,
     &super::torque_curve::DEFINITION,
     &super::unbalance_step::DEFINITION,
+    &super::servo_trace::DEFINITION,
 ];
 
 /// Which default set of objectives: that of a search, or that of the nonlinear

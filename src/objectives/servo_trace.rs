@@ -1,0 +1,185 @@
+//! Servo-trace output error: the recorded trace replayed on the model through its
+//! sampled servo, closed loop, over the whole record (`experiments::servo_trace`), and
+//! the replayed force and loop-encoder position compared with the recorded ones,
+//! sample by sample. The output-error refinement of the IDIM-LS start: unlike
+//! the inverse model it sees the whole loop (the controller, its delay, the encoder's
+//! quantisation), and its residuals are the benchmark's simulation error.
+//!
+//! Scales: 1 % of the recorded force's RMS per force sample and 1 % of the recorded
+//! following error's RMS (reference − position) per position sample. They set the
+//! relative weight of the two signals only: the standard errors come from the
+//! residuals' own scatter (σ² = Σr²/(m − n)), so the absolute scale cancels.
+
+use super::registry::{Definition, SetupError, Source};
+use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
+use crate::experiments::servo_trace::{replay, ServoTrace, TraceError};
+use crate::io::experiment_file::{Data, Kind};
+use crate::model::{Params, Topology};
+
+/// The servo-trace objective: a closed-loop replay with quantised encoders (rough);
+/// determines the rigid core of the axis — inertia, viscous and Coulomb friction and
+/// the constant load — and, for a geared table, the motor's friction.
+pub static DEFINITION: Definition = Definition {
+    name: "servo_trace",
+    summary:
+        "output error of the trace replayed through the servo: force and position, sample by sample",
+    reads: &[Kind::ServoTrace],
+    needs: "a servo_trace experiment",
+    properties: Properties {
+        smoothness: Smoothness::Rough,
+        frequency_response: false,
+    },
+    determines,
+    default_weight: |kind, _| (kind == Kind::ServoTrace).then_some(1.0),
+    build,
+};
+
+fn determines(p: &Params) -> Vec<&'static str> {
+    match p.topology {
+        Topology::DirectDrive | Topology::TwoMass => vec!["Jt", "Ct", "ft", "Tload"],
+        Topology::SpurGear | Topology::Direct => vec!["fm", "Cm"],
+    }
+}
+
+fn build(source: &Source<'_>, _: Fidelity) -> Result<Box<dyn Objective>, SetupError> {
+    let Data::ServoTrace(file) = &source.experiment.data else {
+        return Err(SetupError::Unsupported {
+            file: source.file.into(),
+            kind: source.kind().name(),
+        });
+    };
+    Ok(Box::new(TraceResidual::new(ServoTrace::from_file(file))))
+}
+
+/// One scaled residual is this fraction of the recorded signal's RMS.
+pub const SCALE_OF_RMS: f64 = 0.01;
+
+/// A recorded trace and the scales of its two signals.
+#[derive(Clone, Debug)]
+pub struct TraceResidual {
+    pub trace: ServoTrace,
+    /// N or N·m per unit of scaled force residual.
+    pub force_scale: f64,
+    /// m or rad per unit of scaled position residual.
+    pub position_scale: f64,
+}
+
+impl TraceResidual {
+    pub fn new(trace: ServoTrace) -> Self {
+        let following: Vec<f64> = trace
+            .reference
+            .iter()
+            .zip(&trace.position)
+            .map(|(r, q)| r - q)
+            .collect();
+        TraceResidual {
+            force_scale: (SCALE_OF_RMS * rms(&trace.force)).max(1e-9),
+            position_scale: (SCALE_OF_RMS * rms(&following)).max(1e-12),
+            trace,
+        }
+    }
+}
+
+fn rms(x: &[f64]) -> f64 {
+    (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64).sqrt()
+}
+
+fn objective_error(e: TraceError) -> ObjectiveError {
+    match e {
+        TraceError::Simulation(s) => ObjectiveError::Sim(s),
+        other => ObjectiveError::Data {
+            what: "servo trace".into(),
+            reason: other.to_string(),
+        },
+    }
+}
+
+impl Objective for TraceResidual {
+    fn name(&self) -> &'static str {
+        "servo_trace"
+    }
+
+    fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+        let run = replay(p, &self.trace).map_err(objective_error)?;
+        let force = run
+            .force
+            .iter()
+            .zip(&self.trace.force)
+            .map(|(m, f)| (m - f) / self.force_scale);
+        let position = run
+            .position
+            .iter()
+            .zip(&self.trace.position)
+            .map(|(m, q)| (m - q) / self.position_scale);
+        Ok(force.chain(position).collect())
+    }
+
+    fn len(&self) -> usize {
+        2 * self.trace.len()
+    }
+
+    fn scale(&self) -> String {
+        format!(
+            "{:.3e} of force and {:.3e} of position per sample (1 % of the recorded force's and following error's RMS)",
+            self.force_scale, self.position_scale
+        )
+    }
+
+    fn detail(&self, r: &[f64]) -> Option<Detail> {
+        let (force, position) = r.split_at(r.len() / 2);
+        Some(Detail::Trace {
+            force_rms: rms(force) * self.force_scale,
+            position_rms: rms(position) * self.position_scale,
+            position_max: position.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
+                * self.position_scale,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_detail_is_the_simulation_error() {
+        let trace = ServoTrace {
+            time_s: vec![0.0, 1.0],
+            reference: vec![1.0, 1.0],
+            position: vec![0.0, 0.0],
+            force: vec![3.0, 4.0],
+            ..Default::default()
+        };
+        let o = TraceResidual::new(trace.clone());
+        let run = crate::experiments::servo_trace::Replay {
+            time_s: trace.time_s.clone(),
+            position: vec![0.5, -1.0],
+            table_position: vec![0.0; 2],
+            force: vec![3.0, 6.0],
+            controller_output: vec![0.0; 2],
+        };
+        let r: Vec<f64> = run
+            .force
+            .iter()
+            .zip(&trace.force)
+            .map(|(m, f)| (m - f) / o.force_scale)
+            .chain(
+                run.position
+                    .iter()
+                    .zip(&trace.position)
+                    .map(|(m, q)| (m - q) / o.position_scale),
+            )
+            .collect();
+        let want = crate::experiments::servo_trace::simulation_error(&trace, &run).unwrap();
+        let Some(Detail::Trace {
+            force_rms,
+            position_rms,
+            position_max,
+        }) = o.detail(&r)
+        else {
+            panic!("a trace detail")
+        };
+        assert!((force_rms - want.force_rms).abs() < 1e-12);
+        assert!((position_rms - want.position_rms).abs() < 1e-12);
+        assert!((position_max - want.position_max).abs() < 1e-12);
+    }
+}
