@@ -1,0 +1,43 @@
+//! Servo traces: `cargo bench --bench servo_trace`; figures in docs/performance.md.
+//!
+//! On the EMPS estimation record (24 841 samples, fixtures/real/emps):
+//! `servo_trace/idim` — the IDIM-LS friction law (filters, decimation, least squares);
+//! `servo_trace/replay` — one closed-loop replay of the whole record on the published
+//! model, the unit of cost of the output-error identification (`servo-trace`
+//! objective: ~110 replays from the IDIM estimate).
+
+use std::path::PathBuf;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use rtid::experiments::inverse_dynamics::IdimSettings;
+use rtid::experiments::servo_trace::{replay, ServoTrace};
+use rtid::io::experiment_file::{self, Data};
+use rtid::model::Params;
+
+fn emps() -> (ServoTrace, Params) {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/real/emps");
+    let e = experiment_file::read(&root.join("emps_estimation.json")).unwrap();
+    let Data::ServoTrace(file) = &e.data else {
+        panic!("not a servo trace")
+    };
+    let text = std::fs::read_to_string(root.join("axis.json")).unwrap();
+    (
+        ServoTrace::from_file(file),
+        serde_json::from_str(&text).unwrap(),
+    )
+}
+
+fn bench(c: &mut Criterion) {
+    let (trace, params) = emps();
+    let mut group = c.benchmark_group("servo_trace");
+    group.sample_size(20);
+    group.throughput(Throughput::Elements(trace.len() as u64));
+    group.bench_function("idim", |b| {
+        b.iter(|| trace.fit_friction(&IdimSettings::default()).unwrap())
+    });
+    group.bench_function("replay", |b| b.iter(|| replay(&params, &trace).unwrap()));
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
