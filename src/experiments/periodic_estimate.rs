@@ -160,12 +160,7 @@ pub fn h1(
         .iter()
         .zip(nl)
         .map(|(&k, nl)| {
-            let a: Vec<_> = y
-                .line(k)
-                .zip(x.line(k))
-                .map(|(y, x)| y * x.conj())
-                .collect();
-            let b: Vec<_> = x.line(k).map(|x| Complex::new(x.norm_sqr(), 0.0)).collect();
+            let (a, b) = (cross(&y, &x, k), cross(&x, &x, k));
             let g = coherence(&x, &y, k);
             line(rec, k, &a, &b, g, nl, "input")
         })
@@ -189,16 +184,7 @@ pub fn reference_ratio(
         .iter()
         .zip(nl)
         .map(|(&k, nl)| {
-            let a: Vec<_> = y
-                .line(k)
-                .zip(r.line(k))
-                .map(|(y, r)| y * r.conj())
-                .collect();
-            let b: Vec<_> = x
-                .line(k)
-                .zip(r.line(k))
-                .map(|(x, r)| x * r.conj())
-                .collect();
+            let (a, b) = (cross(&y, r, k), cross(&x, r, k));
             let g = coherence(&x, &y, k);
             line(rec, k, &a, &b, g, nl, "denominator")
         })
@@ -245,8 +231,16 @@ fn estimate(
 }
 
 /// γ² between x and y at line k over the periods.
+/// Per period, line `k` of `a` times the conjugate of `b`'s (a cross-spectrum's terms).
+fn cross(a: &PeriodSpectra, b: &PeriodSpectra, k: usize) -> Vec<Complex<f64>> {
+    a.line(k)
+        .zip(b.line(k))
+        .map(|(a, b)| a * b.conj())
+        .collect()
+}
+
 fn coherence(x: &PeriodSpectra, y: &PeriodSpectra, k: usize) -> f64 {
-    let sxy: Complex<f64> = y.line(k).zip(x.line(k)).map(|(y, x)| y * x.conj()).sum();
+    let sxy: Complex<f64> = cross(y, x, k).into_iter().sum();
     let sxx: f64 = x.line(k).map(|v| v.norm_sqr()).sum();
     let syy: f64 = y.line(k).map(|v| v.norm_sqr()).sum();
     if sxx > 0.0 && syy > 0.0 {

@@ -2,6 +2,7 @@
 //! measured and, when the model replayed it, replayed.
 
 use super::figure::{Figure, Series, Style};
+use crate::experiments::iso230::ARCSEC_PER_RAD;
 use crate::experiments::servo_trace::{Replay, ServoTrace};
 use crate::io::experiment_file::Axis;
 
@@ -60,6 +61,6 @@ pub fn effort(trace: &ServoTrace, replay: Option<&Replay>, axis: Axis) -> Figure
 pub fn position_unit(axis: Axis) -> (f64, &'static str) {
     match axis {
         Axis::Linear => (1e6, "µm"),
-        Axis::Rotary => (180.0 / std::f64::consts::PI * 3600.0, "arcsec"),
+        Axis::Rotary => (ARCSEC_PER_RAD, "arcsec"),
     }
 }
