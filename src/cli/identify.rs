@@ -12,7 +12,7 @@ use super::ModelArgs;
 use rtid::identify::comparison;
 use rtid::identify::{
     identify, Bound, Config, ExperimentSpec, FidelityChoice, Identified, IdentifyResult, Method,
-    Monitor, SearchOptions, Warning,
+    Monitor, SearchOptions, StartChoice, Warning,
 };
 use rtid::io::experiment_file;
 use rtid::io::params_file;
@@ -34,12 +34,19 @@ whole gain curve, dB) and gain-near-peaks (the gain within ±3 % of each resonan
   torque_curve        torque-curve: the motor torque of the closed-loop torque test, sample by \
 sample. A torque curve determines one Coulomb and one viscous sum (fm + fw·Rg + ft·Rg·Rw, and \
 the viscous alike): fit one of each.
+  servo_trace         servo-trace: the recorded trace replayed through the servo (the \
+recorded reference into the controller, closed loop, over the whole record), force and \
+position against the recorded ones, sample by sample. On a direct-drive axis it determines \
+Jt, Ct, ft and Tload, and the search starts at their inverse-dynamics least-squares estimate \
+(IDIM-LS, instant: --start given to start at the --params values instead); on a geared axis \
+fm and Cm.
   unbalance           unbalance-step: the table angles where the deviation θt − θm·Rg·Rw steps \
 across the backlash (where the unbalance moment overcomes the table friction), model against \
 measured, 0.05° per unit. It determines ft (the manifest must give mass_kg and radius_m).
 Default --fit: Kw (and Kg with a spur stage) from resonances; fm and Cm from a torque curve \
 (the table's friction reaches the motor divided by the ratio — 1/90 for the worm — and \
-hardly shows in its torque); ft from an unbalance test. fm and ft together: give both files \
+hardly shows in its torque); ft from an unbalance test; Jt, Ct, ft, Tload from a servo trace \
+of a direct-drive axis. fm and ft together: give both files \
 and --fit fm,ft.
 
 The model's frequency response (--model): `linear` is the exact linear response with damping \
@@ -75,6 +82,8 @@ Examples:
   rtid identify fixtures/worm-gear/torque_curve.json fixtures/worm-gear/unbalance.json \\
       --preset worm-gear --fit fm,ft --out friction.json
   rtid identify fixtures/paper/worm-gear.json --preset worm-gear --fit Kw,Kg,Jt --model linear
+  rtid identify fixtures/real/emps/emps_estimation.json --params fixtures/real/emps/axis.json \\
+      --out emps-fit.json --save-params emps-fit-params.json
   rtid modes --params worm-fit.json";
 
 /// Arguments of `rtid identify`.
@@ -127,6 +136,11 @@ pub struct Args {
     /// Continue from --checkpoint.
     #[arg(long, requires = "checkpoint")]
     pub resume: bool,
+    /// Where the search starts: `estimate` — at an experiment's direct estimate where
+    /// it offers one (a servo trace of a direct-drive axis: IDIM-LS for Jt, Ct, ft,
+    /// Tload), else the --preset/--params values; `given` — at those values always.
+    #[arg(long, value_enum, default_value = "estimate")]
+    pub start: StartArg,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
@@ -159,6 +173,24 @@ impl From<MethodArg> for Method {
             MethodArg::Lsq => Method::Lsq,
             MethodArg::NelderMead => Method::NelderMead,
             MethodArg::Pso => Method::Pso,
+        }
+    }
+}
+
+/// Where the search starts (`--start`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum StartArg {
+    /// At an experiment's direct estimate where there is one.
+    Estimate,
+    /// At the --preset/--params values.
+    Given,
+}
+
+impl From<StartArg> for StartChoice {
+    fn from(s: StartArg) -> StartChoice {
+        match s {
+            StartArg::Estimate => StartChoice::Estimate,
+            StartArg::Given => StartChoice::Given,
         }
     }
 }
@@ -243,6 +275,7 @@ impl Args {
             },
             checkpoint: self.checkpoint.clone(),
             resume: self.resume,
+            start: self.start.into(),
         })
     }
 
@@ -388,6 +421,10 @@ fn spinner(monitor: &Arc<Monitor>, quiet: bool) -> Option<Spinner> {
 }
 
 fn print_summary(r: &IdentifyResult) {
+    for e in &r.start_estimates {
+        let names: Vec<&str> = e.values.keys().map(String::as_str).collect();
+        println!("start of {}: {}", names.join(", "), e.method);
+    }
     println!("{}", parameter_table(r));
     for res in &r.residuals {
         println!(

@@ -104,6 +104,20 @@ impl Default for IdimSettings {
     }
 }
 
+impl IdimSettings {
+    /// The default design carried to a record sampled every `period_s`: the same
+    /// filters relative to the sampling frequency (the position filter at fs/10, the
+    /// decimation by 10, 200 samples trimmed), the 1 mm/s (1 mrad/s) speed threshold
+    /// unchanged. At 1 kHz, [`IdimSettings::default`].
+    pub fn for_sample_period(period_s: f64) -> Self {
+        let d = IdimSettings::default();
+        IdimSettings {
+            cutoff_hz: d.cutoff_hz * 1e-3 / period_s,
+            ..d
+        }
+    }
+}
+
 /// One estimated parameter.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Estimate {

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use super::solvers::Method;
 use super::space::Bound;
+use super::start::StartChoice;
 use crate::io::experiment_file::Experiment;
 use crate::model::Params;
 use crate::objectives::ObjectiveKind;
@@ -88,12 +89,15 @@ pub struct Config {
     pub checkpoint: Option<PathBuf>,
     /// Continue from the checkpoint.
     pub resume: bool,
+    /// Where the search starts: at an experiment's direct estimate (default) or the
+    /// given values.
+    pub start: StartChoice,
 }
 
 impl Config {
     /// `fit` from `experiments` on `base`, everything else at its default (default
     /// bounds and objectives, weights 1, the auto model, [`SearchOptions::default`],
-    /// no checkpoint).
+    /// no checkpoint, the start at a direct estimate where there is one).
     pub fn new(experiments: Vec<ExperimentSpec>, base: Params, fit: &[&str]) -> Config {
         Config {
             experiments,
@@ -104,6 +108,7 @@ impl Config {
             search: SearchOptions::default(),
             checkpoint: None,
             resume: false,
+            start: StartChoice::default(),
         }
     }
 

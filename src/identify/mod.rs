@@ -33,6 +33,7 @@ pub mod setup;
 pub mod solvers;
 pub mod space;
 pub mod stages;
+pub mod start;
 pub mod termination;
 pub mod uncertainty;
 pub mod warning;
@@ -45,6 +46,7 @@ pub use run::{identify, Identified};
 pub use search::{Settings, StartRecord};
 pub use solvers::Method;
 pub use space::{Bound, ParamSpace, SpaceError};
+pub use start::{StartChoice, StartEstimate};
 pub use termination::Termination;
 pub use warning::Warning;
 

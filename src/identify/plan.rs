@@ -5,7 +5,7 @@
 //! whether the result is checked on the nonlinear test. Pure: no simulation runs.
 
 use super::config::{Config, FidelityChoice};
-use super::search::Settings;
+use super::search::{Settings, SIMPLEX_STEP, SIMPLEX_STEP_NEAR};
 use super::setup::{self, Declared};
 use super::solvers::Method;
 use crate::objectives::{Fidelity, SetupError, Stage};
@@ -96,6 +96,7 @@ impl Plan {
                     FD_ROUGH
                 },
                 max_evaluations: o.max_evaluations,
+                simplex_step: SIMPLEX_STEP,
             },
         }];
         if nonlinear && declared.gain_curve {
@@ -109,6 +110,7 @@ impl Plan {
                     max_iters: 50,
                     fd_step: if rough { FD_ROUGH } else { FD_SMOOTH },
                     max_evaluations: o.max_evaluations,
+                    simplex_step: SIMPLEX_STEP,
                 },
             });
         }
@@ -120,6 +122,13 @@ impl Plan {
             check_nonlinear: config.fidelity == FidelityChoice::Auto && declared.gain_curve,
             uncertainty_step: uncertainty_step(rough, last),
         })
+    }
+
+    /// The plan of a search that starts at a direct estimate
+    /// ([`super::start`]): the first stage's Nelder–Mead simplex starts small.
+    pub fn from_estimate(mut self) -> Plan {
+        self.stages[0].settings.simplex_step = SIMPLEX_STEP_NEAR;
+        self
     }
 
     /// What the result says of the model: `linear`, `nonlinear`, `linear, then

@@ -8,6 +8,7 @@ use super::config::Config;
 use super::plan::Plan;
 use super::search::StartRecord;
 use super::space::ParamSpace;
+use super::start::StartEstimate;
 use super::termination::Termination;
 use super::uncertainty::Uncertainty;
 use super::warning::{Coded, Warning};
@@ -50,6 +51,9 @@ pub struct IdentifyResult {
     pub parameters: BTreeMap<String, f64>,
     /// Name → start value.
     pub initial: BTreeMap<String, f64>,
+    /// The direct estimates the start values came from (a servo trace's IDIM-LS).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub start_estimates: Vec<StartEstimate>,
     /// Name → [lo, hi].
     pub bounds: BTreeMap<String, [f64; 2]>,
     pub method: String,
@@ -88,6 +92,7 @@ impl IdentifyResult {
 /// What the run contributes to the result beside the assessment.
 pub struct Run {
     pub values: Vec<f64>,
+    pub start_estimates: Vec<StartEstimate>,
     pub starts: Vec<StartRecord>,
     pub evaluations: usize,
     pub wall_time_s: f64,
@@ -130,6 +135,7 @@ pub fn assemble(
             .collect(),
         parameters: named(&run.values),
         initial: named(&space.start),
+        start_estimates: run.start_estimates,
         bounds: space
             .names
             .iter()

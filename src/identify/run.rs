@@ -12,6 +12,7 @@ use super::problem::Monitor;
 use super::result::{assemble, IdentifyResult, Run};
 use super::space::ParamSpace;
 use super::stages;
+use super::start::start;
 use super::warning::Warning;
 use super::IdentifyError;
 use crate::model::Params;
@@ -28,6 +29,17 @@ pub struct Identified {
 pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, IdentifyError> {
     let clock = Instant::now();
     let plan = Plan::new(config)?;
+    let start = start(config, &plan.fit)?;
+    let (config, plan) = if start.estimates.is_empty() {
+        (config.clone(), plan)
+    } else {
+        let config = Config {
+            base: start.base.clone(),
+            ..config.clone()
+        };
+        (config, plan.from_estimate())
+    };
+    let config = &config;
     let space = ParamSpace::new(config.base.clone(), &plan.fit, &config.bounds)?;
     let checkpoint = Checkpointer::open(
         config.checkpoint.as_deref(),
@@ -44,13 +56,15 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
         )
     })?;
     let params = space.params(&best.values).map_err(ObjectiveError::from)?;
-    let mut warnings = ran.warnings.clone();
+    let mut warnings = start.warnings;
+    warnings.extend(ran.warnings.iter().cloned());
     if let Some((path, error)) = checkpoint.finish(monitor.evaluations()) {
         warnings.push(Warning::CheckpointNotWritten { path, error });
     }
     let assessment = assess(config, &plan, &space, &ran, &best, &params, monitor)?;
     let run = Run {
         values: best.values,
+        start_estimates: start.estimates,
         starts: ran.starts,
         evaluations: monitor.evaluations(),
         wall_time_s: clock.elapsed().as_secs_f64(),

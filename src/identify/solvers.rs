@@ -47,6 +47,8 @@ impl Method {
 #[derive(Clone, Copy, Debug)]
 pub struct Limits {
     pub max_iters: u64,
+    /// Nelder–Mead's initial simplex step, solver coordinates.
+    pub simplex_step: f64,
     /// Seed of the particle swarm.
     pub seed: u64,
 }
@@ -84,8 +86,9 @@ pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limit
             let mut simplex = vec![x0.clone()];
             for j in 0..n {
                 let mut v = x0.clone();
-                // A quarter of the solver coordinate's range, towards the middle.
-                v[j] += if x0[j] > 0.0 { -0.4 } else { 0.4 };
+                // Towards the middle of the solver coordinate's range.
+                let step = limits.simplex_step;
+                v[j] += if x0[j] > 0.0 { -step } else { step };
                 simplex.push(v);
             }
             let solver = NelderMead::new(simplex)

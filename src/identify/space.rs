@@ -11,6 +11,7 @@ use nalgebra::DVector;
 use rand::{rngs::StdRng, seq::SliceRandom, Rng, SeedableRng};
 
 use super::warning::Side;
+use crate::model::registry::Constraint;
 use crate::model::{ParamError, Params};
 
 /// The range a parameter may take.
@@ -67,7 +68,7 @@ pub enum SpaceError {
     },
     #[error("{name} has bounds but is not fitted")]
     NotFitted { name: String },
-    #[error("{name} starts at {value}, which has no default range (0.1×..10× the start needs a positive start): give it bounds")]
+    #[error("{name} starts at {value}, which has no default range (0.1×..10× the start needs a positive start, −10|v|..10|v| a signed one a non-zero start): give it bounds")]
     NoDefaultBound { name: String, value: f64 },
     #[error("{name} starts at {value}, outside its bounds {lo}..{hi}")]
     StartOutside {
@@ -94,7 +95,7 @@ const EDGE: f64 = 1e-6;
 
 impl ParamSpace {
     /// `names` fitted, starting from `base`; `bounds` given per name, the others
-    /// 0.1×..10× their start.
+    /// 0.1×..10× their start (a signed parameter, a load: −10|v|..10|v|).
     pub fn new(
         base: Params,
         names: &[String],
@@ -125,6 +126,7 @@ impl ParamSpace {
         }
         let mut out = Vec::new();
         for (name, &v) in specs.iter().zip(&start) {
+            let signed = crate::model::params::spec(name)?.constraint == Constraint::Finite;
             let b = match bounds.iter().find(|(n, _)| n == name) {
                 Some((_, b)) => {
                     let bad = |reason: &str| SpaceError::BadBound {
@@ -141,9 +143,14 @@ impl ParamSpace {
                     }
                     *b
                 }
-                None if v > 0.0 => Bound {
+                None if v > 0.0 && !signed => Bound {
                     lo: 0.1 * v,
                     hi: 10.0 * v,
+                },
+                // A load may take either sign: a linear range as wide on both sides.
+                None if v != 0.0 && signed => Bound {
+                    lo: -10.0 * v.abs(),
+                    hi: 10.0 * v.abs(),
                 },
                 None => {
                     return Err(SpaceError::NoDefaultBound {

@@ -59,6 +59,8 @@ pub enum Warning {
     },
     /// The standard errors of a fit to a closed-loop simulation are lower bounds.
     RoughCost,
+    /// An experiment's direct estimate of where to start was not used.
+    EstimateUnused { source: String, values: String },
     /// The nonlinear virtual test puts the resonances more than 1 % from the linear fit.
     NonlinearShift {
         source: String,
@@ -84,6 +86,7 @@ impl Warning {
             Warning::Singular { .. } => "singular",
             Warning::Correlated { .. } => "correlated",
             Warning::RoughCost => "rough_cost",
+            Warning::EstimateUnused { .. } => "estimate_unused",
             Warning::NonlinearShift { .. } => "nonlinear_shift",
         }
     }
@@ -145,6 +148,10 @@ impl fmt::Display for Warning {
             ),
             Warning::RoughCost => f.write_str(
                 "the standard errors of a fit to a closed-loop simulation (torque curve, unbalance test, servo trace) count the residuals' scatter only: the quantised encoders make the cost rough, and on clean data that roughness, not the scatter, sets the error (fm −1.8 % against a 0.1 % standard error on the worm fixture) — read them as lower bounds",
+            ),
+            Warning::EstimateUnused { source, values } => write!(
+                f,
+                "{source}: its direct estimate ({values}) is not a valid parameter set, so the search starts at the given values instead — check the record (too little motion, a wrong unit or sign)"
             ),
             Warning::NonlinearShift {
                 source,

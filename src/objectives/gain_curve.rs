@@ -31,6 +31,7 @@ pub static DEFINITION: Definition = Definition {
     determines: drive_stiffnesses,
     default_weight: |_, _| None,
     build: |source, fidelity| Ok(Box::new(GainCurve::of(source, fidelity, |_| true))),
+    first_estimate: None,
 };
 
 /// The measured gain within ±[`GRID_BAND`] of each resonance: the peaks' shape,
@@ -50,6 +51,7 @@ pub static NEAR_PEAKS: Definition = Definition {
         (kind == Kind::FrequencyResponse && stage == Stage::Correction).then_some(1.0)
     },
     build: near_peaks,
+    first_estimate: None,
 };
 
 fn near_peaks(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, SetupError> {

@@ -38,7 +38,7 @@ use crate::model::{ParamError, Params};
 use crate::sim::SimError;
 
 pub use joint::Joint;
-pub use registry::{Definition, ObjectiveKind, SetupError, Source, Stage};
+pub use registry::{Definition, Estimated, ObjectiveKind, SetupError, Source, Stage};
 
 /// What the model's frequency response is computed with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -44,6 +44,7 @@ pub static DEFINITION: Definition = Definition {
         (kind == Kind::FrequencyResponse && stage == Stage::Search).then_some(DEFAULT_HEIGHT_WEIGHT)
     },
     build,
+    first_estimate: None,
 };
 
 fn build(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, SetupError> {

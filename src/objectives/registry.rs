@@ -46,6 +46,19 @@ impl Source<'_> {
 /// How an objective is built for one experiment at a fidelity.
 pub type Build = fn(&Source<'_>, Fidelity) -> Result<Box<dyn Objective>, SetupError>;
 
+/// A direct estimate of some parameters from one experiment, made before any
+/// simulation (a servo trace's inverse-dynamics least squares): where the search
+/// starts. `None` when the experiment or the parameter set does not allow one.
+pub type FirstEstimate = fn(&Source<'_>, &Params) -> Result<Option<Estimated>, SetupError>;
+
+/// What a [`FirstEstimate`] gives: values of named parameters (SI) and how they were
+/// obtained, in words.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Estimated {
+    pub values: Vec<(String, f64)>,
+    pub method: String,
+}
+
 /// What an objective declares about itself.
 pub struct Definition {
     /// The name in results (`peak_amplitude`); `peak-amplitude` is accepted too.
@@ -64,6 +77,8 @@ pub struct Definition {
     pub default_weight: fn(kind: Kind, stage: Stage) -> Option<f64>,
     /// The objective of one experiment at a fidelity.
     pub build: Build,
+    /// Its direct estimate of where to start, if it has one.
+    pub first_estimate: Option<FirstEstimate>,
 }
 
 /// An objective by name: a handle on its [`Definition`] in the registry.
@@ -121,6 +136,19 @@ impl ObjectiveKind {
             });
         }
         (self.0.build)(source, fidelity)
+    }
+
+    /// Its direct estimate from one experiment, when it has one and the experiment and
+    /// `base` allow it.
+    pub fn first_estimate(
+        self,
+        source: &Source<'_>,
+        base: &Params,
+    ) -> Result<Option<Estimated>, SetupError> {
+        match self.0.first_estimate {
+            Some(f) if self.reads(source.kind()) => f(source, base),
+            _ => Ok(None),
+        }
     }
 
     /// The objectives an experiment of `kind` feeds by default at `stage`, with their

@@ -36,6 +36,7 @@ pub static DEFINITION: Definition = Definition {
         _ => None,
     },
     build,
+    first_estimate: None,
 };
 
 /// The drive stiffnesses: Kw, and Kg where there is a spur stage.

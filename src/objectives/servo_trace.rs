@@ -10,8 +10,9 @@
 //! relative weight of the two signals only: the standard errors come from the
 //! residuals' own scatter (σ² = Σr²/(m − n)), so the absolute scale cancels.
 
-use super::registry::{Definition, SetupError, Source};
+use super::registry::{Definition, Estimated, SetupError, Source};
 use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
+use crate::experiments::inverse_dynamics::IdimSettings;
 use crate::experiments::servo_trace::{replay, ServoTrace, TraceError};
 use crate::io::experiment_file::{Data, Kind};
 use crate::model::{Params, Topology};
@@ -32,6 +33,7 @@ pub static DEFINITION: Definition = Definition {
     determines,
     default_weight: |kind, _| (kind == Kind::ServoTrace).then_some(1.0),
     build,
+    first_estimate: Some(inverse_dynamics_start),
 };
 
 fn determines(p: &Params) -> Vec<&'static str> {
@@ -49,6 +51,44 @@ fn build(source: &Source<'_>, _: Fidelity) -> Result<Box<dyn Objective>, SetupEr
         });
     };
     Ok(Box::new(TraceResidual::new(ServoTrace::from_file(file))))
+}
+
+/// The IDIM-LS estimate of a direct-drive axis's rigid core (M, Fv, Fc, OF → Jt, Ct,
+/// ft, Tload = −OF), the filters carried to the record's sampling rate: where the
+/// output error starts. None for a geared or two-mass axis, whose recorded force
+/// moves more than one body.
+fn inverse_dynamics_start(
+    source: &Source<'_>,
+    base: &Params,
+) -> Result<Option<Estimated>, SetupError> {
+    let Data::ServoTrace(file) = &source.experiment.data else {
+        return Ok(None);
+    };
+    if base.topology != Topology::DirectDrive {
+        return Ok(None);
+    }
+    let trace = ServoTrace::from_file(file);
+    let data = |reason: String| SetupError::Data {
+        file: source.file.into(),
+        reason,
+    };
+    let period = trace.check().map_err(|e| data(e.to_string()))?;
+    let settings = IdimSettings::for_sample_period(period);
+    let fit = trace
+        .fit_friction(&settings)
+        .map_err(|e| data(format!("inverse-dynamics start: {e}")))?;
+    Ok(Some(Estimated {
+        values: vec![
+            ("Jt".into(), fit.inertia.value),
+            ("Ct".into(), fit.viscous.value),
+            ("ft".into(), fit.coulomb.value),
+            ("Tload".into(), -fit.offset.value),
+        ],
+        method: format!(
+            "IDIM-LS on {}: position low-passed at {:.0} Hz (Butterworth order {}, zero phase), decimated by {}, {} samples trimmed at each end, {} rows",
+            source.file, settings.cutoff_hz, settings.filter_order, settings.decimation, settings.trim, fit.rows
+        ),
+    }))
 }
 
 /// One scaled residual is this fraction of the recorded signal's RMS.

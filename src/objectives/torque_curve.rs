@@ -32,6 +32,7 @@ pub static DEFINITION: Definition = Definition {
     determines: |_| vec!["fm", "Cm"],
     default_weight: |kind, _| (kind == Kind::TorqueCurve).then_some(1.0),
     build,
+    first_estimate: None,
 };
 
 fn build(

@@ -45,6 +45,7 @@ pub static DEFINITION: Definition = Definition {
     determines: |_| vec!["ft"],
     default_weight: |kind, _| (kind == Kind::Unbalance).then_some(1.0),
     build,
+    first_estimate: None,
 };
 
 fn build(

@@ -42,7 +42,7 @@ pub fn report(
     let trace = ServoTrace::from_file(file);
     let sample_period_s = trace.check().with_context(|| source.clone())?;
     let fit = trace
-        .fit_friction(&IdimSettings::default())
+        .fit_friction(&IdimSettings::for_sample_period(sample_period_s))
         .with_context(|| format!("{source}: inverse dynamics"))?;
     let run = match &model {
         Some(p) => Some(replayed(p, &trace, file.axis, &source)?),
