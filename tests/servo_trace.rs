@@ -273,3 +273,83 @@ fn output_error_from_the_idim_estimate_reaches_the_published_model() {
         "{position_rms} m, {force_rms} N"
     );
 }
+
+/// The EMPS record as the force curve a user first tries (issue 11): time, force and
+/// carriage position in a `torque_curve` file, with an amplitude and a period.
+fn emps_as_force_curve() -> experiment_file::Experiment {
+    use rtid::io::experiment_file::{Kind, Manifest};
+    let trace = emps_record();
+    let mut manifest = Manifest::new(Kind::TorqueCurve);
+    manifest.conditions.amplitude_m = Some(0.1);
+    manifest.conditions.period_s = Some(6.0);
+    experiment_file::Experiment {
+        manifest,
+        data: Data::ForceCurve {
+            time_s: trace.time_s.clone(),
+            force_n: trace.force.clone(),
+            table_position_m: Some(trace.position.clone()),
+            extra: Default::default(),
+        },
+        path: PathBuf::from("emps_force_curve.json"),
+        data_path: None,
+    }
+}
+
+/// The evaluator's friction on a trajectory unlike the torque test's sine: the law
+/// fitted over the whole curve reads the published Fc (20.39 N) where the reversal
+/// windows, placed for a sine, read +39 % (the issue's 28.4 N).
+#[test]
+fn the_torque_curve_evaluator_reads_the_published_friction_on_the_emps_motion() {
+    let e = emps_as_force_curve();
+    let curve = torque_curve::from_data(&e.data).expect("a force curve");
+    let test = TorqueTest::from_conditions(&e.manifest.conditions);
+    assert_eq!(test.amplitude, 0.1, "a linear amplitude in m");
+    let report = torque_curve::evaluate(&curve, &test).unwrap();
+    let windows: Vec<f64> = report.reversals.iter().map(|r| r.friction_nm).collect();
+    eprintln!(
+        "EMPS as a force curve: Fc {:?} from {}; reversal windows {windows:.2?}",
+        report.friction_nm, report.friction_from
+    );
+    assert_eq!(report.friction_from, "inverse_dynamics");
+    let fc = report.friction_nm.unwrap();
+    assert!((fc / 20.3935 - 1.0).abs() < 0.02, "{fc}");
+}
+
+/// The torque-curve objective simulates its sine test: on a record of another motion
+/// it refuses, naming the recorded amplitude and period against the test's and
+/// pointing to the servo_trace kind, instead of walking to nonsense (the issue: fm =
+/// 3.9, Cm = 39 with a 63.6 N RMS error).
+#[test]
+fn the_torque_curve_objective_refuses_a_motion_that_is_not_its_test() {
+    use rtid::objectives::{Fidelity, ObjectiveKind, Source};
+    let e = emps_as_force_curve();
+    let source = Source {
+        file: "emps_force_curve.json",
+        experiment: &e,
+    };
+    let kind = ObjectiveKind::named("torque_curve").unwrap();
+    let Err(err) = kind.build(&source, Fidelity::Linear) else {
+        panic!("the EMPS motion was accepted as the torque test's sine");
+    };
+    let text = err.to_string();
+    eprintln!("{text}");
+    for part in [
+        "emps_force_curve.json",
+        "not the torque test's",
+        "100.0000 mm",
+        "6 s period",
+        "servo_trace",
+    ] {
+        assert!(text.contains(part), "`{part}` missing: {text}");
+    }
+    // The worm fixture's recorded angle is its test's sine: accepted.
+    let worm = experiment_file::read(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/worm-gear/torque_curve.json"),
+    )
+    .unwrap();
+    let source = Source {
+        file: "torque_curve.json",
+        experiment: &worm,
+    };
+    assert!(kind.build(&source, Fidelity::Linear).is_ok());
+}

@@ -23,7 +23,7 @@ file carries one.
 R↓i, Ri; for the axis the reversal B and mean reversal B̄, repeatability R↑, R↓, R, \
 systematic deviation E↑, E↓, E, mean deviation M, accuracy A↑, A↓, A. Plot: the paper's \
 Fig. 10.
-  torque_curve  RMS and peak motor torque, N·m, and the Coulomb friction torque at the motor: half the torque jump across each reversal of the table velocity (reversals from the table angle, or from the commanded motion's period when the file has no angle), averaged. Plot: torque over time (the paper's Fig. 9), and over table angle in FILE-vs-angle.svg when the file has the angle.
+  torque_curve  RMS and peak motor torque, N·m (force, N, on a linear axis), and the Coulomb friction at the motor: with the table angle (position) in the file, from the friction law F = M·a + Fv·v + Fc·sign(v) + OF fitted over the whole curve (IDIM-LS: any trajectory); without it, half the torque jump across each reversal of the commanded sine, averaged (the reversals and their jumps are listed either way). Plot: torque over time (the paper's Fig. 9), and over table angle in FILE-vs-angle.svg when the file has the angle.
   fluctuation   deviation θt − θm·ratio over table angle per direction (ratio: the \
 manifest's conditions.ratio, else Rg·Rw of the preset named in `mechanism`): mean, \
 peak-to-peak, the gap between the directions (lost motion), the power spectrum over \

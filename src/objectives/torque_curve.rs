@@ -13,8 +13,10 @@
 
 use super::registry::{Definition, SetupError, Source};
 use super::{Detail, Objective, ObjectiveError, Properties, Smoothness};
-use crate::experiments::torque_curve::{simulate_torque, TorqueTest};
-use crate::io::experiment_file::{Data, Kind};
+use crate::experiments::torque_curve::{
+    from_data, motion_difference, simulate_torque, MotionDifference, TorqueTest,
+};
+use crate::io::experiment_file::{Axis, Kind};
 use crate::model::Params;
 
 /// The torque-curve objective: a closed-loop simulation (rough); determines the motor's
@@ -40,22 +42,50 @@ fn build(
     _: crate::objectives::Fidelity,
 ) -> Result<Box<dyn Objective>, SetupError> {
     let exp = source.experiment;
-    let Data::TorqueCurve {
-        time_s,
-        motor_torque_nm,
-        ..
-    } = &exp.data
-    else {
+    let Some(curve) = from_data(&exp.data) else {
         return Err(SetupError::Unsupported {
             file: source.file.into(),
             kind: source.kind().name(),
         });
     };
+    let test = TorqueTest::from_conditions(&exp.manifest.conditions);
+    if let Some(d) = motion_difference(&curve, &test).filter(|d| d.relative_rms > MOTION_TOLERANCE)
+    {
+        return Err(SetupError::Data {
+            file: source.file.into(),
+            reason: other_motion(&d, &test, exp.data.axis().unwrap_or(Axis::Rotary)),
+        });
+    }
     Ok(Box::new(TorqueResidual::new(
-        time_s.clone(),
-        motor_torque_nm.clone(),
-        TorqueTest::from_conditions(&exp.manifest.conditions),
+        curve.time,
+        curve.motor_torque,
+        test,
     )))
+}
+
+/// The largest RMS difference, relative to the command's RMS, between a recorded
+/// position and the test's command for which the objective's simulation of the test
+/// is the recorded run: the servo's lag is simulated too (on the worm preset it makes
+/// ~8 %), a different amplitude, period or phase makes more.
+pub const MOTION_TOLERANCE: f64 = 0.25;
+
+/// Why a curve recorded along another motion cannot feed the objective, naming what
+/// differs.
+fn other_motion(d: &MotionDifference, test: &TorqueTest, axis: Axis) -> String {
+    let (scale, unit) = match axis {
+        Axis::Rotary => (1f64.to_degrees(), "°"),
+        Axis::Linear => (1e3, " mm"),
+    };
+    let period = d.recorded_period.map_or("no clear period".into(), |p| {
+        format!("a period of about {p:.3} s")
+    });
+    format!(
+        "the recorded motion is not the torque test's: amplitude {:.4}{unit} and {period}, against the test's {:.4}{unit} sine of {} s period (the manifest's conditions) — {:.0} % RMS apart. The torque-curve objective simulates that sine test; to identify from the motion the axis actually ran, write the record as a servo_trace experiment (time_s, reference_position_*, position_*, force_n or torque_nm: docs/experiment-files.md), which is replayed as recorded",
+        d.recorded_amplitude * scale,
+        test.amplitude * scale,
+        test.period,
+        100.0 * d.relative_rms
+    )
 }
 
 /// One scaled residual is this fraction of the measured RMS torque.

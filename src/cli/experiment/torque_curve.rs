@@ -9,7 +9,7 @@ use rtid::report::torque_curve as figures;
 use super::{check, Common};
 use crate::cli::progress;
 use rtid::experiments::torque_curve::{self, TorqueTest};
-use rtid::io::experiment_file::Experiment;
+use rtid::io::experiment_file::{Axis, Experiment};
 use rtid::model::{LoopMode, Params};
 
 pub const LONG_ABOUT: &str = "\
@@ -112,8 +112,11 @@ fn run_torque_curve(a: &Args, p: &Params, test: TorqueTest) -> anyhow::Result<()
 /// JSON); torque over time written to `plot`, and, when the file has the table angle,
 /// torque over angle beside it (`STEM-vs-angle.svg`).
 pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
-    let curve = torque_curve::from_data(&exp.data).expect("a torque-curve experiment");
+    let Some(curve) = torque_curve::from_data(&exp.data) else {
+        anyhow::bail!("{}: not a torque curve", exp.path.display());
+    };
     let test = TorqueTest::from_conditions(&exp.manifest.conditions);
+    let linear = exp.data.axis() == Some(Axis::Linear);
     let report = torque_curve::evaluate(&curve, &test)
         .map_err(|e| anyhow::anyhow!("{}: {e}", exp.path.display()))?;
     let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
@@ -125,23 +128,51 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
     }
     if json {
         let mut value = serde_json::to_value(&report)?;
+        if linear {
+            in_newtons(&mut value);
+        }
         value["kind"] = serde_json::json!("torque_curve");
         value["source"] = serde_json::json!(exp.path);
         println!("{}", serde_json::to_string_pretty(&value)?);
     } else {
+        let amplitude = if linear {
+            format!("{:.2} mm", test.amplitude * 1e3)
+        } else {
+            format!("{:.0}°", test.amplitude.to_degrees())
+        };
         println!(
-            "{}: torque curve, {:.0}° amplitude, {} s period",
+            "{}: {} curve, {amplitude} amplitude, {} s period",
             exp.path.display(),
-            test.amplitude.to_degrees(),
+            if linear { "force" } else { "torque" },
             test.period
         );
-        println!("{}", table(&report));
+        println!("{}", table(&report, if linear { "N" } else { "N·m" }));
     }
     Ok(())
 }
 
-/// A readable summary.
-fn table(report: &TorqueReport) -> String {
+/// A linear axis's report: the `_nm` keys (N·m) renamed `_n`, as its values are
+/// forces in N.
+fn in_newtons(value: &mut serde_json::Value) {
+    match value {
+        serde_json::Value::Object(map) => {
+            let old = std::mem::take(map);
+            for (k, mut v) in old {
+                in_newtons(&mut v);
+                let key = match k.strip_suffix("_nm") {
+                    Some(stem) => format!("{stem}_n"),
+                    None => k,
+                };
+                map.insert(key, v);
+            }
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(in_newtons),
+        _ => {}
+    }
+}
+
+/// A readable summary, efforts in `unit` (N·m, or N on a linear axis).
+fn table(report: &TorqueReport, unit: &str) -> String {
     let mut t = Table::new();
     t.load_preset(UTF8_FULL_CONDENSED);
     t.set_header(["torque curve", "value"]);
@@ -150,27 +181,39 @@ fn table(report: &TorqueReport) -> String {
         "duration, s".to_string(),
         format!("{:.3}", report.duration_s),
     ]);
+    t.add_row([format!("RMS, {unit}"), format!("{:.4}", report.rms_nm)]);
+    t.add_row([format!("peak, {unit}"), format!("{:.4}", report.peak_nm)]);
+    let how = match report.friction_from {
+        "inverse_dynamics" => "law over the whole curve",
+        _ => "jumps at the reversals",
+    };
     t.add_row([
-        "RMS torque, N·m".to_string(),
-        format!("{:.4}", report.rms_nm),
-    ]);
-    t.add_row([
-        "peak torque, N·m".to_string(),
-        format!("{:.4}", report.peak_nm),
-    ]);
-    t.add_row([
-        "Coulomb friction at the motor, N·m".to_string(),
+        format!("Coulomb friction at the motor, {unit} ({how})"),
         report
             .friction_nm
             .map_or("– (no usable reversal)".into(), |f| format!("{f:.4}")),
     ]);
+    if let Some(law) = &report.inverse_dynamics {
+        let rows = [
+            ("M (per unit of table acceleration)", law.inertia),
+            ("Fv (per unit of table speed)", law.viscous),
+            ("Fc", law.coulomb),
+            ("OF (offset)", law.offset),
+        ];
+        for (name, e) in rows {
+            t.add_row([
+                format!("law: {name}"),
+                format!("{:.4e} ± {:.1e}", e.value, e.std_error),
+            ]);
+        }
+    }
     let mut r = Table::new();
     r.load_preset(UTF8_FULL_CONDENSED);
     r.set_header([
         format!("reversal (from {})", report.reversals_from),
         "moving before".into(),
-        "jump N·m".into(),
-        "friction N·m".into(),
+        format!("jump {unit}"),
+        format!("friction {unit}"),
     ]);
     for v in &report.reversals {
         r.add_row([
