@@ -880,3 +880,59 @@ fn evaluate_replays_the_emps_servo_trace_on_its_published_model() {
     );
     assert_one_line_error(&out, &["emps_estimation.json", "linear axis", "rotary"]);
 }
+
+/// `rtid experiment servo-trace` writes a trace of the model that `evaluate` reads
+/// (here the worm preset: its IDIM-LS Coulomb friction is the friction at the motor,
+/// fm + fw·Rg + ft·Rg·Rw = 0.335 N·m); a malformed move is one clear error naming the
+/// option.
+#[test]
+fn experiment_servo_trace_writes_a_trace_of_the_model() {
+    let dir = tempdir();
+    let v = rtid_json(
+        &[
+            "experiment",
+            "servo-trace",
+            "--preset",
+            "worm-gear",
+            "--out",
+            "trace",
+            "--json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(v["kind"], "servo_trace");
+    assert_eq!(v["axis"], "rotary");
+    let fc = v["inverse_dynamics"]["coulomb"]["value"].as_f64().unwrap();
+    assert!((fc / 0.335 - 1.0).abs() < 0.02, "{fc}");
+    for f in ["servo_trace.json", "servo_trace.csv", "servo_trace.svg"] {
+        assert!(dir.path().join("trace").join(f).is_file(), "{f}");
+    }
+    let out = rtid(
+        &[
+            "experiment",
+            "servo-trace",
+            "--preset",
+            "worm-gear",
+            "--moves",
+            "0.1@fast",
+            "--out",
+            "bad",
+        ],
+        dir.path(),
+    );
+    assert_one_line_error(&out, &["--moves", "fast"]);
+    let out = rtid(
+        &[
+            "experiment",
+            "servo-trace",
+            "--preset",
+            "worm-gear",
+            "--moves",
+            "0.1@-2",
+            "--out",
+            "bad",
+        ],
+        dir.path(),
+    );
+    assert_one_line_error(&out, &["--moves", "-2"]);
+}

@@ -353,3 +353,42 @@ fn the_torque_curve_objective_refuses_a_motion_that_is_not_its_test() {
     };
     assert!(kind.build(&source, Fidelity::Linear).is_ok());
 }
+
+/// A virtual trace of the worm preset along trapezoidal moves — three speeds each way,
+/// unlike the torque test's sine — gives back the motor friction fm and Cm by the
+/// output error, as the EMPS record gives the direct drive's (issue 11), from a start
+/// 29 % and 20 % off. About 10 s.
+#[test]
+#[cfg_attr(
+    not(feature = "slow-tests"),
+    ignore = "slow tier (~10 s): --features slow-tests"
+)]
+fn output_error_on_a_virtual_worm_trace_gives_back_the_motor_friction() {
+    use rtid::identify::{identify, Config, ExperimentSpec, Monitor};
+    use rtid::io::experiment_file::{Axis, CommandUnit, Experiment, Kind, Manifest};
+    let truth = presets::load("worm-gear").unwrap();
+    let trace = virtual_trace(&truth, &TrapezoidalMoves::default(), None).unwrap();
+    let experiment = Experiment {
+        manifest: Manifest::new(Kind::ServoTrace),
+        data: Data::ServoTrace(trace.to_file(Axis::Rotary, CommandUnit::NewtonMetre)),
+        path: PathBuf::from("worm_trace.json"),
+        data_path: None,
+    };
+    let mut start = truth.clone();
+    start.fm *= 1.29;
+    start.cm *= 0.8;
+    let spec = ExperimentSpec::new("worm_trace.json", experiment);
+    let r = identify(&Config::new(vec![spec], start, &[]), &Monitor::default()).unwrap();
+    let got = &r.result.parameters;
+    eprintln!(
+        "worm trace: {got:?} (truth fm {}, Cm {})",
+        truth.fm, truth.cm
+    );
+    assert_eq!(got.len(), 2, "the default fit on a geared table: fm, Cm");
+    assert!((got["fm"] / truth.fm - 1.0).abs() < 0.01, "{got:?}");
+    assert!((got["Cm"] / truth.cm - 1.0).abs() < 0.01, "{got:?}");
+    assert!(
+        r.result.start_estimates.is_empty(),
+        "no IDIM start on a geared table"
+    );
+}

@@ -45,6 +45,9 @@ pub enum Test {
     /// Vertical table with an offset mass: the backlash step (paper §4.5, Fig. 14).
     #[command(long_about = unbalance::LONG_ABOUT)]
     Unbalance(unbalance::Args),
+    /// A servo trace of the model along point-to-point moves, as a drive's oscilloscope records it.
+    #[command(long_about = servo_trace::LONG_ABOUT)]
+    ServoTrace(servo_trace::Args),
 }
 
 /// Arguments every test takes.
@@ -103,5 +106,6 @@ pub fn run(test: Test) -> anyhow::Result<()> {
         Test::TorqueCurve(a) => torque_curve::run(a),
         Test::Fluctuation(a) => fluctuation::run(a),
         Test::Unbalance(a) => unbalance::run(a),
+        Test::ServoTrace(a) => servo_trace::run(a),
     }
 }

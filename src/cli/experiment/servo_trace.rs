@@ -1,5 +1,6 @@
-//! `rtid evaluate` of a servo trace: the friction law by inverse dynamics (IDIM-LS)
-//! and, with a model, the trace replayed and the benchmark's simulation error.
+//! `rtid experiment servo-trace` (a virtual trace of the model) and `rtid evaluate` of
+//! a servo trace: the friction law by inverse dynamics (IDIM-LS) and, with a model,
+//! the trace replayed and the benchmark's simulation error.
 
 use std::path::Path;
 
@@ -8,10 +9,126 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use serde::Serialize;
 
 use rtid::experiments::inverse_dynamics::{IdimFit, IdimSettings};
-use rtid::experiments::servo_trace::{replay, simulation_error, Misfit, ServoTrace};
-use rtid::io::experiment_file::{Axis, Data, Experiment};
+use rtid::experiments::servo_trace::{
+    replay, simulation_error, virtual_trace, Misfit, MoveTo, ServoTrace, TrapezoidalMoves,
+};
+use rtid::io::experiment_file::{Axis, CommandUnit, Data, Experiment, Kind, Manifest};
 use rtid::model::Params;
 use rtid::report::servo_trace as figures;
+
+use super::Common;
+use crate::cli::progress;
+
+pub const LONG_ABOUT: &str = "\
+A servo trace of the model (docs/experiment-files.md, servo_trace): the axis's own sampled \
+servo drives it from rest at 0 along point-to-point moves with trapezoidal velocity, and \
+the run is recorded at the control period as a drive's oscilloscope would record it — time, \
+the position reference, the loop encoder (quantised), the table encoder, the drive's torque \
+or force and the controller output. Units follow the axis: degrees and N·m on a rotary one, \
+metres and N on a linear one; --moves, --acceleration in rad or m (SI).
+
+The default moves go to +0.1 at 0.2 per s, to −0.1 at 0.1 per s and back to 0 at 0.05 per s, \
+accelerating at 2 per s², with 0.2 s dwells (5.5 s): three speeds in both directions, so \
+that a friction fit separates viscous from Coulomb friction. Such a trace is unlike the \
+torque test's sine: `rtid identify servo_trace.json` fits the axis to it (fm, Cm on a \
+geared table; Jt, Ct, ft, Tload on a direct drive, from their IDIM-LS estimate).
+
+Outputs, in --out DIR: servo_trace.json/.csv and the evaluation of `rtid evaluate`: the \
+friction law by inverse dynamics and plots of the following error and the force.
+
+Examples:
+  rtid experiment servo-trace --preset worm-gear --out runs/worm-trace
+  rtid experiment servo-trace --preset direct-drive --moves 0.5@1,-0.5@0.5,0@0.25 --out runs/dd";
+
+/// Arguments of `rtid experiment servo-trace`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub common: Common,
+    /// The moves in turn from 0, TARGET@SPEED each (rad and rad/s, or m and m/s):
+    /// 0.1@0.2,-0.1@0.1,0@0.05 by default.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "TARGET@SPEED",
+        allow_hyphen_values = true
+    )]
+    pub moves: Vec<String>,
+    /// Acceleration and deceleration of every move, rad/s² or m/s².
+    #[arg(long, value_name = "PER_S2", default_value_t = 2.0)]
+    pub acceleration: f64,
+    /// Rest before the first move and after each, s.
+    #[arg(long, value_name = "SECONDS", default_value_t = 0.2)]
+    pub dwell_s: f64,
+}
+
+/// Parses `TARGET@SPEED`.
+fn parse_move(s: &str) -> anyhow::Result<MoveTo> {
+    let (target, speed) = s
+        .split_once('@')
+        .with_context(|| format!("--moves {s}: expected TARGET@SPEED, e.g. 0.1@0.2"))?;
+    let num = |t: &str| -> anyhow::Result<f64> {
+        t.trim()
+            .parse()
+            .map_err(|_| anyhow::anyhow!("--moves {s}: `{t}` is not a number"))
+    };
+    Ok(MoveTo {
+        target: num(target)?,
+        speed: num(speed)?,
+    })
+}
+
+/// The moves the flags describe, checked before anything runs.
+fn moves(a: &Args) -> anyhow::Result<TrapezoidalMoves> {
+    let mut m = TrapezoidalMoves {
+        acceleration: a.acceleration,
+        dwell_s: a.dwell_s,
+        ..Default::default()
+    };
+    if !a.moves.is_empty() {
+        m.moves = a
+            .moves
+            .iter()
+            .map(|s| parse_move(s))
+            .collect::<anyhow::Result<_>>()?;
+    }
+    m.check()
+        .map_err(|e| anyhow::anyhow!("--moves/--acceleration/--dwell-s: {e}"))?;
+    Ok(m)
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let p = a.common.model.load()?;
+    let m = moves(&a)?;
+    a.common.create_out()?;
+    let bar = progress::bar(1, "servo trace", a.common.quiet);
+    let trace = virtual_trace(&p, &m, None)?;
+    bar.finish_and_clear();
+    let unit = match (p.controller.drive_gain == 1.0, p.axis) {
+        (false, _) => CommandUnit::Volt,
+        (true, Axis::Rotary) => CommandUnit::NewtonMetre,
+        (true, Axis::Linear) => CommandUnit::Newton,
+    };
+    let mut manifest = Manifest::new(Kind::ServoTrace);
+    manifest.mechanism = Some(p.name.clone());
+    manifest.notes = Some(format!(
+        "virtual servo trace by rtid: {} trapezoidal move(s) from rest at 0 (targets and speeds {}), acceleration {}, dwell {} s; sampled at the control period {} s, encoders quantised",
+        m.moves.len(),
+        m.moves
+            .iter()
+            .map(|x| format!("{}@{}", x.target, x.speed))
+            .collect::<Vec<_>>()
+            .join(", "),
+        m.acceleration,
+        m.dwell_s,
+        p.controller.tc
+    ));
+    let data = Data::ServoTrace(trace.to_file(p.axis, unit));
+    a.common
+        .write_and_report("servo_trace", manifest, &data, |exp, plot, json| {
+            report(exp, plot, json, None)
+        })
+}
 
 /// What the evaluation of a trace reports (SI units).
 #[derive(Serialize)]

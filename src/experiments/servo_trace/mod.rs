@@ -170,6 +170,28 @@ impl ServoTrace {
         }
     }
 
+    /// The trace as a `servo_trace` experiment file's data on `axis`, the controller
+    /// signals in `unit`.
+    pub fn to_file(&self, axis: file::Axis, unit: file::CommandUnit) -> file::ServoTrace {
+        let signal = |v: &Option<Vec<f64>>| {
+            v.as_ref().map(|values| file::Signal {
+                unit,
+                values: values.clone(),
+            })
+        };
+        file::ServoTrace {
+            axis,
+            time_s: self.time_s.clone(),
+            reference_position: self.reference.clone(),
+            position: self.position.clone(),
+            table_position: self.table_position.clone(),
+            effort: self.force.clone(),
+            controller_output: signal(&self.controller_output),
+            controller_added: signal(&self.controller_added),
+            extra: Default::default(),
+        }
+    }
+
     /// The friction law F = M·a + Fv·v + Fc·sign(v) + offset fitted to the loop
     /// encoder's position and the force (inverse_dynamics.rs).
     pub fn fit_friction(&self, settings: &IdimSettings) -> Result<IdimFit, FitError> {
