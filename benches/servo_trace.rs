@@ -4,18 +4,26 @@
 //! `servo_trace/idim` — the IDIM-LS friction law (filters, decimation, least squares);
 //! `servo_trace/replay` — one closed-loop replay of the whole record on the published
 //! model, the unit of cost of the output-error identification (`servo-trace`
-//! objective: ~110 replays from the IDIM estimate).
+//! objective: ~110 replays from the IDIM estimate);
+//! `servo_trace/identify` — the whole EMPS identification as `rtid identify` runs it:
+//! the IDIM-LS start, then the output-error search of Jt, Ct, ft, Tload (50
+//! Nelder–Mead iterations) and the uncertainty at the result.
 
 use std::path::PathBuf;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rtid::experiments::inverse_dynamics::IdimSettings;
 use rtid::experiments::servo_trace::{replay, ServoTrace};
+use rtid::identify::{identify, Config, ExperimentSpec, Monitor};
 use rtid::io::experiment_file::{self, Data};
 use rtid::model::Params;
 
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/real/emps")
+}
+
 fn emps() -> (ServoTrace, Params) {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/real/emps");
+    let root = root();
     let e = experiment_file::read(&root.join("emps_estimation.json")).unwrap();
     let Data::ServoTrace(file) = &e.data else {
         panic!("not a servo trace")
@@ -39,5 +47,22 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// The whole identification: seconds per run, so the fewest samples criterion allows.
+fn bench_identify(c: &mut Criterion) {
+    let (_, params) = emps();
+    let e = experiment_file::read(&root().join("emps_estimation.json")).unwrap();
+    let config = Config::new(
+        vec![ExperimentSpec::new("emps_estimation.json", e)],
+        params,
+        &[],
+    );
+    let mut group = c.benchmark_group("servo_trace");
+    group.sample_size(10);
+    group.bench_function("identify", |b| {
+        b.iter(|| identify(&config, &Monitor::default()).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_identify);
 criterion_main!(benches);

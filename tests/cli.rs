@@ -936,3 +936,37 @@ fn experiment_servo_trace_writes_a_trace_of_the_model() {
     );
     assert_one_line_error(&out, &["--moves", "-2"]);
 }
+
+/// ISO 230-2 on a linear axis, natively: a laser run written in mm and µm is
+/// evaluated in µm (targets in mm), in the table, the JSON and the plot.
+#[test]
+fn evaluate_reports_a_linear_positioning_run_in_micrometres() {
+    let dir = tempdir();
+    let mut csv = String::from("target_mm,direction,run,deviation_um\n");
+    for target in [0, 100, 200] {
+        for (run, up) in [(1, 1.0), (2, 1.2)] {
+            csv += &format!("{target},up,{run},{up}\n{target},down,{run},{}\n", -up);
+        }
+    }
+    std::fs::write(dir.path().join("laser.csv"), csv).unwrap();
+    std::fs::write(
+        dir.path().join("laser.json"),
+        r#"{"kind": "positioning", "data": "laser.csv", "mechanism": "X axis"}"#,
+    )
+    .unwrap();
+    let v = rtid_json(&["evaluate", "laser.json", "--json"], dir.path());
+    assert_eq!(v["unit"], "um");
+    let b = v["axis"]["B"].as_f64().unwrap();
+    assert!((b - 2.2).abs() < 1e-9, "B = x̄↑ − x̄↓ = 2.2 µm: {b}");
+    assert_eq!(v["targets"][2]["target_mm"], 200.0);
+    let text = rtid_ok(&["evaluate", "laser.json"], dir.path());
+    assert!(
+        text.contains("ISO 230-2 evaluation, µm") && text.contains("target mm"),
+        "{text}"
+    );
+    let svg = std::fs::read_to_string(dir.path().join("laser.svg")).unwrap();
+    assert!(
+        svg.contains("µm") && svg.contains("mm"),
+        "plot axes in mm and µm"
+    );
+}

@@ -74,6 +74,51 @@ use serde::{Deserialize, Serialize};
 /// Arc-seconds per radian, 180·3600/π.
 pub const ARCSEC_PER_RAD: f64 = 648_000.0 / std::f64::consts::PI;
 
+/// The units a report uses, as the field does: targets in degrees and deviations in
+/// arc-seconds on a rotary axis, millimetres and micrometres on a linear one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReportUnits {
+    /// Report unit per SI unit (rad or m) of a target.
+    pub target_per_si: f64,
+    /// `°` or `mm`.
+    pub target: &'static str,
+    /// The column-name suffix of a target (`deg`, `mm`).
+    pub target_key: &'static str,
+    /// Report unit per SI unit of a deviation.
+    pub deviation_per_si: f64,
+    /// `″` or `µm`.
+    pub deviation: &'static str,
+    /// The column-name suffix of a deviation (`arcsec`, `um`).
+    pub deviation_key: &'static str,
+}
+
+impl ReportUnits {
+    pub const ROTARY: ReportUnits = ReportUnits {
+        target_per_si: 180.0 / std::f64::consts::PI,
+        target: "°",
+        target_key: "deg",
+        deviation_per_si: ARCSEC_PER_RAD,
+        deviation: "″",
+        deviation_key: "arcsec",
+    };
+    pub const LINEAR: ReportUnits = ReportUnits {
+        target_per_si: 1e3,
+        target: "mm",
+        target_key: "mm",
+        deviation_per_si: 1e6,
+        deviation: "µm",
+        deviation_key: "um",
+    };
+
+    /// The units of an axis.
+    pub fn of(axis: crate::model::Axis) -> ReportUnits {
+        match axis {
+            crate::model::Axis::Rotary => ReportUnits::ROTARY,
+            crate::model::Axis::Linear => ReportUnits::LINEAR,
+        }
+    }
+}
+
 /// Targets closer than this (rad) are one target position (about 2e-4″).
 pub const SAME_TARGET_RAD: f64 = 1e-9;
 
@@ -126,7 +171,12 @@ impl TargetStats {
     /// The same statistics with every deviation-valued field in arc-seconds; `target`
     /// stays in rad and the counts are unchanged.
     pub fn in_arcsec(&self) -> TargetStats {
-        let k = ARCSEC_PER_RAD;
+        self.scaled(ARCSEC_PER_RAD)
+    }
+
+    /// The same statistics with every deviation-valued field times `k` (a report's
+    /// unit per SI unit: [`ReportUnits::deviation_per_si`]); `target` unchanged.
+    pub fn scaled(&self, k: f64) -> TargetStats {
         TargetStats {
             mean_up: self.mean_up * k,
             mean_down: self.mean_down * k,
@@ -186,7 +236,11 @@ pub struct AxisStats {
 impl AxisStats {
     /// The same values in arc-seconds.
     pub fn in_arcsec(&self) -> AxisStats {
-        let k = ARCSEC_PER_RAD;
+        self.scaled(ARCSEC_PER_RAD)
+    }
+
+    /// The same values times `k` (a report's unit per SI unit).
+    pub fn scaled(&self, k: f64) -> AxisStats {
         AxisStats {
             b: self.b * k,
             b_mean: self.b_mean * k,

@@ -151,25 +151,33 @@ pub fn to_data(measurements: &[Measurement]) -> Data {
     }
 }
 
-/// The readings of a positioning experiment file (`None` for another kind).
+/// The readings of a positioning experiment file (`None` for another kind): rad on
+/// a rotary axis, m on a linear one.
 pub fn from_data(data: &Data) -> Option<Vec<Measurement>> {
-    let Data::Positioning {
-        target_rad,
-        direction,
-        run,
-        deviation_rad,
-        ..
-    } = data
-    else {
-        return None;
+    let (target, direction, run, deviation) = match data {
+        Data::Positioning {
+            target_rad,
+            direction,
+            run,
+            deviation_rad,
+            ..
+        } => (target_rad, direction, run, deviation_rad),
+        Data::LinearPositioning {
+            target_m,
+            direction,
+            run,
+            deviation_m,
+            ..
+        } => (target_m, direction, run, deviation_m),
+        _ => return None,
     };
     Some(
-        (0..target_rad.len())
+        (0..target.len())
             .map(|i| Measurement {
-                target: target_rad[i],
+                target: target[i],
                 direction: direction[i],
                 run: run[i],
-                deviation: deviation_rad[i],
+                deviation: deviation[i],
             })
             .collect(),
     )

@@ -1,19 +1,29 @@
 //! Figures of the positioning test (ISO 230-2; paper Fig. 10).
 
 use super::figure::{Figure, Series, Style};
-use crate::experiments::iso230::{Iso230Report, TargetStats, ARCSEC_PER_RAD};
+use crate::experiments::iso230::{Iso230Report, ReportUnits, TargetStats};
 
-/// The paper's Fig. 10: x̄↑, x̄↓, their ±2s bands and x̄ over the target angle, in
-/// arc-seconds.
-pub fn deviations(report: &Iso230Report, title: &str) -> Figure {
+/// The paper's Fig. 10: x̄↑, x̄↓, their ±2s bands and x̄ over the target, in the
+/// axis's report units (degrees and arc-seconds, or mm and µm).
+pub fn deviations(report: &Iso230Report, title: &str, units: ReportUnits) -> Figure {
     let pts = |f: &dyn Fn(&TargetStats) -> f64| -> Vec<(f64, f64)> {
         report
             .targets
             .iter()
-            .map(|s| (s.target.to_degrees(), f(s) * ARCSEC_PER_RAD))
+            .map(|s| {
+                (
+                    s.target * units.target_per_si,
+                    f(s) * units.deviation_per_si,
+                )
+            })
             .collect()
     };
-    Figure::new(title, "target angle, deg", "positional deviation, arc-sec")
+    let (x, y) = if units == ReportUnits::ROTARY {
+        ("target angle, deg", "positional deviation, arc-sec")
+    } else {
+        ("target position, mm", "positional deviation, µm")
+    };
+    Figure::new(title, x, y)
         .with(Series::new("x̄↑", pts(&|s| s.mean_up), Style::Line))
         .with(Series::new(
             "x̄↑ ± 2s↑",

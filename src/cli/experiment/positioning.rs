@@ -8,6 +8,7 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use super::{check, Common};
 use crate::cli::progress;
+use rtid::experiments::iso230::ReportUnits;
 use rtid::experiments::{iso230, positioning};
 use rtid::io::experiment_file::Experiment;
 use rtid::model::{LoopMode, Params};
@@ -57,6 +58,12 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
+    if p.axis == rtid::model::Axis::Linear {
+        bail!(
+            "{}: a linear axis — the virtual ISO 230-2 test turns a table through targets in degrees and is rotary only; a measured positioning file of a linear axis (target_mm, deviation_um…) is evaluated in µm by `rtid evaluate`",
+            p.name
+        );
+    }
     let test = test(&a)?;
     a.common.create_out()?;
     run_positioning(&a, &p, test)
@@ -100,65 +107,77 @@ fn run_positioning(a: &Args, p: &Params, test: positioning::PositioningTest) -> 
 }
 
 /// Evaluates a positioning experiment: ISO 230-2 statistics printed (table or
-/// JSON), and the Fig. 10 plot written to `plot`.
+/// JSON) in the axis's units (arc-seconds, or µm on a linear axis), and the Fig. 10
+/// plot written to `plot`.
 pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
-    let readings = positioning::from_data(&exp.data).expect("a positioning experiment");
+    let Some(readings) = positioning::from_data(&exp.data) else {
+        bail!("{}: not a positioning experiment", exp.path.display());
+    };
+    let units = ReportUnits::of(exp.data.axis().unwrap_or_default());
     let report =
         iso230::evaluate(&readings).map_err(|e| anyhow::anyhow!("{}: {e}", exp.path.display()))?;
     let title = format!(
         "{}: ISO 230-2 positioning",
         exp.manifest.mechanism.as_deref().unwrap_or("table")
     );
-    rtid::report::positioning::deviations(&report, &title).write(plot)?;
-    print_positioning(&report, json, &exp.path)
+    rtid::report::positioning::deviations(&report, &title, units).write(plot)?;
+    print_positioning(&report, units, json, &exp.path)
 }
 
-/// Prints an ISO 230-2 evaluation, as a table or JSON.
+/// Prints an ISO 230-2 evaluation, as a table or JSON, in `u`.
 fn print_positioning(
     report: &iso230::Iso230Report,
+    u: ReportUnits,
     json: bool,
     source: &Path,
 ) -> anyhow::Result<()> {
+    let k = u.deviation_per_si;
     if json {
         let value = serde_json::json!({
             "kind": "positioning",
             "source": source,
-            "unit": "arcsec",
-            "axis": report.axis.in_arcsec(),
+            "unit": u.deviation_key,
+            "axis": report.axis.scaled(k),
             "targets": report.targets.iter().map(|t| {
-                let mut v = serde_json::to_value(t.in_arcsec()).expect("serialises");
-                v["target_deg"] = serde_json::json!(t.target.to_degrees());
+                let mut v = serde_json::to_value(t.scaled(k)).expect("serialises");
+                v[format!("target_{}", u.target_key)] = serde_json::json!(t.target * u.target_per_si);
                 v
             }).collect::<Vec<_>>(),
         });
         println!("{}", serde_json::to_string_pretty(&value)?);
     } else {
-        println!("{}: ISO 230-2 evaluation, arc-seconds", source.display());
-        println!("{}", table(report));
+        let unit = if u == ReportUnits::ROTARY {
+            "arc-seconds"
+        } else {
+            "µm"
+        };
+        println!("{}: ISO 230-2 evaluation, {unit}", source.display());
+        println!("{}", table(report, u));
     }
     Ok(())
 }
 
-/// A readable ISO 230-2 summary in arc-seconds.
-fn table(report: &iso230::Iso230Report) -> String {
+/// A readable ISO 230-2 summary in `u`.
+fn table(report: &iso230::Iso230Report, u: ReportUnits) -> String {
+    let d = u.deviation;
     let mut t = Table::new();
     t.load_preset(UTF8_FULL_CONDENSED);
     t.set_header([
-        "target °",
-        "x̄↑ ″",
-        "x̄↓ ″",
-        "s↑ ″",
-        "s↓ ″",
-        "Bi ″",
-        "R↑i ″",
-        "R↓i ″",
-        "Ri ″",
+        format!("target {}", u.target),
+        format!("x̄↑ {d}"),
+        format!("x̄↓ {d}"),
+        format!("s↑ {d}"),
+        format!("s↓ {d}"),
+        format!("Bi {d}"),
+        format!("R↑i {d}"),
+        format!("R↓i {d}"),
+        format!("Ri {d}"),
     ]);
     for s in &report.targets {
-        let a = s.in_arcsec();
+        let a = s.scaled(u.deviation_per_si);
         t.add_row(
             [
-                s.target.to_degrees(),
+                s.target * u.target_per_si,
                 a.mean_up,
                 a.mean_down,
                 a.s_up,
@@ -171,39 +190,44 @@ fn table(report: &iso230::Iso230Report) -> String {
             .map(|v| format!("{v:.2}")),
         );
     }
-    let x = report.axis.in_arcsec();
+    format!(
+        "{t}\n{}",
+        axis_table(&report.axis.scaled(u.deviation_per_si), d)
+    )
+}
+
+/// The axis values, already in the unit `d`.
+fn axis_table(x: &iso230::AxisStats, d: &str) -> Table {
     let mut axis = Table::new();
     axis.load_preset(UTF8_FULL_CONDENSED);
-    axis.set_header(["axis, arc-sec", "↑", "↓", "bidirectional"]);
+    axis.set_header([
+        format!("axis, {d}"),
+        "↑".into(),
+        "↓".into(),
+        "bidirectional".into(),
+    ]);
+    let both = |name: &str, up: f64, down: f64, bi: f64| {
+        [
+            name.to_string(),
+            format!("{up:.2}"),
+            format!("{down:.2}"),
+            format!("{bi:.2}"),
+        ]
+    };
     axis.add_row([
         "reversal B / mean B̄".to_string(),
         "".into(),
         "".into(),
         format!("{:.2} / {:.2}", x.b, x.b_mean),
     ]);
-    axis.add_row([
-        "repeatability R".to_string(),
-        format!("{:.2}", x.r_up),
-        format!("{:.2}", x.r_down),
-        format!("{:.2}", x.r),
-    ]);
-    axis.add_row([
-        "systematic deviation E".to_string(),
-        format!("{:.2}", x.e_up),
-        format!("{:.2}", x.e_down),
-        format!("{:.2}", x.e),
-    ]);
+    axis.add_row(both("repeatability R", x.r_up, x.r_down, x.r));
+    axis.add_row(both("systematic deviation E", x.e_up, x.e_down, x.e));
     axis.add_row([
         "mean deviation M".to_string(),
         "".into(),
         "".into(),
         format!("{:.2}", x.m),
     ]);
-    axis.add_row([
-        "accuracy A".to_string(),
-        format!("{:.2}", x.a_up),
-        format!("{:.2}", x.a_down),
-        format!("{:.2}", x.a),
-    ]);
-    format!("{t}\n{axis}")
+    axis.add_row(both("accuracy A", x.a_up, x.a_down, x.a));
+    axis
 }
