@@ -970,3 +970,82 @@ fn evaluate_reports_a_linear_positioning_run_in_micrometres() {
         "plot axes in mm and µm"
     );
 }
+
+/// The virtual tests on a linear axis (the EMPS carriage), natively: the ISO 230-2 run
+/// written in mm and µm and reported in µm, the force curve in N and m with the
+/// carriage's Coulomb friction (ft = 20.39 N) read back; a rotary option on it is one
+/// clear error naming the option.
+#[test]
+fn the_virtual_tests_run_on_a_linear_axis_in_its_units() {
+    let dir = tempdir();
+    let axis = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/real/emps/axis.json");
+    let axis = axis.to_str().unwrap();
+    let v = rtid_json(
+        &[
+            "experiment",
+            "positioning",
+            "--params",
+            axis,
+            "--travel-mm",
+            "100",
+            "--target-step-mm",
+            "50",
+            "--runs",
+            "2",
+            "--out",
+            "iso",
+            "--json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(v["unit"], "um");
+    let targets: Vec<f64> = v["targets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["target_mm"].as_f64().unwrap())
+        .collect();
+    assert_eq!(targets, [0.0, 50.0, 100.0]);
+    let csv = std::fs::read_to_string(dir.path().join("iso/positioning.csv")).unwrap();
+    assert!(
+        csv.contains("target_mm") && csv.contains("deviation_um"),
+        "{csv}"
+    );
+    let v = rtid_json(
+        &[
+            "experiment",
+            "torque-curve",
+            "--params",
+            axis,
+            "--amplitude-mm",
+            "50",
+            "--periods",
+            "1",
+            "--out",
+            "force",
+            "--json",
+        ],
+        dir.path(),
+    );
+    let fc = v["friction_n"].as_f64().unwrap();
+    assert!((fc / 20.3935 - 1.0).abs() < 0.03, "Fc = {fc} N");
+    let csv = std::fs::read_to_string(dir.path().join("force/torque_curve.csv")).unwrap();
+    assert!(
+        csv.lines().nth(1).unwrap().contains("force_n"),
+        "{csv:.200}"
+    );
+    let out = rtid(
+        &[
+            "experiment",
+            "positioning",
+            "--params",
+            axis,
+            "--target-step-deg",
+            "30",
+            "--out",
+            "bad",
+        ],
+        dir.path(),
+    );
+    assert_one_line_error(&out, &["--target-step-deg", "linear"]);
+}

@@ -34,7 +34,7 @@ fn write_folder(dir: &Path, name: &str) {
     experiment_file::write(
         &dir.join("positioning.json"),
         &m,
-        &positioning::to_data(&readings),
+        &positioning::to_data(&readings, p.axis),
     )
     .unwrap();
 
@@ -48,7 +48,7 @@ fn write_folder(dir: &Path, name: &str) {
     experiment_file::write(
         &dir.join("torque_curve.json"),
         &m,
-        &torque_curve::to_data(&curve),
+        &torque_curve::to_data(&curve, p.axis),
     )
     .unwrap();
 

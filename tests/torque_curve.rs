@@ -150,7 +150,7 @@ fn simulate_torque_reproduces_the_recorded_file() {
     let mut manifest = torque_curve::manifest(&p, &test);
     manifest.data = Some("torque_curve.csv".into());
     let curve = run(&p, &test, |_, _| {}).unwrap();
-    experiment_file::write(&path, &manifest, &torque_curve::to_data(&curve)).unwrap();
+    experiment_file::write(&path, &manifest, &torque_curve::to_data(&curve, p.axis)).unwrap();
     let exp = experiment_file::read(&path).unwrap();
     let file = torque_curve::from_data(&exp.data).unwrap();
     // The conditions as the identification will see them: from the manifest.

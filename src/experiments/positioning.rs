@@ -16,7 +16,7 @@ use crate::controller::quantise;
 use crate::input::Move;
 use crate::io::experiment_file::{Data, Kind, Manifest};
 use crate::model::idx::THETA_T;
-use crate::model::params::{LoopMode, Params};
+use crate::model::params::{Axis, LoopMode, Params};
 use crate::model::rest::{rest_state, Preload};
 use crate::recorder::NullRecorder;
 use crate::sim::{SimError, Simulation};
@@ -140,14 +140,28 @@ pub fn run(
     Ok(out)
 }
 
-/// The experiment-file form of a positioning test's readings.
-pub fn to_data(measurements: &[Measurement]) -> Data {
-    Data::Positioning {
-        target_rad: measurements.iter().map(|m| m.target).collect(),
-        direction: measurements.iter().map(|m| m.direction).collect(),
-        run: measurements.iter().map(|m| m.run).collect(),
-        deviation_rad: measurements.iter().map(|m| m.deviation).collect(),
-        extra: Default::default(),
+/// The experiment-file form of a positioning test's readings on `axis` (angles in
+/// rad, or lengths in m).
+pub fn to_data(measurements: &[Measurement], axis: Axis) -> Data {
+    let target = measurements.iter().map(|m| m.target).collect();
+    let direction = measurements.iter().map(|m| m.direction).collect();
+    let run = measurements.iter().map(|m| m.run).collect();
+    let deviation = measurements.iter().map(|m| m.deviation).collect();
+    match axis {
+        Axis::Rotary => Data::Positioning {
+            target_rad: target,
+            direction,
+            run,
+            deviation_rad: deviation,
+            extra: Default::default(),
+        },
+        Axis::Linear => Data::LinearPositioning {
+            target_m: target,
+            direction,
+            run,
+            deviation_m: deviation,
+            extra: Default::default(),
+        },
     }
 }
 
@@ -189,20 +203,37 @@ pub fn manifest(params: &Params, test: &PositioningTest) -> Manifest {
     m.mechanism = Some(params.name.clone());
     m.conditions.loop_mode = Some(test.loop_mode);
     m.conditions.dwell_s = Some(test.dwell);
-    m.conditions.speed_deg_per_min = Some(test.speed.to_degrees() * 60.0);
+    let resolution = params.controller.table_encoder_resolution;
+    let (encoder, noise) = match params.axis {
+        Axis::Rotary => {
+            m.conditions.speed_deg_per_min = Some(test.speed.to_degrees() * 60.0);
+            (
+                format!("{:.6}°", resolution.to_degrees()),
+                format!("{:.3}″", test.noise * ARCSEC_PER_RAD),
+            )
+        }
+        Axis::Linear => (
+            if resolution > 0.0 {
+                format!("{:.4} µm", resolution * 1e6)
+            } else {
+                "exact (no quantum)".into()
+            },
+            format!("{:.3} µm", test.noise * 1e6),
+        ),
+    };
     m.notes = Some(format!(
-        "virtual ISO 230-2 test by rtid: {} targets, {} runs each way, table encoder {:.6}° {}",
+        "virtual ISO 230-2 test by rtid: {} targets, {} runs each way, table encoder {encoder} {}{}",
         test.targets.len(),
         test.runs,
-        params.controller.table_encoder_resolution.to_degrees(),
         if test.noise > 0.0 {
-            format!(
-                "plus {:.3}″ rms noise (seed {})",
-                test.noise * ARCSEC_PER_RAD,
-                test.seed
-            )
+            format!("plus {noise} rms noise (seed {})", test.seed)
         } else {
             "without added noise".into()
+        },
+        if params.axis == Axis::Linear {
+            format!(", speed {:.0} mm/min", test.speed * 6e4)
+        } else {
+            String::new()
         }
     ));
     m

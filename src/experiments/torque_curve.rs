@@ -26,7 +26,7 @@ use crate::experiments::inverse_dynamics::{of_torque_curve, IdimFit, IdimSetting
 use crate::input::{Harmonic, Trajectory};
 use crate::io::experiment_file::{Conditions, Data, Kind, Manifest};
 use crate::model::idx::THETA_T;
-use crate::model::params::{LoopMode, Params};
+use crate::model::params::{Axis, LoopMode, Params};
 use crate::model::NSTATE;
 use crate::recorder::{NullRecorder, Recorder};
 use crate::sim::{SimError, Simulation};
@@ -242,13 +242,27 @@ fn interpolate(x: &[f64], y: &[f64], t: f64) -> f64 {
     y[i - 1] + (y[i] - y[i - 1]) * (t - x0) / (x1 - x0)
 }
 
-/// The experiment-file form of a recorded curve.
-pub fn to_data(curve: &TorqueCurve) -> Data {
-    Data::TorqueCurve {
-        time_s: curve.time.clone(),
-        motor_torque_nm: curve.motor_torque.clone(),
-        table_angle_rad: Some(curve.table_angle.clone()),
-        extra: Default::default(),
+/// The experiment-file form of a recorded curve on `axis` (torque and angle, or
+/// force and position).
+pub fn to_data(curve: &TorqueCurve, axis: Axis) -> Data {
+    let (time_s, effort, position) = (
+        curve.time.clone(),
+        curve.motor_torque.clone(),
+        Some(curve.table_angle.clone()),
+    );
+    match axis {
+        Axis::Rotary => Data::TorqueCurve {
+            time_s,
+            motor_torque_nm: effort,
+            table_angle_rad: position,
+            extra: Default::default(),
+        },
+        Axis::Linear => Data::ForceCurve {
+            time_s,
+            force_n: effort,
+            table_position_m: position,
+            extra: Default::default(),
+        },
     }
 }
 
@@ -282,7 +296,10 @@ pub fn from_data(data: &Data) -> Option<TorqueCurve> {
 pub fn manifest(params: &Params, test: &TorqueTest) -> Manifest {
     let mut m = Manifest::new(Kind::TorqueCurve);
     m.mechanism = Some(params.name.clone());
-    m.conditions.amplitude_deg = Some(test.amplitude.to_degrees());
+    match params.axis {
+        Axis::Rotary => m.conditions.amplitude_deg = Some(test.amplitude.to_degrees()),
+        Axis::Linear => m.conditions.amplitude_m = Some(test.amplitude),
+    }
     m.conditions.period_s = Some(test.period);
     m.conditions.loop_mode = Some(test.loop_mode);
     m.notes = Some(format!(

@@ -11,7 +11,7 @@ use crate::cli::progress;
 use rtid::experiments::iso230::ReportUnits;
 use rtid::experiments::{iso230, positioning};
 use rtid::io::experiment_file::Experiment;
-use rtid::model::{LoopMode, Params};
+use rtid::model::{Axis, LoopMode, Params};
 
 pub const LONG_ABOUT: &str = "\
 ISO 230-2 positioning accuracy and repeatability (paper §4.3): the servo, in semi-closed \
@@ -20,9 +20,15 @@ with 1 s dwell; the table encoder (0.0001°) reads each stop. Writes positioning
 (deviation_arcsec per reading) and positioning.svg (the paper's Fig. 10), and prints the \
 ISO 230-2 statistics in arc-seconds.
 
-Example:
+On a linear axis (a parameter file with \"axis\": \"linear\") the carriage approaches \
+targets every 50 mm over 500 mm at 3000 mm/min (--target-step-mm, --travel-mm, \
+--speed-mm-per-min, --noise-um), with 5 mm of overrun; the file is written in mm and µm \
+(target_mm, deviation_um) and the statistics are printed in µm.
+
+Examples:
   rtid experiment positioning --preset worm-gear --out runs/worm
-  rtid experiment positioning --preset worm-gear --noise-arcsec 0.5 --seed 7 --out runs/noisy";
+  rtid experiment positioning --preset worm-gear --noise-arcsec 0.5 --seed 7 --out runs/noisy
+  rtid experiment positioning --params fixtures/real/emps/axis.json --travel-mm 200 --out runs/emps";
 
 /// Arguments of `rtid experiment positioning`.
 #[derive(Debug, clap::Args)]
@@ -39,18 +45,30 @@ pub struct Args {
     /// Approaches of each target from each side.
     #[arg(long, default_value_t = 5)]
     pub runs: u32,
-    /// Spacing of the targets from 0° to 360°, degrees.
-    #[arg(long, value_name = "DEG", default_value_t = 30.0)]
-    pub target_step_deg: f64,
+    /// Rotary axis: spacing of the targets from 0° to 360°, degrees [default: 30].
+    #[arg(long, value_name = "DEG")]
+    pub target_step_deg: Option<f64>,
+    /// Rotary axis: table speed of the moves, degrees per minute [default: 3600].
+    #[arg(long, value_name = "DEG_PER_MIN")]
+    pub speed_deg_per_min: Option<f64>,
+    /// Rotary axis: rms of Gaussian noise added to each reading, arc-seconds [default: 0].
+    #[arg(long, value_name = "ARCSEC")]
+    pub noise_arcsec: Option<f64>,
+    /// Linear axis: spacing of the targets from 0 to --travel-mm, mm [default: 50].
+    #[arg(long, value_name = "MM")]
+    pub target_step_mm: Option<f64>,
+    /// Linear axis: the travel measured, from 0, mm [default: 500].
+    #[arg(long, value_name = "MM")]
+    pub travel_mm: Option<f64>,
+    /// Linear axis: carriage speed of the moves, mm per minute [default: 3000].
+    #[arg(long, value_name = "MM_PER_MIN")]
+    pub speed_mm_per_min: Option<f64>,
+    /// Linear axis: rms of Gaussian noise added to each reading, µm [default: 0].
+    #[arg(long, value_name = "UM")]
+    pub noise_um: Option<f64>,
     /// Dwell before each reading, s.
     #[arg(long, value_name = "SECONDS", default_value_t = 1.0)]
     pub dwell_s: f64,
-    /// Table speed of the moves, degrees per minute.
-    #[arg(long, value_name = "DEG_PER_MIN", default_value_t = 3600.0)]
-    pub speed_deg_per_min: f64,
-    /// Rms of Gaussian noise added to each reading, arc-seconds.
-    #[arg(long, value_name = "ARCSEC", default_value_t = 0.0)]
-    pub noise_arcsec: f64,
     /// Seed of the measurement noise.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -58,40 +76,87 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
-    if p.axis == rtid::model::Axis::Linear {
-        bail!(
-            "{}: a linear axis — the virtual ISO 230-2 test turns a table through targets in degrees and is rotary only; a measured positioning file of a linear axis (target_mm, deviation_um…) is evaluated in µm by `rtid evaluate`",
-            p.name
-        );
-    }
-    let test = test(&a)?;
+    let test = test(&a, p.axis)?;
     a.common.create_out()?;
     run_positioning(&a, &p, test)
 }
 
-/// The test the flags describe, checked before anything runs.
-fn test(a: &Args) -> anyhow::Result<positioning::PositioningTest> {
-    let step = check::positive(a.target_step_deg, "--target-step-deg")?;
+/// The test the flags describe on `axis`, checked before anything runs.
+fn test(a: &Args, axis: Axis) -> anyhow::Result<positioning::PositioningTest> {
     if a.runs < 2 {
         bail!(
             "--runs {}: ISO 230-2 needs at least 2 runs per direction (5 in the standard test)",
             a.runs
         );
     }
-    check::non_negative(a.noise_arcsec, "--noise-arcsec")?;
-    let count = (360.0 / step).floor() as usize;
+    let (targets, speed, noise) = match axis {
+        Axis::Rotary => rotary(a)?,
+        Axis::Linear => linear(a)?,
+    };
     Ok(positioning::PositioningTest {
-        targets: (0..=count)
-            .map(|i| (step * i as f64).to_radians())
-            .collect(),
+        targets,
         runs: a.runs,
         dwell: check::positive(a.dwell_s, "--dwell-s")?,
-        speed: check::positive(a.speed_deg_per_min, "--speed-deg-per-min")?.to_radians() / 60.0,
-        noise: a.noise_arcsec / iso230::ARCSEC_PER_RAD,
+        speed,
+        noise,
         seed: a.seed,
         loop_mode: a.loop_mode,
-        ..Default::default()
+        overrun: match axis {
+            Axis::Rotary => 5f64.to_radians(),
+            Axis::Linear => 5e-3,
+        },
     })
+}
+
+/// Targets, speed and noise of a rotary table (rad, rad/s, rad).
+fn rotary(a: &Args) -> anyhow::Result<(Vec<f64>, f64, f64)> {
+    let other = [
+        ("--target-step-mm", a.target_step_mm),
+        ("--travel-mm", a.travel_mm),
+        ("--speed-mm-per-min", a.speed_mm_per_min),
+        ("--noise-um", a.noise_um),
+    ];
+    if let Some((flag, _)) = other.iter().find(|(_, v)| v.is_some()) {
+        bail!("{flag} is for a linear axis; this axis is rotary (--target-step-deg, --speed-deg-per-min, --noise-arcsec)");
+    }
+    let step = check::positive(a.target_step_deg.unwrap_or(30.0), "--target-step-deg")?;
+    let speed = check::positive(a.speed_deg_per_min.unwrap_or(3600.0), "--speed-deg-per-min")?;
+    let noise = a.noise_arcsec.unwrap_or(0.0);
+    check::non_negative(noise, "--noise-arcsec")?;
+    let count = (360.0 / step).floor() as usize;
+    Ok((
+        (0..=count)
+            .map(|i| (step * i as f64).to_radians())
+            .collect(),
+        speed.to_radians() / 60.0,
+        noise / iso230::ARCSEC_PER_RAD,
+    ))
+}
+
+/// Targets, speed and noise of a linear axis (m, m/s, m).
+fn linear(a: &Args) -> anyhow::Result<(Vec<f64>, f64, f64)> {
+    let other = [
+        ("--target-step-deg", a.target_step_deg),
+        ("--speed-deg-per-min", a.speed_deg_per_min),
+        ("--noise-arcsec", a.noise_arcsec),
+    ];
+    if let Some((flag, _)) = other.iter().find(|(_, v)| v.is_some()) {
+        bail!("{flag} is for a rotary axis; this axis is linear (--target-step-mm, --travel-mm, --speed-mm-per-min, --noise-um)");
+    }
+    let step = check::positive(a.target_step_mm.unwrap_or(50.0), "--target-step-mm")?;
+    let travel = check::positive(a.travel_mm.unwrap_or(500.0), "--travel-mm")?;
+    let speed = check::positive(a.speed_mm_per_min.unwrap_or(3000.0), "--speed-mm-per-min")?;
+    let noise = a.noise_um.unwrap_or(0.0);
+    check::non_negative(noise, "--noise-um")?;
+    if travel / step > 1000.0 {
+        bail!("--travel-mm {travel} / --target-step-mm {step}: over 1000 targets");
+    }
+    let count = (travel / step + 1e-9).floor() as usize;
+    Ok((
+        (0..=count).map(|i| step * i as f64 * 1e-3).collect(),
+        speed * 1e-3 / 60.0,
+        noise * 1e-6,
+    ))
 }
 
 fn run_positioning(a: &Args, p: &Params, test: positioning::PositioningTest) -> anyhow::Result<()> {
@@ -101,7 +166,7 @@ fn run_positioning(a: &Args, p: &Params, test: positioning::PositioningTest) -> 
     a.common.write_and_report(
         "positioning",
         positioning::manifest(p, &test),
-        &positioning::to_data(&readings),
+        &positioning::to_data(&readings, p.axis),
         report,
     )
 }

@@ -23,13 +23,20 @@ torque_curve.json/.csv (time_s, motor_torque_nm, table_angle_deg), torque_curve.
 
   RMS torque    root mean square of the motor torque, N·m
   peak torque   largest |motor torque|, N·m
-  friction      the Coulomb friction torque at the motor, N·m: half the jump of the torque \
-across each reversal of the table velocity (lines fitted on either side, outside a guard \
-of T/100, over T·6/100), averaged. On the model it is fm + fw·Rg + ft·Rg·Rw (roller \
+  friction      the Coulomb friction torque at the motor, N·m: from the friction law \
+T = M·a + Fv·v + Fc·sign(v) + OF fitted over the whole curve against the table angle \
+(IDIM-LS); the paper's reading, half the jump of the torque across each reversal of the \
+table velocity (lines fitted on either side, outside a guard of T/100, over T·6/100), is \
+listed per reversal beside it. On the model it is fm + fw·Rg + ft·Rg·Rw (roller \
 gear cam: fm + ft·Rw) — the table's friction reaches the motor divided by the ratio.
+
+On a linear axis the carriage moves 50 mm·sin(2πt/3 s) (--amplitude-mm) and the drive's \
+force is the curve: torque_curve.csv then has force_n and table_position_mm, and the values \
+are printed in N.
 
 Example:
   rtid experiment torque-curve --preset worm-gear --out runs/worm
+  rtid experiment torque-curve --params fixtures/real/emps/axis.json --amplitude-mm 50 --out runs/emps
   rtid experiment torque-curve --preset roller-gear-cam --period-s 6 --periods 3 --json --out runs/roller";
 
 /// Arguments of `rtid experiment torque-curve`.
@@ -44,9 +51,12 @@ pub struct Args {
         default_value = "full_closed"
     )]
     pub loop_mode: LoopMode,
-    /// Amplitude of the commanded table motion, degrees.
-    #[arg(long, value_name = "DEG", default_value_t = 30.0)]
-    pub amplitude_deg: f64,
+    /// Rotary axis: amplitude of the commanded table motion, degrees [default: 30].
+    #[arg(long, value_name = "DEG")]
+    pub amplitude_deg: Option<f64>,
+    /// Linear axis: amplitude of the commanded carriage motion, mm [default: 50].
+    #[arg(long, value_name = "MM")]
+    pub amplitude_mm: Option<f64>,
     /// Period of the commanded table motion, s.
     #[arg(long, value_name = "SECONDS", default_value_t = 3.0)]
     pub period_s: f64,
@@ -63,17 +73,33 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
-    let test = test(&a)?;
+    let test = test(&a, p.axis)?;
     a.common.create_out()?;
     run_torque_curve(&a, &p, test)
 }
 
 /// The test the flags describe, or why they do not describe one (checked before
 /// anything runs).
-fn test(a: &Args) -> anyhow::Result<TorqueTest> {
+fn test(a: &Args, axis: Axis) -> anyhow::Result<TorqueTest> {
     check::non_negative(a.noise_percent, "--noise-percent")?;
+    let amplitude = match (axis, a.amplitude_deg, a.amplitude_mm) {
+        (Axis::Rotary, deg, None) => {
+            check::positive(deg.unwrap_or(30.0), "--amplitude-deg")?.to_radians()
+        }
+        (Axis::Linear, None, mm) => check::positive(mm.unwrap_or(50.0), "--amplitude-mm")? * 1e-3,
+        (Axis::Rotary, _, Some(_)) => {
+            anyhow::bail!(
+                "--amplitude-mm is for a linear axis; this axis is rotary (--amplitude-deg)"
+            )
+        }
+        (Axis::Linear, Some(_), _) => {
+            anyhow::bail!(
+                "--amplitude-deg is for a rotary axis; this axis is linear (--amplitude-mm)"
+            )
+        }
+    };
     Ok(TorqueTest {
-        amplitude: check::positive(a.amplitude_deg, "--amplitude-deg")?.to_radians(),
+        amplitude,
         period: check::positive(a.period_s, "--period-s")?,
         periods: check::positive(a.periods, "--periods")?,
         loop_mode: a.loop_mode,
@@ -103,7 +129,7 @@ fn run_torque_curve(a: &Args, p: &Params, test: TorqueTest) -> anyhow::Result<()
     a.common.write_and_report(
         "torque_curve",
         manifest,
-        &torque_curve::to_data(&curve),
+        &torque_curve::to_data(&curve, p.axis),
         report,
     )
 }
@@ -240,10 +266,25 @@ mod tests {
     #[test]
     fn defaults_are_the_papers_conditions_and_bad_values_are_refused() {
         let cli = Cli::parse_from(["t", "--preset", "worm-gear", "--out", "x"]);
-        let t = test(&cli.args).unwrap();
+        let t = test(&cli.args, Axis::Rotary).unwrap();
         assert_eq!(t, TorqueTest::default());
+        let cli = Cli::parse_from([
+            "t",
+            "--preset",
+            "worm-gear",
+            "--out",
+            "x",
+            "--amplitude-mm",
+            "20",
+        ]);
+        assert_eq!(test(&cli.args, Axis::Linear).unwrap().amplitude, 0.02);
+        let refused = test(&cli.args, Axis::Rotary).unwrap_err().to_string();
+        assert!(
+            refused.contains("--amplitude-mm") && refused.contains("rotary"),
+            "{refused}"
+        );
         let cli = Cli::parse_from(["t", "--preset", "worm-gear", "--out", "x", "--periods", "0"]);
-        assert!(test(&cli.args)
+        assert!(test(&cli.args, Axis::Rotary)
             .unwrap_err()
             .to_string()
             .contains("--periods"));
