@@ -348,3 +348,28 @@ fn a_file_missing_a_field_its_topology_needs_names_it() {
     assert_eq!(back, p);
     assert_eq!(Drive::new(&p).unwrap().tload(), 3.1648);
 }
+
+/// A direct drive is one body: its table follows its motor at every frequency
+/// (table/motor = 1), and its motor compliance is that of a free inertia with viscous
+/// friction, 1/(−ω²J + iωC) — not a panic for a missing motor coordinate.
+#[test]
+fn the_linear_response_of_a_direct_drive_is_one_body() {
+    use rtid::model::linear_response::{Channel, LinearResponse};
+    let p = presets::load("direct-drive").unwrap();
+    let ratio = LinearResponse::new(&p, Channel::TableOverMotor).unwrap();
+    let compliance = LinearResponse::new(&p, Channel::MotorOverTorque).unwrap();
+    for hz in [10.0, 100.0, 600.0] {
+        let r = ratio.at(hz).unwrap();
+        assert!(
+            (r.re - 1.0).abs() < 1e-12 && r.im.abs() < 1e-12,
+            "{hz} Hz: {r}"
+        );
+        let w = std::f64::consts::TAU * hz;
+        let free = 1.0 / nalgebra::Complex::new(-w * w * p.jt, w * p.ct);
+        let c = compliance.at(hz).unwrap();
+        assert!(
+            (c - free).norm() < 1e-9 * free.norm(),
+            "{hz} Hz: {c} vs {free}"
+        );
+    }
+}

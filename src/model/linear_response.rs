@@ -40,8 +40,9 @@ impl LinearResponse {
     /// Validates `p` and builds its linear model.
     pub fn new(p: &Params, channel: Channel) -> Result<Self, ParamError> {
         let model = LinearModel::new(p)?;
-        let motor = model.index("theta_m").expect("every topology has theta_m");
         let table = model.index("theta_t").expect("every topology has theta_t");
+        // A direct drive's motor is its table: one body, table/motor = 1.
+        let motor = model.index("theta_m").unwrap_or(table);
         let mut force = DVector::from_element(model.n_dof(), Complex::new(0.0, 0.0));
         force[motor] = Complex::new(1.0, 0.0);
         Ok(LinearResponse {

@@ -107,6 +107,12 @@ pub fn run_test(
     run: &RunArgs,
 ) -> anyhow::Result<()> {
     let name = test.kind().name();
+    if p.axis == rtid::model::Axis::Linear {
+        anyhow::bail!(
+            "{}: a linear axis — the {name} test turns a table through whole revolutions and reports per revolution: rotary axes only (a linear axis's positioning: `rtid experiment positioning`)",
+            p.name
+        );
+    }
     let bar = progress::bar(test.duration().ceil() as u64, name, common.quiet);
     let mut record = fluctuation::run(p, test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
