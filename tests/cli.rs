@@ -907,34 +907,22 @@ fn experiment_servo_trace_writes_a_trace_of_the_model() {
     for f in ["servo_trace.json", "servo_trace.csv", "servo_trace.svg"] {
         assert!(dir.path().join("trace").join(f).is_file(), "{f}");
     }
-    let out = rtid(
-        &[
-            "experiment",
-            "servo-trace",
-            "--preset",
-            "worm-gear",
-            "--moves",
-            "0.1@fast",
-            "--out",
-            "bad",
-        ],
-        dir.path(),
-    );
-    assert_one_line_error(&out, &["--moves", "fast"]);
-    let out = rtid(
-        &[
-            "experiment",
-            "servo-trace",
-            "--preset",
-            "worm-gear",
-            "--moves",
-            "0.1@-2",
-            "--out",
-            "bad",
-        ],
-        dir.path(),
-    );
-    assert_one_line_error(&out, &["--moves", "-2"]);
+    for (moves, named) in [("0.1@fast", "fast"), ("0.1@-2", "-2")] {
+        let out = rtid(
+            &[
+                "experiment",
+                "servo-trace",
+                "--preset",
+                "worm-gear",
+                "--moves",
+                moves,
+                "--out",
+                "bad",
+            ],
+            dir.path(),
+        );
+        assert_one_line_error(&out, &["--moves", named]);
+    }
 }
 
 /// ISO 230-2 on a linear axis, natively: a laser run written in mm and µm is
