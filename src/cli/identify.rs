@@ -14,7 +14,7 @@ use rtid::identify::{
     identify, Bound, Config, ExperimentSpec, FidelityChoice, Identified, IdentifyResult, Method,
     Monitor, SearchOptions, StartChoice, Warning,
 };
-use rtid::io::experiment_file;
+use rtid::io::experiment_file::{self, Kind};
 use rtid::io::params_file;
 use rtid::model::Params;
 use rtid::objectives::{Detail, ObjectiveKind};
@@ -100,6 +100,12 @@ pub struct Args {
     /// Bounds of a fitted parameter, SI units; repeatable: --bound Kw=1e5..1e7.
     #[arg(long = "bound", value_name = "NAME=LO..HI")]
     pub bounds: Vec<String>,
+    /// The band of the resonances, Hz: only the measured peaks (and gain-curve points)
+    /// inside it count, and the model's peaks are sought there — a noise ripple or a
+    /// mode outside it is not matched. Sets `conditions.band_hz` of every
+    /// frequency-response and resonance experiment.
+    #[arg(long, value_name = "LO..HI")]
+    pub band: Option<String>,
     /// Objectives to use (default: by experiment kind, see above); each experiment
     /// feeds those of them it can.
     #[arg(long, value_delimiter = ',', value_parser = objective_names())]
@@ -293,10 +299,15 @@ impl Args {
             .as_ref()
             .map(|v| v.iter().map(|o| ObjectiveKind::named(o)).collect())
             .transpose()?;
+        let band = self.band.as_deref().map(parse_band).transpose()?;
         let mut specs = Vec::new();
         for (i, path) in self.experiments.iter().enumerate() {
             let mut spec =
                 ExperimentSpec::new(path.display().to_string(), experiment_file::read(path)?);
+            let kind = spec.experiment.manifest.kind;
+            if band.is_some() && matches!(kind, Kind::FrequencyResponse | Kind::Resonance) {
+                spec.experiment.manifest.conditions.band_hz = band;
+            }
             if let Some(&w) = self.weights.get(i) {
                 anyhow::ensure!(
                     w.is_finite() && w > 0.0,
@@ -309,8 +320,35 @@ impl Args {
             }
             specs.push(spec);
         }
+        if band.is_some()
+            && !specs
+                .iter()
+                .any(|s| s.experiment.manifest.conditions.band_hz.is_some())
+        {
+            bail!("--band: no frequency_response or resonance experiment to apply it to");
+        }
         Ok(specs)
     }
+}
+
+/// Parses `LO..HI` (Hz) for --band.
+fn parse_band(s: &str) -> anyhow::Result<[f64; 2]> {
+    let (lo, hi) = s
+        .split_once("..")
+        .with_context(|| format!("--band {s}: expected LO..HI in Hz, e.g. 100..300"))?;
+    let num = |t: &str| -> anyhow::Result<f64> {
+        t.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .with_context(|| format!("--band {s}: `{t}` is not a finite number"))
+    };
+    let (lo, hi) = (num(lo)?, num(hi)?);
+    anyhow::ensure!(
+        lo >= 0.0 && lo < hi,
+        "--band {s}: the band must be LO..HI Hz with 0 ≤ LO < HI"
+    );
+    Ok([lo, hi])
 }
 
 /// The objectives of `all` that `spec`'s experiment can feed; an error naming the

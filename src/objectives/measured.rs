@@ -26,7 +26,8 @@ pub fn frequency_test(exp: &Experiment) -> FrequencyTest {
 }
 
 /// The measured resonances of an experiment: the manifest's peaks, or the prominent
-/// peaks of the gain curve ([`PROMINENCE_DB`]). Heights are NaN where not given.
+/// peaks of the gain curve ([`PROMINENCE_DB`]), inside its band when it has one.
+/// Heights are NaN where not given.
 pub fn peaks(source: &Source<'_>) -> Result<Vec<Peak>, SetupError> {
     match &source.experiment.data {
         Data::Resonance {
@@ -43,6 +44,7 @@ pub fn peaks(source: &Source<'_>) -> Result<Vec<Peak>, SetupError> {
                     .copied()
                     .unwrap_or(f64::NAN),
             })
+            .filter(|pk| in_band(source.experiment, pk.frequency_hz))
             .collect()),
         Data::FrequencyResponse { .. } => {
             let curve: Vec<(f64, f64)> = valid_points(source.experiment).collect();
@@ -61,9 +63,19 @@ pub fn peaks(source: &Source<'_>) -> Result<Vec<Peak>, SetupError> {
     }
 }
 
-/// The (frequency, gain) points of a gain curve that are measurements of the drive:
-/// points flagged `below_resolution` (the table did not move more than the encoder
-/// resolves) are left out. Empty for other kinds.
+/// The band of an experiment's resonances (`conditions.band_hz`), Hz.
+pub fn band(exp: &Experiment) -> Option<(f64, f64)> {
+    exp.manifest.conditions.band_hz.map(|[lo, hi]| (lo, hi))
+}
+
+/// Whether `hz` lies in the experiment's band (always, without one).
+fn in_band(exp: &Experiment, hz: f64) -> bool {
+    band(exp).map_or(true, |(lo, hi)| lo <= hz && hz <= hi)
+}
+
+/// The (frequency, gain) points of a gain curve that are measurements of the drive,
+/// inside its band when it has one: points flagged `below_resolution` (the table did
+/// not move more than the encoder resolves) are left out. Empty for other kinds.
 pub(crate) fn valid_points(exp: &Experiment) -> impl Iterator<Item = (f64, f64)> + '_ {
     let (f, g, flags) = match &exp.data {
         Data::FrequencyResponse {
@@ -80,6 +92,7 @@ pub(crate) fn valid_points(exp: &Experiment) -> impl Iterator<Item = (f64, f64)>
     };
     (0..f.len())
         .filter(move |&i| flags.map_or(true, |c| c.get(i).map_or(true, |&v| v < 0.5)))
+        .filter(move |&i| in_band(exp, f[i]))
         .map(move |i| (f[i], g[i]))
 }
 

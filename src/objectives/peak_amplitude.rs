@@ -57,7 +57,11 @@ fn build(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, 
             needs: "peak heights (`peak_gain_db` in a resonance manifest)",
         });
     }
-    let o = PeakAmplitude::new(peaks, fidelity, measured::frequency_test(source.experiment));
+    let mut o = PeakAmplitude::new(peaks, fidelity, measured::frequency_test(source.experiment));
+    if let Some(band) = measured::band(source.experiment) {
+        // The model's peaks in the same band: they pair with the measured ones in order.
+        o.model.band = (band.0.max(0.1), band.1);
+    }
     Ok(Box::new(match measured::grid(source.experiment) {
         Some(grid) => o.on_grid(grid),
         None => o,

@@ -53,7 +53,11 @@ fn build(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, 
         .iter()
         .map(|p| p.frequency_hz)
         .collect();
-    let o = ResonanceMatch::new(hz, fidelity, measured::frequency_test(source.experiment));
+    let mut o = ResonanceMatch::new(hz, fidelity, measured::frequency_test(source.experiment));
+    if let Some(band) = measured::band(source.experiment) {
+        // The model's peaks in the same band: they pair with the measured ones in order.
+        o.model.band = (band.0.max(0.1), band.1);
+    }
     Ok(Box::new(match measured::grid(source.experiment) {
         Some(grid) => o.on_grid(grid),
         None => o,

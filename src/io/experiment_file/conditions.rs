@@ -110,6 +110,11 @@ pub struct Conditions {
     /// record's (a trace decimated for storage). Absent: the record's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub loop_period_s: Option<f64>,
+    /// Frequency response or resonances: the band in which resonances are sought,
+    /// [lowest, highest] Hz (identification: the measured peaks, the gain curve and the
+    /// model's peaks; `rtid identify --band` sets it). Absent: the whole curve.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub band_hz: Option<[f64; 2]>,
     /// Condition keys this version does not know, kept as written.
     #[serde(flatten)]
     pub extra: Map<String, Value>,
@@ -117,7 +122,7 @@ pub struct Conditions {
 
 impl Conditions {
     /// The JSON keys of the typed fields.
-    pub(super) const KEYS: [&'static str; 19] = [
+    pub(super) const KEYS: [&'static str; 20] = [
         "torque_amplitude_nm",
         "preload_nm",
         "amplitude_deg",
@@ -137,6 +142,7 @@ impl Conditions {
         "transient_periods",
         "drive_gain",
         "loop_period_s",
+        "band_hz",
     ];
 
     /// True when no condition is given.
@@ -219,6 +225,13 @@ impl Conditions {
 /// The conditions `kind` needs, checked on the manifest alone (JSON numbers are
 /// finite, so `<= 0` is the whole check of a positive value).
 pub(super) fn check(kind: Kind, c: &Conditions) -> Result<(), String> {
+    if let Some([lo, hi]) = c.band_hz {
+        if !(lo >= 0.0 && lo < hi) {
+            return Err(format!(
+                "`conditions.band_hz` is [{lo}, {hi}]: it must be [lowest, highest] Hz with 0 ≤ lowest < highest"
+            ));
+        }
+    }
     match kind {
         Kind::FrequencyResponseTime => check_record(c),
         Kind::ServoTrace => check_servo(c),
