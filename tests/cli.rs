@@ -1115,3 +1115,77 @@ fn identify_in_a_band_ignores_a_ripple_outside_it() {
     );
     assert_one_line_error(&out, &["--band", "300..100"]);
 }
+
+/// A UTF-8 byte-order mark at the start of a JSON manifest or parameter file (as some
+/// Windows editors write) is accepted, as it is in CSV, not refused at "line 1,
+/// column 1".
+#[test]
+fn json_files_with_a_byte_order_mark_are_read() {
+    let dir = tempdir();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures");
+    let with_bom = |from: &Path, to: &str| {
+        let text = std::fs::read_to_string(from).unwrap();
+        std::fs::write(dir.path().join(to), format!("\u{feff}{text}")).unwrap();
+    };
+    with_bom(
+        &root.join("worm-gear/frequency_response.json"),
+        "frequency_response.json",
+    );
+    std::fs::copy(
+        root.join("worm-gear/frequency_response.csv"),
+        dir.path().join("frequency_response.csv"),
+    )
+    .unwrap();
+    with_bom(&root.join("presets/worm-gear.json"), "worm.json");
+    let v = rtid_json(
+        &["evaluate", "frequency_response.json", "--json"],
+        dir.path(),
+    );
+    assert_eq!(v["kind"], "frequency_response");
+    rtid_ok(&["modes", "--params", "worm.json"], dir.path());
+}
+
+/// Inputs are never outputs: `identify … --out` (or `--save-params`, `--checkpoint`)
+/// and `evaluate --plot` naming a manifest, its CSV or the parameter file are one
+/// clear error, and the input is left as it was.
+#[test]
+fn an_output_over_an_input_is_refused_and_the_input_kept() {
+    let dir = tempdir();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/worm-gear");
+    for f in ["frequency_response.json", "frequency_response.csv"] {
+        std::fs::copy(root.join(f), dir.path().join(f)).unwrap();
+    }
+    let before = std::fs::read(dir.path().join("frequency_response.csv")).unwrap();
+    for (option, target) in [
+        ("--out", "frequency_response.json"),
+        ("--out", "frequency_response.csv"),
+        ("--checkpoint", "./frequency_response.json"),
+    ] {
+        let out = rtid(
+            &[
+                "identify",
+                "frequency_response.json",
+                "--preset",
+                "worm-gear",
+                option,
+                target,
+            ],
+            dir.path(),
+        );
+        assert_one_line_error(&out, &[option, target, "input"]);
+    }
+    let out = rtid(
+        &[
+            "evaluate",
+            "frequency_response.json",
+            "--plot",
+            "frequency_response.csv",
+        ],
+        dir.path(),
+    );
+    assert_one_line_error(&out, &["--plot", "frequency_response.csv", "input"]);
+    assert_eq!(
+        std::fs::read(dir.path().join("frequency_response.csv")).unwrap(),
+        before
+    );
+}

@@ -74,6 +74,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .plot
         .clone()
         .unwrap_or_else(|| a.file.with_extension("svg"));
+    let mut inputs: Vec<&std::path::Path> = vec![&a.file];
+    inputs.extend(exp.data_path.as_deref());
+    inputs.extend(a.model.params.as_deref());
+    super::inputs::refuse_overwrite("--plot", &plot, &inputs)?;
     match exp.manifest.kind {
         Kind::Positioning => positioning::report(&exp, &plot, a.json),
         Kind::FrequencyResponse => frequency_response::report(&exp, &plot, a.json),

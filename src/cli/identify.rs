@@ -252,6 +252,7 @@ impl Args {
     fn config(&self) -> anyhow::Result<Config> {
         let base = self.model.load()?;
         let experiments = self.experiment_specs()?;
+        self.refuse_overwrites(&experiments)?;
         let bounds = self
             .bounds
             .iter()
@@ -283,6 +284,28 @@ impl Args {
             resume: self.resume,
             start: self.start.into(),
         })
+    }
+
+    /// No output (--out, --save-params, --checkpoint) over an input: a manifest, its
+    /// data file or the parameter file.
+    fn refuse_overwrites(&self, experiments: &[ExperimentSpec]) -> anyhow::Result<()> {
+        let mut inputs: Vec<&Path> = Vec::new();
+        for (path, spec) in self.experiments.iter().zip(experiments) {
+            inputs.push(path);
+            inputs.extend(spec.experiment.data_path.as_deref());
+        }
+        inputs.extend(self.model.params.as_deref());
+        let outputs = [
+            ("--out", &self.out),
+            ("--save-params", &self.save_params),
+            ("--checkpoint", &self.checkpoint),
+        ];
+        for (option, path) in outputs {
+            if let Some(path) = path {
+                super::inputs::refuse_overwrite(option, path, &inputs)?;
+            }
+        }
+        Ok(())
     }
 
     /// Each experiment with its weight and the chosen objectives it can feed.

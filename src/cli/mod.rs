@@ -5,6 +5,7 @@ mod compare;
 mod evaluate;
 mod experiment;
 mod identify;
+mod inputs;
 mod model_args;
 mod modes;
 mod params_cmd;

@@ -112,7 +112,7 @@ fn is_manifest(path: &Path) -> Result<bool, CompareError> {
         source,
     })?;
     let value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| CompareError::NotJson {
+        serde_json::from_str(crate::io::without_bom(&text)).map_err(|e| CompareError::NotJson {
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;

@@ -138,13 +138,12 @@ impl Checkpoint {
             path: path.into(),
             source,
         })?;
-        let c: Checkpoint =
-            serde_json::from_str(text.trim_start_matches('\u{feff}')).map_err(|e| {
-                CheckpointError::Parse {
-                    path: path.into(),
-                    message: e.to_string(),
-                }
-            })?;
+        let c: Checkpoint = serde_json::from_str(crate::io::without_bom(&text)).map_err(|e| {
+            CheckpointError::Parse {
+                path: path.into(),
+                message: e.to_string(),
+            }
+        })?;
         if let Some(field) = c.fingerprint.difference(expected) {
             return Err(CheckpointError::OtherProblem {
                 path: path.into(),

@@ -1,6 +1,8 @@
 //! Atomic file output: write a temporary file beside the target, then rename it over
 //! the target, so a reader never sees a half-written file and an interrupted run
-//! leaves the previous version intact.
+//! leaves the previous version intact. The file gets the permissions the user's umask
+//! gives a new file (0644 under the usual 022), not a temporary file's private 0600:
+//! sweep shards on a cluster are read by colleagues.
 
 use std::io::Write;
 use std::path::Path;
@@ -11,7 +13,7 @@ pub fn write(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+    let mut tmp = temporary_in(dir)?;
     tmp.write_all(bytes)?;
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
@@ -28,7 +30,7 @@ pub fn write_with<E: From<std::io::Error>>(
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let tmp = tempfile::NamedTempFile::new_in(dir)?;
+    let tmp = temporary_in(dir)?;
     {
         let mut w = std::io::BufWriter::new(tmp.as_file());
         fill(&mut w)?;
@@ -37,6 +39,18 @@ pub fn write_with<E: From<std::io::Error>>(
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
+}
+
+/// A temporary file in `dir` created with mode 0666, which the system masks with the
+/// umask as for any new file.
+fn temporary_in(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(dir)
 }
 
 #[cfg(test)]
@@ -55,5 +69,24 @@ mod tests {
         assert!(r.is_err());
         assert_eq!(std::fs::read(&path).unwrap(), b"old");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    /// The written file's mode is a new file's under the process's umask, compared
+    /// with a file made by `File::create` in the same folder.
+    #[cfg(unix)]
+    #[test]
+    fn the_file_gets_the_umask_permissions_of_a_new_file() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let plain = dir.path().join("plain");
+        std::fs::File::create(&plain).unwrap();
+        let path = dir.path().join("out.json");
+        write(&path, b"{}").unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(
+            mode(&path),
+            mode(&plain),
+            "a new file's mode, not a temporary's 0600"
+        );
     }
 }

@@ -340,7 +340,7 @@ pub fn read_manifest(path: &Path) -> Result<Manifest, ExperimentFileError> {
         source,
     })?;
     let manifest: Manifest =
-        serde_json::from_str(&text).map_err(|e| ExperimentFileError::Json {
+        serde_json::from_str(super::without_bom(&text)).map_err(|e| ExperimentFileError::Json {
             path: path.to_path_buf(),
             line: e.line(),
             column: e.column(),

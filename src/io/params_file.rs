@@ -41,17 +41,18 @@ pub fn read(path: &Path) -> Result<Params, ParamsFileError> {
 
 /// Parses and validates parameter JSON; `path` is only used in error messages.
 pub fn parse(text: &str, path: &Path) -> Result<Params, ParamsFileError> {
-    let params: Params = serde_json::from_str(text).map_err(|e| ParamsFileError::Syntax {
-        path: path.to_path_buf(),
-        line: e.line(),
-        column: e.column(),
-        message: e
-            .to_string()
-            .split(" at line ")
-            .next()
-            .unwrap_or("")
-            .to_string(),
-    })?;
+    let params: Params =
+        serde_json::from_str(super::without_bom(text)).map_err(|e| ParamsFileError::Syntax {
+            path: path.to_path_buf(),
+            line: e.line(),
+            column: e.column(),
+            message: e
+                .to_string()
+                .split(" at line ")
+                .next()
+                .unwrap_or("")
+                .to_string(),
+        })?;
     params
         .validate()
         .map_err(|source| ParamsFileError::Invalid {
