@@ -1189,3 +1189,47 @@ fn an_output_over_an_input_is_refused_and_the_input_kept() {
         before
     );
 }
+
+/// `simulate --out` and `experiment … --out DIR` never write over the parameter file
+/// they read (here named like the test's own manifest, in the output folder).
+#[test]
+fn simulate_and_experiments_keep_their_parameter_file() {
+    let dir = tempdir();
+    let preset = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/presets/worm-gear.json");
+    std::fs::create_dir(dir.path().join("d")).unwrap();
+    std::fs::copy(&preset, dir.path().join("d/torque_curve.json")).unwrap();
+    let before = std::fs::read(dir.path().join("d/torque_curve.json")).unwrap();
+    let out = rtid(
+        &[
+            "simulate",
+            "--params",
+            "d/torque_curve.json",
+            "--input",
+            "none",
+            "--duration-s",
+            "0.01",
+            "--out",
+            "d/torque_curve.json",
+        ],
+        dir.path(),
+    );
+    assert_one_line_error(&out, &["--out", "torque_curve.json", "input"]);
+    let out = rtid(
+        &[
+            "experiment",
+            "torque-curve",
+            "--params",
+            "d/torque_curve.json",
+            "--periods",
+            "1",
+            "--out",
+            "d",
+        ],
+        dir.path(),
+    );
+    assert_one_line_error(&out, &["--out", "torque_curve.json", "input"]);
+    assert_eq!(
+        std::fs::read(dir.path().join("d/torque_curve.json")).unwrap(),
+        before
+    );
+}

@@ -244,6 +244,11 @@ impl Args {
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.model.load()?;
     a.check()?;
+    let mut inputs: Vec<&std::path::Path> = a.model.params.iter().map(|p| p.as_path()).collect();
+    if let InputSpec::File(path) = &a.input {
+        inputs.push(path);
+    }
+    super::inputs::refuse_overwrite("--out", &a.out, &inputs)?;
     let mut sim = match a.dt_s {
         Some(dt) => Simulation::new(&p, dt)?,
         None => Simulation::with_default_step(&p)?,

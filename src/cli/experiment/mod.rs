@@ -82,6 +82,12 @@ impl Common {
         report: Report,
     ) -> anyhow::Result<()> {
         let path = self.out.join(format!("{stem}.json"));
+        if let Some(params) = &self.model.params {
+            for ext in ["json", "csv", "svg"] {
+                let output = self.out.join(format!("{stem}.{ext}"));
+                crate::cli::inputs::refuse_overwrite("--out", &output, &[params])?;
+            }
+        }
         manifest.data = Some(format!("{stem}.csv"));
         experiment_file::write(&path, &manifest, data)?;
         report(
