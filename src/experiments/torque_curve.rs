@@ -24,7 +24,7 @@ use serde::Serialize;
 
 use crate::experiments::inverse_dynamics::{of_torque_curve, IdimFit, IdimSettings};
 use crate::input::{Harmonic, Trajectory};
-use crate::io::experiment_file::{Conditions, Data, Kind, Manifest};
+use crate::io::experiment_file::{sample_period, Conditions, Data, Kind, Manifest};
 use crate::model::idx::THETA_T;
 use crate::model::params::{Axis, LoopMode, Params};
 use crate::model::NSTATE;
@@ -432,10 +432,10 @@ pub fn evaluate(curve: &TorqueCurve, test: &TorqueTest) -> Result<TorqueReport, 
 /// filters carried to its sampling rate); none without the angle or when the curve
 /// cannot carry the fit (too short, too little motion).
 fn friction_law(curve: &TorqueCurve) -> Option<IdimFit> {
-    if curve.table_angle.len() != curve.time.len() || curve.time.len() < 2 {
+    if curve.table_angle.len() != curve.time.len() {
         return None;
     }
-    let period = (curve.time[curve.time.len() - 1] - curve.time[0]) / (curve.time.len() - 1) as f64;
+    let period = sample_period(&curve.time)?;
     of_torque_curve(curve, &IdimSettings::for_sample_period(period)).ok()
 }
 

@@ -2,6 +2,7 @@
 //! the stages, the assessment of the best point, the result. The command line and
 //! the tests both come through [`identify`].
 
+use std::borrow::Cow;
 use std::time::Instant;
 
 use super::assess::assess;
@@ -30,16 +31,18 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
     let clock = Instant::now();
     let plan = Plan::new(config)?;
     let start = start(config, &plan.fit)?;
+    // Only a start moved by an estimate needs its own configuration (a copy of the
+    // experiments' data): otherwise the caller's serves.
     let (config, plan) = if start.estimates.is_empty() {
-        (config.clone(), plan)
+        (Cow::Borrowed(config), plan)
     } else {
         let config = Config {
             base: start.base.clone(),
             ..config.clone()
         };
-        (config, plan.from_estimate())
+        (Cow::Owned(config), plan.from_estimate())
     };
-    let config = &config;
+    let config: &Config = &config;
     let space = ParamSpace::new(config.base.clone(), &plan.fit, &config.bounds)?;
     let checkpoint = Checkpointer::open(
         config.checkpoint.as_deref(),
