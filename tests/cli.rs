@@ -1233,3 +1233,142 @@ fn simulate_and_experiments_keep_their_parameter_file() {
         before
     );
 }
+
+/// The two-mass bench's multisine record (fixtures/real/two-mass, MIT) evaluated as a
+/// drive engineer would: both channels, each one's resonances and antiresonances and
+/// nothing else, the two-mass ratios, and the reference values of the record's README
+/// (load/motor peak 53.5–53.9 Hz, motor/current resonance 76.2 ± 0.3 Hz and
+/// antiresonance 53.9 ± 0.3 Hz, Jl/Jm within 3 % of 1.00, k/Jl within 2 % of 1.15e5).
+#[test]
+fn evaluate_gives_both_channels_of_the_two_mass_multisine_record() {
+    let dir = tempdir();
+    let record =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/real/two-mass/multisine_a.json");
+    let record = record.to_str().unwrap();
+    let plot = dir.path().join("bench.svg");
+    let plot = plot.to_str().unwrap();
+    let v = rtid_json(&["evaluate", record, "--json", "--plot", plot], dir.path());
+    assert_eq!(v["estimator"], "periodic");
+    let hz = |key: &str| -> Vec<f64> {
+        v[key]
+            .as_array()
+            .unwrap_or_else(|| panic!("{key} in {v}"))
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let (table, motor) = (hz("table_resonances_hz"), hz("motor_resonances_hz"));
+    let anti = hz("motor_antiresonances_hz");
+    assert!(hz("table_antiresonances_hz").is_empty());
+    assert!(
+        table.len() == 1 && (53.5..=53.9).contains(&table[0]),
+        "{table:?}"
+    );
+    assert!(
+        motor.len() == 1 && (motor[0] - 76.2).abs() < 0.3,
+        "{motor:?}"
+    );
+    assert!(anti.len() == 1 && (anti[0] - 53.9).abs() < 0.3, "{anti:?}");
+    let r = &v["two_mass"];
+    let ratio = r["inertia_ratio"].as_f64().unwrap();
+    let k = r["k_over_jl"].as_f64().unwrap();
+    assert!(
+        (ratio - 1.0).abs() < 0.03 && (k / 1.15e5 - 1.0).abs() < 0.02,
+        "{r}"
+    );
+    assert!(dir.path().join("bench.svg").exists());
+    assert!(dir.path().join("bench-coherence.svg").exists());
+    let text = rtid_ok(&["evaluate", record, "--plot", plot], dir.path());
+    assert!(
+        text.contains("without a torque constant") && text.contains("Jl/Jm = 1.00"),
+        "{text}"
+    );
+}
+
+/// A virtual multisine record of the two-mass preset gives back the model: the
+/// motor-free mode √(Kw(1/Jm + 1/Jt)) = 76.3 Hz, the motor-held one √(Kw/Jt) = 54.0 Hz
+/// on both channels, Jt/Jm = 1 and Kw/Jt = 1.15e5 rad²/s² (friction on: within 3 % and
+/// 2 %). A random-odd multisine measures the friction's odd distortion at the lines it
+/// leaves out.
+#[test]
+fn a_virtual_two_mass_multisine_gives_back_the_model() {
+    let dir = tempdir();
+    let run = |lines: &str, out: &str| {
+        rtid_json(
+            &[
+                "experiment",
+                "frequency-response-time",
+                "--preset",
+                "two-mass",
+                "--excitation",
+                "multisine",
+                "--lines",
+                lines,
+                "--from-hz",
+                "11",
+                "--to-hz",
+                "250",
+                "--amplitude-nm",
+                "0.2",
+                "--sample-rate-hz",
+                "2500",
+                "--periods",
+                "10",
+                "--out",
+                out,
+                "--quiet",
+                "--json",
+            ],
+            dir.path(),
+        )
+    };
+    let v = run("full", "full");
+    let first = |key: &str| v[key][0].as_f64().unwrap_or_else(|| panic!("{key}: {v}"));
+    assert!((first("motor_resonances_hz") - 76.3).abs() < 0.5, "{v}");
+    assert!((first("motor_antiresonances_hz") - 54.0).abs() < 0.5, "{v}");
+    assert!((first("table_resonances_hz") - 54.0).abs() < 0.5, "{v}");
+    let r = &v["two_mass"];
+    assert!(
+        (r["inertia_ratio"].as_f64().unwrap() - 1.0).abs() < 0.03,
+        "{r}"
+    );
+    assert!(
+        (r["k_over_jl"].as_f64().unwrap() / 1.15e5 - 1.0).abs() < 0.02,
+        "{r}"
+    );
+    let manifest =
+        std::fs::read_to_string(dir.path().join("full/frequency_response_time.json")).unwrap();
+    assert!(
+        manifest.contains("\"excitation\": \"multisine\""),
+        "{manifest}"
+    );
+    let odd = run("random-odd", "odd");
+    let bands = odd["motor"]["distortion"].as_array().unwrap();
+    assert!(
+        bands.iter().any(|b| b["odd"]["detected"] == true),
+        "friction distorts at the odd lines left out: {bands:?}"
+    );
+}
+
+/// A current-driven record must be a multisine; a period that is not a whole number
+/// of samples is named.
+#[test]
+fn a_multisine_record_with_a_wrong_period_is_one_clear_error() {
+    let dir = tempdir();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/real/two-mass");
+    std::fs::copy(
+        root.join("multisine_a.csv"),
+        dir.path().join("multisine_a.csv"),
+    )
+    .unwrap();
+    let manifest = std::fs::read_to_string(root.join("multisine_a.json")).unwrap();
+    let odd = manifest.replace("\"period_s\": 1,", "\"period_s\": 1.00001,");
+    assert_ne!(odd, manifest);
+    std::fs::write(dir.path().join("odd.json"), odd).unwrap();
+    let out = rtid(&["evaluate", "odd.json"], dir.path());
+    assert_one_line_error(&out, &["odd.json", "period_s"]);
+    let broadband = manifest.replace("\"excitation\": \"multisine\",", "");
+    std::fs::write(dir.path().join("broadband.json"), broadband).unwrap();
+    let out = rtid(&["evaluate", "broadband.json"], dir.path());
+    assert_one_line_error(&out, &["broadband.json", "multisine"]);
+}

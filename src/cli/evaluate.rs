@@ -33,11 +33,17 @@ FILE.svg (Fig. 11) and FILE-spectrum.svg (Fig. 12).
 uniformly sampled. A stepped sine (conditions.excitation = stepped_sine, frequencies_hz, \
 dwell_s) is demodulated per dwell: the first --settle-fraction discarded, then a \
 least-squares fit of offset, drift and sine over whole cycles; gain, phase, and the fit's \
-residual (a flag for noise or backlash rattle). A broadband record (noise, chirp, \
-multisine) gives the H1 estimate with Welch averaging (Hann, 50 % overlap, --segment-s: \
-resolution 1/segment) and the coherence γ²; bins below --min-coherence are left out. \
-Gain = table angle / (motor angle × ratio); resonances as above (for H1 only peaks that \
-stand out of the random error). Plots: FILE.svg (gain) and FILE-coherence.svg.
+residual (a flag for noise or backlash rattle). A broadband record (noise, chirp, an \
+undescribed multisine) gives the H1 estimate with Welch averaging (Hann, 50 % overlap, \
+--segment-s: resolution 1/segment) and the coherence γ²; bins below --min-coherence are \
+left out. Gain = table angle / (motor angle × ratio); resonances as above (for H1 only \
+peaks that stand out of the random error). A periodic multisine (conditions.excitation = \
+multisine, period_s; input motor_torque_nm or motor_current_a) is cut into whole periods \
+(no leakage) and gives both channels — table/motor and motor/torque (or motor/current) — \
+with each line's noise from the spread over the periods, the resonances and \
+antiresonances that stand out of it (fitted frequency, damping), the two-mass ratios \
+Jl/Jm and k/Jl, and the nonlinear distortion at the lines left out (docs/multisine.md). \
+Plots: FILE.svg (gain) and FILE-coherence.svg.
   unbalance     as fluctuation; the step (largest change of the deviation across 0.5° of \
 table angle, and where) is the backlash crossed when the unbalance moment overcomes the \
 friction. Plots: FILE.svg (Fig. 14) and FILE-spectrum.svg.

@@ -606,7 +606,7 @@ fn hint(w: &Warning) -> String {
     match w {
         Warning::AtBound { name, .. } => format!(" (--bound {name}=LO..HI)"),
         Warning::Interrupted { .. } => " (--resume with the same --checkpoint)".into(),
-        Warning::NonlinearShift { .. } => " (--model nonlinear)".into(),
+        Warning::Escalated { .. } => " (--model linear for the linear fit alone)".into(),
         _ => String::new(),
     }
 }

@@ -18,9 +18,12 @@
 use serde::Serialize;
 
 use super::fluctuation::{self, FluctuationError};
+use super::periodic_evaluation::{
+    self, Input, PeriodicEvaluation, PeriodicEvaluationError, Series,
+};
 use super::stepped_sine::{self, SinePoint, SteppedSineError, SteppedSineOptions};
 use super::welch::{self, WelchError, WelchOptions};
-use crate::io::experiment_file::{sample_period, Data, Excitation, Experiment, Kind};
+use crate::io::experiment_file::{sample_period, Conditions, Data, Excitation, Experiment, Kind};
 use crate::peaks::{self, Peak};
 
 /// Default Welch segment length, s: 0.5 Hz resolution, several bins across the
@@ -103,13 +106,17 @@ pub enum Evaluation {
         bins: Vec<Bin>,
         peaks: Vec<Peak>,
     },
+    /// A periodic multisine: both channels over whole periods
+    /// ([`super::periodic_evaluation`]).
+    Periodic(Box<PeriodicEvaluation>),
 }
 
 impl Evaluation {
-    /// The resonances found.
+    /// The resonances found (of the table channel).
     pub fn peaks(&self) -> &[Peak] {
         match self {
             Evaluation::SteppedSine { peaks, .. } | Evaluation::H1 { peaks, .. } => peaks,
+            Evaluation::Periodic(p) => &p.peaks,
         }
     }
 }
@@ -120,6 +127,10 @@ impl Evaluation {
 pub enum EstimateError {
     #[error("not a frequency_response_time experiment")]
     WrongKind,
+    #[error("a record driven by motor_current_a is evaluated as a periodic multisine only: its manifest must say \"excitation\": \"multisine\" (with \"period_s\")")]
+    CurrentNotMultisine,
+    #[error("{0}")]
+    Periodic(#[from] PeriodicEvaluationError),
     #[error("{0}")]
     Ratio(#[from] FluctuationError),
     #[error("{0}")]
@@ -134,11 +145,63 @@ pub enum EstimateError {
     BadCoherence(f64),
 }
 
+/// A multisine record, torque- or current-driven.
+fn periodic(exp: &Experiment, c: &Conditions) -> Result<Evaluation, EstimateError> {
+    let (time_s, input, excitation, motor, table) = match &exp.data {
+        Data::FrequencyResponseTime {
+            time_s,
+            motor_torque_nm,
+            motor_angle_rad,
+            table_angle_rad,
+            ..
+        } => (
+            time_s,
+            Input::Torque,
+            motor_torque_nm,
+            motor_angle_rad,
+            table_angle_rad,
+        ),
+        Data::FrequencyResponseTimeCurrent {
+            time_s,
+            motor_current_a,
+            motor_angle_rad,
+            table_angle_rad,
+            ..
+        } => (
+            time_s,
+            Input::Current,
+            motor_current_a,
+            motor_angle_rad,
+            table_angle_rad,
+        ),
+        _ => return Err(EstimateError::WrongKind),
+    };
+    let period = sample_period(time_s).ok_or(EstimateError::TooShort(time_s.len()))?;
+    let series = Series {
+        sample_rate_hz: 1.0 / period,
+        input,
+        excitation,
+        motor_angle_rad: motor,
+        table_angle_rad: table,
+        ratio: fluctuation::ratio(exp)?,
+    };
+    Ok(Evaluation::Periodic(Box::new(
+        periodic_evaluation::evaluate(&series, c)?,
+    )))
+}
+
 /// Evaluates a `frequency_response_time` experiment with `opts`.
 pub fn evaluate_experiment(
     exp: &Experiment,
     opts: &EstimateOptions,
 ) -> Result<Evaluation, EstimateError> {
+    let c = exp
+        .manifest
+        .conditions
+        .with_defaults(Kind::FrequencyResponseTime);
+    if c.excitation == Some(Excitation::Multisine) {
+        return periodic(exp, &c);
+    }
     let Data::FrequencyResponseTime {
         time_s,
         motor_torque_nm,
@@ -147,13 +210,12 @@ pub fn evaluate_experiment(
         ..
     } = &exp.data
     else {
-        return Err(EstimateError::WrongKind);
+        return Err(match exp.data {
+            Data::FrequencyResponseTimeCurrent { .. } => EstimateError::CurrentNotMultisine,
+            _ => EstimateError::WrongKind,
+        });
     };
     let ratio = fluctuation::ratio(exp)?;
-    let c = exp
-        .manifest
-        .conditions
-        .with_defaults(Kind::FrequencyResponseTime);
     let period = sample_period(time_s).ok_or(EstimateError::TooShort(time_s.len()))?;
     if c.excitation == Some(Excitation::SteppedSine) {
         // The reader has checked both conditions for a stepped sine.

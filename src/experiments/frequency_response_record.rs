@@ -14,6 +14,7 @@
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
+use super::multisine::{self, Level, LineSet, MultisineSpec, PhaseRule};
 use crate::controller::quantise;
 use crate::experiments::frequency_response::{initial_state, FrequencyTest};
 use crate::input::TorqueInput;
@@ -39,6 +40,26 @@ pub enum Excitation {
     /// `amplitude·sin(φ(t))`, frequency rising linearly from `from_hz` to `to_hz` over
     /// the record.
     Chirp { from_hz: f64, to_hz: f64 },
+    /// A periodic multisine ([`super::multisine`]): Schroeder phases on `lines` of
+    /// `from_hz..=to_hz` (spacing 1/`period_s`), RMS `amplitude`, `periods` periods,
+    /// a new value every sample, held in between (a D/A's zero-order hold).
+    Multisine {
+        period_s: f64,
+        periods: usize,
+        from_hz: f64,
+        to_hz: f64,
+        lines: LineSet,
+    },
+}
+
+impl Excitation {
+    /// Whether the torque is a sequence of sample values held by a D/A.
+    fn held(&self) -> bool {
+        matches!(
+            self,
+            Excitation::Noise { .. } | Excitation::Multisine { .. }
+        )
+    }
 }
 
 /// Conditions of the recorded test.
@@ -86,6 +107,9 @@ impl RecordTest {
                 frequencies_hz,
                 dwell_s,
             } => frequencies_hz.len() as f64 * dwell_s,
+            Excitation::Multisine {
+                period_s, periods, ..
+            } => *periods as f64 * period_s,
             _ => self.duration_s,
         }
     }
@@ -124,7 +148,7 @@ impl Drive {
                     let k = ((t / dwell_s).floor().max(0.0) as usize).min(frequencies_hz.len() - 1);
                     a * (TAU * frequencies_hz[k] * (t - k as f64 * dwell_s)).sin()
                 }
-                Excitation::Noise { .. } => {
+                Excitation::Noise { .. } | Excitation::Multisine { .. } => {
                     // Mid-sample times never round across a boundary.
                     let j = ((t / self.period).floor().max(0.0) as usize).min(self.held.len() - 1);
                     a * self.held[j]
@@ -141,16 +165,17 @@ impl Drive {
     /// The torque recorded with sample `i` at `t`: for held noise the value held from
     /// this instant on.
     fn sample(&self, i: usize, t: f64) -> f64 {
-        match self.excitation {
-            Excitation::Noise { .. } => self.at((i as f64 + 0.5) * self.period),
-            _ => self.at(t),
+        if self.excitation.held() {
+            self.at((i as f64 + 0.5) * self.period)
+        } else {
+            self.at(t)
         }
     }
 }
 
 impl TorqueInput for &Drive {
     fn step_torques(&mut self, t: f64, h: f64) -> [f64; 3] {
-        if matches!(self.excitation, Excitation::Noise { .. }) {
+        if self.excitation.held() {
             return [self.at(t + 0.5 * h); 3];
         }
         [self.at(t), self.at(t + 0.5 * h), self.at(t + h)]
@@ -222,6 +247,8 @@ pub enum RecordError {
         value: f64,
         why: &'static str,
     },
+    #[error("the multisine: {0}")]
+    Multisine(String),
 }
 
 fn check(name: &'static str, value: f64, ok: bool, why: &'static str) -> Result<(), RecordError> {
@@ -278,29 +305,98 @@ fn validate(test: &RecordTest) -> Result<(), RecordError> {
             )?;
             check("to_hz", *to_hz, to_hz > from_hz, "must be above from_hz")?;
         }
+        Excitation::Multisine {
+            period_s,
+            periods,
+            from_hz,
+            to_hz,
+            ..
+        } => {
+            check("period_s", *period_s, *period_s > 0.0, "must be positive")?;
+            check(
+                "periods",
+                *periods as f64,
+                *periods >= 3,
+                "need 3 or more (the first is dropped as transient, and the noise needs two)",
+            )?;
+            check("from_hz", *from_hz, *from_hz > 0.0, "must be positive")?;
+            check(
+                "to_hz",
+                *to_hz,
+                to_hz >= from_hz,
+                "must be at or above from_hz",
+            )?;
+        }
     }
     let duration = test.duration();
     check("duration_s", duration, duration > 0.0, "must be positive")
 }
 
+/// The generator's description of a multisine test sampled every `period` s (unit
+/// RMS); `None` for other excitations.
+fn multisine_spec(test: &RecordTest, period: f64) -> Option<MultisineSpec> {
+    let Excitation::Multisine {
+        period_s,
+        periods,
+        from_hz,
+        to_hz,
+        lines,
+    } = test.excitation
+    else {
+        return None;
+    };
+    Some(MultisineSpec {
+        sample_rate_hz: 1.0 / period,
+        samples_per_period: (period_s / period).round() as usize,
+        periods,
+        min_frequency_hz: from_hz,
+        max_frequency_hz: to_hz,
+        lines,
+        phases: PhaseRule::Schroeder,
+        level: Level::Rms(1.0),
+    })
+}
+
+/// One period of a multisine test at unit RMS, sampled every `period` s — which must
+/// divide its period.
+fn multisine_samples(test: &RecordTest, period: f64) -> Result<Vec<f64>, RecordError> {
+    let spec = multisine_spec(test, period).expect("a multisine test");
+    let n = spec.samples_per_period as f64 * period;
+    let period_s = test.duration() / spec.periods as f64;
+    check(
+        "period_s",
+        period_s,
+        (n - period_s).abs() <= 1e-9 * period_s,
+        "must be a whole number of sample periods",
+    )?;
+    multisine::generate(&spec)
+        .map(|m| m.period)
+        .map_err(|e| RecordError::Multisine(e.to_string()))
+}
+
 /// The drive of `test` on `p`, sampled every `period` s for `samples` samples.
-fn drive(p: &Params, test: &RecordTest, period: f64, samples: usize) -> Drive {
+fn drive(p: &Params, test: &RecordTest, period: f64, samples: usize) -> Result<Drive, RecordError> {
     let held = match test.excitation {
         Excitation::Noise {
             seed,
             from_hz,
             to_hz,
         } => band_limited_noise(samples.max(2), period, from_hz, to_hz, seed),
+        Excitation::Multisine { .. } => multisine_samples(test, period)?
+            .into_iter()
+            .cycle()
+            .take(samples)
+            .collect(),
         _ => Vec::new(),
     };
-    Drive {
+    Ok(Drive {
         excitation: test.excitation.clone(),
         amplitude: test.amplitude_nm,
         offset: test.preload_nm * p.ratio(),
         duration: test.duration(),
         held,
         period,
-    }
+    })
 }
 
 impl<'a> Sampler<'a> {
@@ -343,7 +439,7 @@ pub fn run(
     let every = ((1.0 / test.sample_rate_hz / dt).round() as u64).max(1);
     let period = every as f64 * dt;
     let samples = (test.duration() / period).round() as usize;
-    let drive = drive(p, test, period, samples);
+    let drive = drive(p, test, period, samples)?;
     let start = FrequencyTest {
         amplitude_nm: 0.0,
         preload_nm: test.preload_nm,
@@ -374,6 +470,39 @@ pub fn to_data(record: &Record) -> Data {
         motor_angle_rad: record.motor_angle.clone(),
         table_angle_rad: record.table_angle.clone(),
         extra: Default::default(),
+    }
+}
+
+/// The manifest's conditions of a multisine test: the period, one transient period,
+/// and the excited lines when they form a regular grid (else they are detected).
+fn multisine_conditions(test: &RecordTest, c: &mut experiment_file::Conditions) {
+    let Some(spec) = multisine_spec(test, 1.0 / test.sample_rate_hz) else {
+        return;
+    };
+    let period_s = test.duration() / spec.periods as f64;
+    c.excitation = Some(experiment_file::Excitation::Multisine);
+    c.period_s = Some(period_s);
+    c.transient_periods = Some(1);
+    let Ok(lines) = multisine::excited_lines(&spec) else {
+        return;
+    };
+    let step = match lines[..] {
+        [a, b, ..] => b - a,
+        _ => 1,
+    };
+    if lines.windows(2).all(|w| w[1] - w[0] == step) {
+        let hz = |k: usize| k as f64 / period_s;
+        c.first_line_hz = lines.first().map(|&k| hz(k));
+        c.last_line_hz = lines.last().map(|&k| hz(k));
+        c.line_step_hz = Some(hz(step));
+    }
+}
+
+fn line_set_name(lines: &LineSet) -> &'static str {
+    match lines {
+        LineSet::Full => "every line",
+        LineSet::Odd => "odd lines",
+        LineSet::RandomOdd { .. } => "random-odd lines",
     }
 }
 
@@ -409,6 +538,19 @@ pub fn manifest(p: &Params, test: &RecordTest) -> Manifest {
         Excitation::Chirp { from_hz, to_hz } => {
             c.excitation = Some(experiment_file::Excitation::Broadband);
             format!("linear chirp {from_hz}–{to_hz} Hz")
+        }
+        Excitation::Multisine {
+            period_s,
+            periods,
+            from_hz,
+            to_hz,
+            lines,
+        } => {
+            multisine_conditions(test, c);
+            format!(
+                "periodic multisine ({}), Schroeder phases, lines {from_hz}–{to_hz} Hz, {periods} periods of {period_s} s, torque RMS as the amplitude, held per sample",
+                line_set_name(lines)
+            )
         }
     };
     m.notes = Some(format!(

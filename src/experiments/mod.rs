@@ -16,6 +16,7 @@ pub mod measurement_noise;
 pub mod multisine;
 pub mod nonlinear_distortion;
 pub mod periodic_estimate;
+pub mod periodic_evaluation;
 pub mod periodic_record;
 pub mod positioning;
 pub mod servo_trace;

@@ -1,8 +1,7 @@
 //! The identified point assessed: each experiment's residuals (one evaluation serves
-//! the report, the cost and the uncertainty), the uncertainty, the check of a linear
-//! fit on the nonlinear test, and the warnings a user should read.
+//! the report, the cost and the uncertainty), the uncertainty, and the warnings a
+//! user should read.
 
-use super::config::Config;
 use super::plan::Plan;
 use super::problem::{describe, Best, Monitor};
 use super::result::{ExperimentResidual, NonlinearCheck};
@@ -13,8 +12,7 @@ use super::uncertainty::{self, Uncertainty};
 use super::warning::Warning;
 use super::IdentifyError;
 use crate::model::Params;
-use crate::objectives::model_peaks::nonlinear_peak_on_grid;
-use crate::objectives::{measured, sum_of_squares, Detail, Joint, ObjectiveError, Source};
+use crate::objectives::{sum_of_squares, Detail, Joint};
 
 /// What the assessment finds.
 pub struct Assessment {
@@ -27,12 +25,9 @@ pub struct Assessment {
 
 /// A resonance missed by more than this, Hz, is worth a warning.
 const RESONANCE_MISS_HZ: f64 = 1.0;
-/// A nonlinear shift of the resonances beyond this fraction is worth a warning.
-const NONLINEAR_SHIFT: f64 = 1e-2;
 
 /// Assesses the best point `best` (= `params`) of the stages `ran`.
 pub fn assess(
-    config: &Config,
     plan: &Plan,
     space: &ParamSpace,
     ran: &Ran,
@@ -55,7 +50,7 @@ pub fn assess(
             joint,
             &best.values,
             &stacked,
-            plan.uncertainty_step,
+            plan.uncertainty_step(ran.stages),
         )?;
         warnings.extend(a.warnings);
         if plan.declared.rough {
@@ -63,18 +58,11 @@ pub fn assess(
         }
         Some(a.uncertainty)
     };
-    let nonlinear_check = if plan.check_nonlinear && !interrupted {
-        let checks = nonlinear_check(config, params)?;
-        warnings.extend(checks.iter().filter_map(shift_warning));
-        Some(checks)
-    } else {
-        None
-    };
     Ok(Assessment {
         residuals,
         cost: sum_of_squares(&stacked),
         uncertainty,
-        nonlinear_check,
+        nonlinear_check: ran.check.clone(),
         warnings,
     })
 }
@@ -150,65 +138,4 @@ fn resonance_misses(residuals: &[ExperimentResidual]) -> Vec<Warning> {
             _ => None,
         })
         .collect()
-}
-
-/// The warning for a nonlinear check whose resonances moved beyond
-/// [`NONLINEAR_SHIFT`] (a NaN counts as beyond).
-fn shift_warning(c: &NonlinearCheck) -> Option<Warning> {
-    let worst = c
-        .model_hz
-        .iter()
-        .zip(&c.measured_hz)
-        .map(|(m, f)| ((m - f) / f).abs())
-        .fold(
-            0.0,
-            |a: f64, b| if b.is_nan() { f64::INFINITY } else { a.max(b) },
-        );
-    (worst > NONLINEAR_SHIFT).then(|| Warning::NonlinearShift {
-        source: c.source.clone(),
-        model_hz: c.model_hz.clone(),
-        measured_hz: c.measured_hz.clone(),
-        max_miss_hz: c.max_miss_hz,
-    })
-}
-
-/// The measured resonances against those of the nonlinear virtual test at the
-/// identified parameters, per measured gain curve — like for like: the test is
-/// simulated at the measured frequencies near each measured peak and its peak located
-/// as the measurement's was ([`nonlinear_peak_on_grid`]), so that at the true
-/// parameters it reproduces the measurement exactly and a difference is the
-/// linearisation's bias.
-fn nonlinear_check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, IdentifyError> {
-    let mut out = Vec::new();
-    for spec in &config.experiments {
-        let Some(grid) = measured::grid(&spec.experiment) else {
-            continue;
-        };
-        let source = Source {
-            file: &spec.source,
-            experiment: &spec.experiment,
-        };
-        let measured: Vec<f64> = measured::peaks(&source)?
-            .iter()
-            .map(|pk| pk.frequency_hz)
-            .collect();
-        let test = measured::frequency_test(&spec.experiment);
-        let model = measured
-            .iter()
-            .map(|&f| nonlinear_peak_on_grid(p, &test, &grid, f).map(|pk| pk.frequency_hz))
-            .collect::<Result<Vec<f64>, _>>()
-            .map_err(ObjectiveError::from)?;
-        let max_miss_hz = model
-            .iter()
-            .zip(&measured)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        out.push(NonlinearCheck {
-            source: spec.source.clone(),
-            measured_hz: measured,
-            model_hz: model,
-            max_miss_hz,
-        });
-    }
-    Ok(out)
 }

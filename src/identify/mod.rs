@@ -8,10 +8,10 @@
 //!    fitted parameters, the stages with their solver, starts and steps — pure;
 //! 3. [`space`]: the fitted parameters in the solvers' bounded coordinates;
 //! 4. [`stages`]: the multi-start [`search`] ([`problem`], [`solvers`]), then with
-//!    `--model nonlinear` the [`correction`]s by the nonlinear test, resumable from a
+//!    `--model nonlinear` — or `auto` when the [`escalation`] check finds the linear
+//!    fit off — the [`correction`]s by the nonlinear test, resumable from a
 //!    [`checkpoint`];
-//! 5. [`assess`]: residuals, [`uncertainty`], the nonlinear check and typed
-//!    [`warning`]s at the best point;
+//! 5. [`assess`]: residuals, [`uncertainty`] and typed [`warning`]s at the best point;
 //! 6. [`result`]: the result file; [`comparison`]: the fitted model against the data.
 //!
 //! Parallelism: starts run in parallel (rayon); inside one cost evaluation the
@@ -24,6 +24,7 @@ pub mod checkpoint;
 pub mod comparison;
 pub mod config;
 pub mod correction;
+pub mod escalation;
 pub mod plan;
 pub mod problem;
 pub mod result;

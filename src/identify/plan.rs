@@ -18,6 +18,9 @@ pub struct StagePlan {
     pub fidelity: Fidelity,
     /// The search's settings (for corrections: those of their linear sub-searches).
     pub settings: Settings,
+    /// Run only when the linear search's result fails the nonlinear check
+    /// (`--model auto`: [`super::escalation`]).
+    pub escalation: bool,
 }
 
 /// The whole plan.
@@ -29,10 +32,10 @@ pub struct Plan {
     /// What the search's objectives declare.
     pub declared: Declared,
     /// Whether the linear result is checked on the nonlinear test (`auto` with a gain
-    /// curve).
+    /// curve), which decides the escalation stage.
     pub check_nonlinear: bool,
-    /// Central-difference step (in ln p) of the Jacobian behind the standard errors.
-    pub uncertainty_step: f64,
+    /// Whether the search's objectives are rough (a closed-loop simulation).
+    rough: bool,
 }
 
 /// Forward-difference step of the Gauss–Newton Jacobian (solver coordinates) on a
@@ -69,6 +72,7 @@ impl Plan {
             config.fit.clone()
         };
         let nonlinear = config.fidelity == FidelityChoice::Nonlinear;
+        let auto = config.fidelity == FidelityChoice::Auto;
         // Without a measured gain curve there are no flanks to correct on: a
         // nonlinear fit then searches on the nonlinear test directly.
         let first = if nonlinear && !declared.gain_curve {
@@ -98,8 +102,9 @@ impl Plan {
                 max_evaluations: o.max_evaluations,
                 simplex_step: SIMPLEX_STEP,
             },
+            escalation: false,
         }];
-        if nonlinear && declared.gain_curve {
+        if (nonlinear || auto) && declared.gain_curve {
             stages.push(StagePlan {
                 stage: Stage::Correction,
                 fidelity: Fidelity::Nonlinear,
@@ -112,16 +117,30 @@ impl Plan {
                     max_evaluations: o.max_evaluations,
                     simplex_step: SIMPLEX_STEP,
                 },
+                escalation: auto,
             });
         }
-        let last = stages.last().map_or(first, |s| s.fidelity);
         Ok(Plan {
             fit,
             stages,
             declared,
-            check_nonlinear: config.fidelity == FidelityChoice::Auto && declared.gain_curve,
-            uncertainty_step: uncertainty_step(rough, last),
+            check_nonlinear: auto && declared.gain_curve,
+            rough,
         })
+    }
+
+    /// The central-difference step (in ln p) of the Jacobian behind the standard
+    /// errors, when the first `ran` stages have run.
+    pub fn uncertainty_step(&self, ran: usize) -> f64 {
+        uncertainty_step(self.rough, self.last_fidelity(ran))
+    }
+
+    /// The model of the last of the first `ran` stages (the first stage's when none
+    /// ran).
+    fn last_fidelity(&self, ran: usize) -> Fidelity {
+        self.stages[..ran.clamp(1, self.stages.len())]
+            .last()
+            .map_or(Fidelity::Linear, |s| s.fidelity)
     }
 
     /// The plan of a search that starts at a direct estimate
@@ -131,14 +150,15 @@ impl Plan {
         self
     }
 
-    /// What the result says of the model: `linear`, `nonlinear`, `linear, then
-    /// nonlinear`; `nonlinear time simulation` when no objective depends on the
-    /// frequency-response model (a torque curve is always simulated).
-    pub(crate) fn fidelity_label(&self) -> String {
+    /// What the result says of the model after the first `ran` stages: `linear`,
+    /// `nonlinear`, `linear, then nonlinear`; `nonlinear time simulation` when no
+    /// objective depends on the frequency-response model (a torque curve is always
+    /// simulated).
+    pub(crate) fn fidelity_label(&self, ran: usize) -> String {
         if !self.declared.frequency_response {
             return "nonlinear time simulation".into();
         }
-        self.stages
+        self.stages[..ran.clamp(1, self.stages.len())]
             .iter()
             .map(|s| s.fidelity.name())
             .collect::<Vec<_>>()

@@ -33,13 +33,18 @@ pub struct ExperimentResidual {
     pub detail: Option<Detail>,
 }
 
-/// The resonances of the nonlinear virtual test at the identified parameters.
+/// The resonances of the nonlinear virtual test at the linear search's result, and
+/// how far the linear model's gain is from the measured curve there.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct NonlinearCheck {
     pub source: String,
     pub measured_hz: Vec<f64>,
     pub model_hz: Vec<f64>,
     pub max_miss_hz: f64,
+    /// RMS of the linear model's gain against the measured curve, dB (at the same
+    /// parameters, every valid measured frequency).
+    #[serde(default)]
+    pub linear_misfit_db: f64,
 }
 
 /// The result of `rtid identify`.
@@ -70,7 +75,8 @@ pub struct IdentifyResult {
     pub interrupted: bool,
     pub starts: Vec<StartRecord>,
     pub uncertainty: Option<Uncertainty>,
-    /// With `--model auto`: the resonances of the nonlinear virtual test at the result.
+    /// With `--model auto`: the resonances of the nonlinear virtual test at the linear
+    /// search's result — the check that decides whether the nonlinear fit follows.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub nonlinear_check: Option<Vec<NonlinearCheck>>,
     /// What the user should know about this fit: a code and a message each.
@@ -98,6 +104,8 @@ pub struct Run {
     pub wall_time_s: f64,
     pub interrupted: bool,
     pub warnings: Vec<Warning>,
+    /// How many of the plan's stages ran.
+    pub stages: usize,
 }
 
 /// The result of `config` run under `plan` in `space`.
@@ -143,7 +151,7 @@ pub fn assemble(
             .map(|(n, b)| (n.to_string(), [b.lo, b.hi]))
             .collect(),
         method: plan.stages[0].settings.method.name().into(),
-        fidelity: plan.fidelity_label(),
+        fidelity: plan.fidelity_label(run.stages),
         cost: assessment.cost,
         residuals: assessment.residuals,
         evaluations: run.evaluations,

@@ -64,10 +64,11 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
     if let Some((path, error)) = checkpoint.finish(monitor.evaluations()) {
         warnings.push(Warning::CheckpointNotWritten { path, error });
     }
-    let assessment = assess(config, &plan, &space, &ran, &best, &params, monitor)?;
+    let assessment = assess(&plan, &space, &ran, &best, &params, monitor)?;
     let run = Run {
         values: best.values,
         start_estimates: start.estimates,
+        stages: ran.stages,
         starts: ran.starts,
         evaluations: monitor.evaluations(),
         wall_time_s: clock.elapsed().as_secs_f64(),

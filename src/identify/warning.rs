@@ -61,12 +61,15 @@ pub enum Warning {
     RoughCost,
     /// An experiment's direct estimate of where to start was not used.
     EstimateUnused { source: String, values: String },
-    /// The nonlinear virtual test puts the resonances more than 1 % from the linear fit.
-    NonlinearShift {
+    /// `--model auto` went on to the nonlinear fit: the nonlinear virtual test at the
+    /// linear fit puts the resonances more than 0.5 % from the measured ones.
+    Escalated {
         source: String,
         model_hz: Vec<f64>,
         measured_hz: Vec<f64>,
         max_miss_hz: f64,
+        max_miss_percent: f64,
+        linear_misfit_db: f64,
     },
 }
 
@@ -87,7 +90,7 @@ impl Warning {
             Warning::Correlated { .. } => "correlated",
             Warning::RoughCost => "rough_cost",
             Warning::EstimateUnused { .. } => "estimate_unused",
-            Warning::NonlinearShift { .. } => "nonlinear_shift",
+            Warning::Escalated { .. } => "escalated",
         }
     }
 }
@@ -153,14 +156,16 @@ impl fmt::Display for Warning {
                 f,
                 "{source}: its direct estimate ({values}) is not a valid parameter set, so the search starts at the given values instead — check the record (too little motion, a wrong unit or sign)"
             ),
-            Warning::NonlinearShift {
+            Warning::Escalated {
                 source,
                 model_hz,
                 measured_hz,
                 max_miss_hz,
+                max_miss_percent,
+                linear_misfit_db,
             } => write!(
                 f,
-                "{source}: fitted on the linear response, but the nonlinear virtual test at the measured conditions puts the resonances at {} Hz (measured {} Hz): a shift of up to {max_miss_hz:.2} Hz (over 1 %): backlash or friction bias the linear fit — use the nonlinear model (slower), or a preloaded test",
+                "{source}: the linear fit does not explain the data — the nonlinear virtual test at its parameters puts the resonances at {} Hz (measured {} Hz), up to {max_miss_hz:.2} Hz ({max_miss_percent:.2} %) off, and the linear model's gain misses the measured curve by {linear_misfit_db:.2} dB RMS — beyond 0.5 % (a stiffness biased twice as much) or 1 dB (a flattened or misplaced peak): backlash or friction at the test's amplitude. So the result is the nonlinear fit, the linear one corrected by the nonlinear test",
                 hz(model_hz),
                 hz(measured_hz)
             ),

@@ -49,6 +49,7 @@ pub fn figures(e: &Evaluation, mechanism: &str) -> (Figure, Option<Figure>) {
             let coherence = coherence(bins, *min_coherence, mechanism);
             (gain.with(markers), Some(coherence))
         }
+        Evaluation::Periodic(p) => super::periodic::figures(p, mechanism),
     }
 }
 

@@ -6,6 +6,7 @@ pub mod fluctuation;
 pub mod frequency_response;
 pub mod frequency_response_time;
 pub mod identify;
+pub mod periodic;
 pub mod positioning;
 pub mod servo_trace;
 pub mod sweep;

@@ -49,6 +49,22 @@ pub fn worm_frequency_response_noisy() -> Fixture {
     fixture("worm-gear-noisy/frequency_response.json", "worm-gear")
 }
 
+/// The worm gear at the paper's ±5 N·m without preload or backlash, friction on, Kw
+/// and Kg moved off the preset (3.6e5 N·m/rad, 760 N·m/rad), 1 % noise: made like an
+/// independent simulator's record (issue 12). Friction flattens the second resonance.
+pub fn worm_frequency_response_with_friction() -> Fixture {
+    let mut f = fixture("worm-gear-friction/frequency_response.json", "worm-gear");
+    for (name, value) in [
+        ("theta_bw", 0.0),
+        ("theta_bg", 0.0),
+        ("Kw", 3.6e5),
+        ("Kg", 760.0),
+    ] {
+        f.truth.set(name, value).expect("a worm parameter");
+    }
+    f
+}
+
 /// The worm gear's friction-torque curve (full-closed loop, 30°·sin(2πt/3 s)).
 pub fn worm_torque_curve() -> Fixture {
     fixture("worm-gear/torque_curve.json", "worm-gear")

@@ -12,13 +12,14 @@ use rtid::experiments::frequency_response_estimate::{
     self as estimate, EstimateOptions, Evaluation,
 };
 use rtid::experiments::frequency_response_record::{self as record, Excitation, RecordTest};
+use rtid::experiments::multisine::LineSet;
 use rtid::io::experiment_file::{self, Experiment};
 use std::fmt::Write as _;
 
 pub const LONG_ABOUT: &str = "\
 The frequency-response test (paper §4.1) recorded as raw time series, the way a DAQ on a \
 real rig records it: one continuous open-loop run under a stepped sine, band-limited \
-random noise or a chirp, sampling motor torque, motor angle and table angle (encoders \
+random noise, a chirp or a periodic multisine, sampling motor torque, motor angle and table angle (encoders \
 quantised, table 0.0001°, plus optional --noise-arcsec) at --sample-rate-hz. Written as a \
 `frequency_response_time` experiment file (docs/experiment-files.md), which `rtid \
 evaluate` turns into the gain curve; a measured recording in the same format is evaluated \
@@ -29,15 +30,23 @@ Evaluation (docs/experiments.md): a stepped sine is demodulated per dwell (the f
 cycles); noise and chirp records give the H1 estimate with Welch averaging (Hann window, \
 50 % overlap, --segment-s long segments: resolution 1/segment) and the coherence γ². Bins \
 with γ² below --min-coherence are flagged and left out of the peak search. Gain = table \
-angle / (motor angle × Rg·Rw), in dB; its peaks are the resonances.
+angle / (motor angle × Rg·Rw), in dB; its peaks are the resonances. A multisine record \
+(manifest `\"excitation\": \"multisine\"`) is cut into whole periods (no window, no \
+leakage; the first dropped as transient) and gives both channels at the excited lines — \
+table/motor by the reference ratio, motor/torque (or motor/current) by H1 — with the \
+noise of each line from the spread over the periods; resonances and antiresonances are \
+the extrema that stand out of that noise, located by a rational fit around them; the \
+lines left out measure the nonlinear distortion (docs/multisine.md).
 
 Outputs, in --out DIR: frequency_response_time.json/.csv, frequency_response_time.svg (the \
-gain, kept bins only, with the resonances) and, for noise and chirp, \
+gain, kept bins only, with the resonances; a multisine's both channels with resonances \
+and antiresonances) and, for noise, chirp and multisine, \
 frequency_response_time-coherence.svg.
 
 Examples:
   rtid experiment frequency-response-time --preset worm-gear --out runs/worm
   rtid experiment frequency-response-time --preset worm-gear --excitation stepped-sine --from-hz 150 --to-hz 260 --step-hz 2 --out runs/stepped
+  rtid experiment frequency-response-time --preset worm-gear --excitation multisine --from-hz 100 --to-hz 400 --preload-nm 6 --out runs/multisine
   rtid experiment frequency-response-time --preset worm-gear --preload-nm 6 --noise-arcsec 1 --out runs/noisy";
 
 /// The excitations.
@@ -49,6 +58,21 @@ pub enum ExcitationKind {
     Noise,
     /// A linear chirp from --from-hz to --to-hz over --duration-s.
     Chirp,
+    /// A periodic multisine: --periods periods of --period-s, Schroeder phases on the
+    /// --lines of --from-hz … --to-hz (spacing 1/period), RMS --amplitude-nm.
+    Multisine,
+}
+
+/// Which lines a multisine excites.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum LinesArg {
+    /// Every line of the band: the densest gain curve; distortion not seen.
+    Full,
+    /// Odd lines: even-degree distortion seen at the even lines.
+    Odd,
+    /// Odd lines, one of every four left out at random: odd- and even-degree
+    /// distortion seen apart from the noise.
+    RandomOdd,
 }
 
 /// How a record is evaluated (shared with `rtid evaluate`).
@@ -86,7 +110,7 @@ pub struct Args {
     /// The motor-torque excitation.
     #[arg(long, value_enum, default_value = "noise")]
     pub excitation: ExcitationKind,
-    /// Sine or chirp amplitude, or the noise's standard deviation, N·m.
+    /// Sine or chirp amplitude, or the noise's or multisine's RMS, N·m.
     #[arg(long, value_name = "NM", default_value_t = 5.0)]
     pub amplitude_nm: f64,
     /// Table brake torque balanced by a motor DC torque, N·m (keeps the flanks loaded).
@@ -112,6 +136,15 @@ pub struct Args {
     /// Noise and chirp: record length, s.
     #[arg(long, value_name = "SECONDS", default_value_t = 16.0)]
     pub duration_s: f64,
+    /// Multisine: the period, s (line spacing 1/period; a whole number of samples).
+    #[arg(long, value_name = "SECONDS", default_value_t = 1.0)]
+    pub period_s: f64,
+    /// Multisine: periods recorded (the first is dropped as transient when evaluated).
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    pub periods: usize,
+    /// Multisine: which lines of the band are excited.
+    #[arg(long, value_enum, default_value = "random-odd")]
+    pub lines: LinesArg,
     /// Sampling rate of the record, Hz (period rounded to whole integration steps).
     #[arg(long, value_name = "HZ", default_value_t = 5000.0)]
     pub sample_rate_hz: f64,
@@ -159,7 +192,24 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             from_hz: from,
             to_hz: to,
         },
+        ExcitationKind::Multisine => Excitation::Multisine {
+            period_s: positive(a.period_s, "--period-s")?,
+            periods: a.periods,
+            from_hz: positive(from, "--from-hz")?,
+            to_hz: to,
+            lines: match a.lines {
+                LinesArg::Full => LineSet::Full,
+                LinesArg::Odd => LineSet::Odd,
+                LinesArg::RandomOdd => LineSet::RandomOdd {
+                    group: 4,
+                    seed: a.seed,
+                },
+            },
+        },
     };
+    if a.excitation == ExcitationKind::Multisine && a.periods < 3 {
+        bail!("--periods {}: need 3 or more (the first is dropped as transient, and the noise needs two)", a.periods);
+    }
     let test = RecordTest {
         excitation,
         amplitude_nm: positive(a.amplitude_nm, "--amplitude-nm")?,
@@ -212,10 +262,20 @@ pub fn report_with(
         let mut value = serde_json::to_value(&e)?;
         value["kind"] = serde_json::json!(exp.manifest.kind.name());
         value["source"] = serde_json::json!(exp.path);
+        if let Evaluation::Periodic(p) = &e {
+            if let (Some(v), serde_json::Value::Object(keys)) =
+                (value.as_object_mut(), super::periodic_summary::hz_keys(p))
+            {
+                v.extend(keys);
+            }
+        }
         println!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }
-    println!("{}", summary(&e, &exp.path));
+    match &e {
+        Evaluation::Periodic(p) => println!("{}", super::periodic_summary::summary(p, &exp.path)),
+        _ => println!("{}", summary(&e, &exp.path)),
+    }
     Ok(())
 }
 
@@ -237,6 +297,7 @@ fn summary(e: &Evaluation, source: &Path) -> String {
     match e {
         Evaluation::SteppedSine { .. } => stepped_sine_summary(e, &mut s),
         Evaluation::H1 { .. } => h1_summary(e, &mut s),
+        Evaluation::Periodic(_) => {}
     }
     let _ = writeln!(
         s,

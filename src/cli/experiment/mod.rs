@@ -6,6 +6,7 @@ pub mod check;
 pub mod fluctuation;
 pub mod frequency_response;
 pub mod frequency_response_time;
+pub mod periodic_summary;
 pub mod positioning;
 pub mod servo_trace;
 pub mod torque_curve;
