@@ -9,7 +9,9 @@
 //!
 //! All run in the bound-respecting solver coordinates of [`super::space`].
 
-use argmin::core::{Executor, State, TerminationReason, TerminationStatus};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use argmin::core::{CostFunction, Executor, State, TerminationReason, TerminationStatus};
 use argmin::solver::gaussnewton::GaussNewtonLS;
 use argmin::solver::linesearch::{condition::ArmijoCondition, BacktrackingLineSearch};
 use argmin::solver::neldermead::NelderMead;
@@ -94,6 +96,10 @@ pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limit
             let solver = NelderMead::new(simplex)
                 .with_sd_tolerance(1e-8)
                 .expect("positive");
+            let problem = SimplexStart {
+                problem,
+                left: AtomicUsize::new(n + 1),
+            };
             Executor::new(problem, solver)
                 .configure(|s| s.max_iters(limits.max_iters))
                 .run()
@@ -138,6 +144,32 @@ pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limit
             iterations: 0,
             termination: failure(&e, monitor.stopped()),
         },
+    }
+}
+
+/// The problem as Nelder–Mead sees it. argmin 0.11's Nelder–Mead unwraps the costs of
+/// its starting simplex, so a stop (Ctrl-C, an evaluation budget reached by another
+/// start) during those n + 1 evaluations would panic: there an interrupted evaluation
+/// costs +∞ instead, and the first evaluation after them reports the interruption.
+struct SimplexStart<'a> {
+    problem: Problem<'a>,
+    /// Evaluations of the starting simplex still to come.
+    left: AtomicUsize,
+}
+
+impl CostFunction for SimplexStart<'_> {
+    type Param = DVector<f64>;
+    type Output = f64;
+
+    fn cost(&self, x: &Self::Param) -> Result<f64, argmin::core::Error> {
+        let starting = self
+            .left
+            .fetch_update(Ordering::Relaxed, Ordering::Relaxed, |k| k.checked_sub(1))
+            .is_ok();
+        match self.problem.cost(x) {
+            Err(_) if starting && self.problem.monitor.stopped() => Ok(f64::INFINITY),
+            r => r,
+        }
     }
 }
 
