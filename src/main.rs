@@ -3,13 +3,14 @@
 
 use std::process::ExitCode;
 
-use clap::Parser;
+use clap::{CommandFactory, FromArgMatches};
 
 mod cli;
 
 fn main() -> ExitCode {
     quiet_on_broken_pipe();
-    let cli = cli::Cli::parse();
+    let matches = negative_numbers(cli::Cli::command()).get_matches();
+    let cli = cli::Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     match cli::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -17,6 +18,15 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Every option and subcommand, recursively, takes a negative number as its value:
+/// `--preload-nm -3` means what it says, and `--amplitude-nm -1` reaches the option's
+/// own check ("--amplitude-nm -1: must be positive") instead of clap's "unexpected
+/// argument '-1'", which does not name the option.
+fn negative_numbers(c: clap::Command) -> clap::Command {
+    c.mut_args(|a| a.allow_negative_numbers(true))
+        .mut_subcommands(negative_numbers)
 }
 
 /// `rtid … | head`: when the reader closes the pipe, `println!` panics with

@@ -21,3 +21,33 @@ pub struct BadForm {
     /// The form, with an example.
     pub expected: &'static str,
 }
+
+/// A number as a message shows it: plain in the usual range, in scientific notation
+/// when very large or very small (`1e-300`, not three hundred zeros).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Num(pub f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a == 0.0 || !a.is_finite() || (1e-4..1e9).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
+}
+
+#[cfg(test)]
+mod num_tests {
+    use super::Num;
+
+    #[test]
+    fn extreme_numbers_are_short() {
+        assert_eq!(Num(1e-300).to_string(), "1e-300");
+        assert_eq!(Num(-2.5e308).to_string(), "-2.5e308");
+        assert_eq!(Num(3600.0).to_string(), "3600");
+        assert_eq!(Num(0.05).to_string(), "0.05");
+        assert_eq!(Num(f64::NAN).to_string(), "NaN");
+    }
+}

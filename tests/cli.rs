@@ -1372,3 +1372,238 @@ fn a_multisine_record_with_a_wrong_period_is_one_clear_error() {
     let out = rtid(&["evaluate", "broadband.json"], dir.path());
     assert_one_line_error(&out, &["broadband.json", "multisine"]);
 }
+
+/// Work is estimated before it starts: sizes that would allocate terabytes, run for
+/// ever or stall the eigen-solver are refused at once, naming the options and the
+/// limit (issue 13). Numbers in the messages stay short.
+#[test]
+fn absurd_sizes_and_values_are_refused_before_any_work() {
+    let dir = tempdir();
+    let sine = "sine:freq_hz=100,amp_nm=5";
+    let cases: &[(&[&str], &[&str])] = &[
+        (
+            &[
+                "experiment",
+                "frequency-response",
+                "--preset",
+                "worm-gear",
+                "--to-hz",
+                "1e308",
+                "--out",
+                "a",
+            ],
+            &["--to-hz", "frequencies", "RTID_ALLOW_LARGE"],
+        ),
+        (
+            &[
+                "experiment",
+                "frequency-response",
+                "--preset",
+                "worm-gear",
+                "--step-hz",
+                "1e-300",
+                "--out",
+                "a",
+            ],
+            &["--step-hz", "limit"],
+        ),
+        (
+            &[
+                "experiment",
+                "torque-curve",
+                "--preset",
+                "worm-gear",
+                "--periods",
+                "1e9",
+                "--out",
+                "a",
+            ],
+            &["--periods", "simulated seconds", "3600"],
+        ),
+        (
+            &[
+                "experiment",
+                "torque-curve",
+                "--preset",
+                "worm-gear",
+                "--period-s",
+                "1e308",
+                "--out",
+                "a",
+            ],
+            &["--period-s", "simulated seconds"],
+        ),
+        (
+            &[
+                "experiment",
+                "positioning",
+                "--preset",
+                "worm-gear",
+                "--runs",
+                "4000000000",
+                "--out",
+                "a",
+            ],
+            &["--runs", "readings"],
+        ),
+        (
+            &[
+                "experiment",
+                "positioning",
+                "--preset",
+                "worm-gear",
+                "--target-step-deg",
+                "1e-300",
+                "--out",
+                "a",
+            ],
+            &["--target-step-deg 1e-300", "targets"],
+        ),
+        (
+            &[
+                "simulate",
+                "--preset",
+                "worm-gear",
+                "--duration-s",
+                "1e308",
+                "--input",
+                sine,
+                "--out",
+                "r.csv",
+            ],
+            &["--duration-s", "integration steps"],
+        ),
+        (
+            &[
+                "simulate",
+                "--preset",
+                "worm-gear",
+                "--dt-s",
+                "5e-324",
+                "--input",
+                sine,
+                "--duration-s",
+                "0.1",
+                "--out",
+                "r.csv",
+            ],
+            &["--dt-s", "integration steps"],
+        ),
+        (
+            &[
+                "simulate",
+                "--preset",
+                "worm-gear",
+                "--set",
+                "Kw=1e308",
+                "--input",
+                sine,
+                "--duration-s",
+                "0.1",
+                "--out",
+                "r.csv",
+            ],
+            &["theta_w", "rad/s", "typo"],
+        ),
+        (
+            &[
+                "simulate",
+                "--preset",
+                "worm-gear",
+                "--set",
+                "r=1e-300",
+                "--input",
+                sine,
+                "--duration-s",
+                "0.1",
+                "--out",
+                "r.csv",
+            ],
+            &["rad/s", "typo"],
+        ),
+        (
+            &["modes", "--preset", "worm-gear", "--set", "Kw=1e308"],
+            &["theta_w", "rad/s"],
+        ),
+        (
+            &[
+                "experiment",
+                "frequency-response",
+                "--preset",
+                "worm-gear",
+                "--amplitude-nm",
+                "-1",
+                "--out",
+                "a",
+            ],
+            &["--amplitude-nm -1", "positive"],
+        ),
+        (
+            &[
+                "experiment",
+                "frequency-response-time",
+                "--preset",
+                "worm-gear",
+                "--sample-rate-hz",
+                "-5",
+                "--out",
+                "a",
+            ],
+            &["--sample-rate-hz -5", "positive"],
+        ),
+    ];
+    for (args, needles) in cases {
+        let out = rtid(args, dir.path());
+        let line = assert_one_line_error(&out, needles);
+        assert!(line.len() < 400, "{args:?}: a short message: {line}");
+        assert!(
+            !line.contains("00000000"),
+            "{args:?}: a readable number: {line}"
+        );
+    }
+    assert!(!dir.path().join("a").exists() && !dir.path().join("r.csv").exists());
+}
+
+/// A negative value reaches the option's own check instead of clap's "unexpected
+/// argument": the option is named either way.
+#[test]
+fn a_negative_value_names_its_option() {
+    let dir = tempdir();
+    let out = rtid(
+        &[
+            "identify",
+            "x.json",
+            "--preset",
+            "worm-gear",
+            "--starts",
+            "-2",
+        ],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(
+        err.lines().next().unwrap_or("").contains("--starts"),
+        "{err}"
+    );
+    // A negative preload means a brake the other way: accepted as a value.
+    let out = rtid(
+        &[
+            "experiment",
+            "frequency-response",
+            "--preset",
+            "worm-gear",
+            "--preload-nm",
+            "-3",
+            "--from-hz",
+            "100",
+            "--to-hz",
+            "110",
+            "--out",
+            "neg",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+}

@@ -8,6 +8,7 @@ use std::time::Instant;
 use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
+use super::experiment::check;
 use super::ModelArgs;
 use rtid::input::{Move, NoTorque, Samples, Sine, Step};
 use rtid::io::{atomic, torque_file};
@@ -219,6 +220,12 @@ impl<W: Write> Recorder for CsvRecorder<W> {
     }
 }
 
+/// Integration steps of one run (≈ 10 minutes of a worm-gear simulation).
+const MAX_STEPS: f64 = 1e9;
+
+/// Rows of the output CSV (≈ 3 GB).
+const MAX_ROWS: f64 = 2e7;
+
 impl Args {
     /// The numeric options, checked before anything runs.
     fn check(&self) -> anyhow::Result<()> {
@@ -254,7 +261,20 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         None => Simulation::with_default_step(&p)?,
     };
     sim.set_load(a.load_nm);
+    let steps = a.duration_s / sim.dt();
+    check::work(
+        steps,
+        MAX_STEPS,
+        "integration steps",
+        "--duration-s over --dt-s (or the default step)",
+    )?;
     let every = ((a.sample_s / sim.dt()).round() as u64).max(1);
+    check::work(
+        steps / every as f64,
+        MAX_ROWS,
+        "rows of CSV",
+        "--duration-s over --sample-s",
+    )?;
     let started = Instant::now();
     let closed = matches!(a.input, InputSpec::Move { .. });
     let mut recorded = match &a.input {

@@ -57,6 +57,11 @@ pub struct LinearModel {
     pub rigid_modes: usize,
 }
 
+/// The fastest rate, rad/s, a model may have (≈ 16 MHz): a drive's modes lie below
+/// 100 kHz; beyond this the parameters are a typo or a unit slip, and the integration
+/// step would be below 1 ns.
+pub const MAX_RATE: f64 = 1e8;
+
 impl LinearModel {
     /// Validates `p` and builds the matrices of the module docs (motor free).
     pub fn new(p: &Params) -> Result<Self, ParamError> {
@@ -115,7 +120,28 @@ impl LinearModel {
                 }
             }
         };
+        model.check_rates()?;
         Ok(model)
+    }
+
+    /// Refuses a model whose stiffness or damping over inertia, at any coordinate,
+    /// exceeds [`MAX_RATE`]: a bound on the fastest eigenvalue (Gershgorin's, cheap and
+    /// always finite or infinite — never the eigen-solver's endless iteration on
+    /// entries of 1e300), which no drive reaches and no integration step could follow.
+    fn check_rates(&self) -> Result<(), ParamError> {
+        for (i, dof) in self.dofs.iter().enumerate() {
+            let m = self.m[(i, i)];
+            let row = |a: &DMatrix<f64>| a.row(i).iter().map(|x| x.abs()).sum::<f64>() / m;
+            let rate = row(&self.k).sqrt() + row(&self.c);
+            if rate.is_nan() || rate > MAX_RATE {
+                return Err(ParamError::TooFast {
+                    coordinate: dof,
+                    rate,
+                    limit: MAX_RATE,
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Number of degrees of freedom.

@@ -12,6 +12,7 @@
 //! by [`Params::set`] and [`Params::validate`] with an error naming it. The JSON form
 //! is `params_json.rs`.
 
+use crate::names::Num;
 use std::collections::BTreeMap;
 use std::fmt;
 
@@ -307,16 +308,16 @@ pub const GRAVITY: f64 = 9.80665;
 pub enum ParamError {
     #[error("unknown parameter `{name}`{suggestion}; `rtid params` lists the names")]
     Unknown { name: String, suggestion: String },
-    #[error("parameter {name} = {value} is not a finite number")]
+    #[error("parameter {name} = {} is not a finite number", Num(*value))]
     NotFinite { name: &'static str, value: f64 },
-    #[error("parameter {name} = {value} {unit} must be positive ({meaning})")]
+    #[error("parameter {name} = {} {unit} must be positive ({meaning})", Num(*value))]
     NotPositive {
         name: &'static str,
         value: f64,
         unit: &'static str,
         meaning: &'static str,
     },
-    #[error("parameter {name} = {value} {unit} must not be negative ({meaning})")]
+    #[error("parameter {name} = {} {unit} must not be negative ({meaning})", Num(*value))]
     Negative {
         name: &'static str,
         value: f64,
@@ -328,11 +329,17 @@ pub enum ParamError {
         name: &'static str,
         meaning: &'static str,
     },
-    #[error("parameter {name} = {value} must be 0 or 1 ({meaning})")]
+    #[error("parameter {name} = {} must be 0 or 1 ({meaning})", Num(*value))]
     NotZeroOrOne {
         name: &'static str,
         value: f64,
         meaning: &'static str,
+    },
+    #[error("the parameters make the drive's {coordinate} move at up to {rate:.2e} rad/s (its stiffnesses and dampings over its inertia), beyond {limit:.0e} rad/s — no drive is that fast and no integration step could follow it: check those values for a typo or a unit slip")]
+    TooFast {
+        coordinate: &'static str,
+        rate: f64,
+        limit: f64,
     },
     #[error("parameter {name} is required by the spur_gear topology ({meaning})")]
     Missing {
@@ -351,7 +358,7 @@ pub enum ParamError {
     NotForAxis { name: &'static str, axis: Axis },
     #[error("a linear axis needs the direct_drive or two_mass topology, not {topology}")]
     LinearTopology { topology: Topology },
-    #[error("parameter {name} = {value}: {reason}")]
+    #[error("parameter {name} = {}: {reason}", Num(*value))]
     Inconsistent {
         name: &'static str,
         value: f64,

@@ -2,13 +2,14 @@
 //! bad value fails at once and not after a simulation.
 
 use anyhow::bail;
+use rtid::names::Num;
 
 /// A positive finite value.
 pub fn positive(v: f64, option: &str) -> anyhow::Result<f64> {
     if v > 0.0 && v.is_finite() {
         Ok(v)
     } else {
-        bail!("{option} {v}: must be a positive number")
+        bail!("{option} {}: must be a positive number", Num(v))
     }
 }
 
@@ -17,7 +18,7 @@ pub fn non_negative(v: f64, option: &str) -> anyhow::Result<f64> {
     if v >= 0.0 && v.is_finite() {
         Ok(v)
     } else {
-        bail!("{option} {v}: must be zero or positive")
+        bail!("{option} {}: must be zero or positive", Num(v))
     }
 }
 
@@ -26,6 +27,32 @@ pub fn finite(v: f64, option: &str) -> anyhow::Result<f64> {
     if v.is_finite() {
         Ok(v)
     } else {
-        bail!("{option} {v}: must be a finite number")
+        bail!("{option} {}: must be a finite number", Num(v))
     }
+}
+
+/// The environment variable that lifts the work limits for a rare large job.
+pub const ALLOW_LARGE: &str = "RTID_ALLOW_LARGE";
+
+/// Frequencies, samples or points one command may ask for.
+pub const MAX_POINTS: f64 = 1e5;
+
+/// Seconds of simulated time one run may ask for (an hour: the paper's tests need
+/// minutes; a worm-gear run simulates ≈ 40 s per wall-clock second on one core).
+pub const MAX_SIMULATED_S: f64 = 3600.0;
+
+/// Work estimated before it starts: `amount` (of `what`) from `options` must stay
+/// within `limit`, unless [`ALLOW_LARGE`] is set to 1. A non-finite amount is always
+/// refused.
+pub fn work(amount: f64, limit: f64, what: &str, options: &str) -> anyhow::Result<()> {
+    let allowed = std::env::var(ALLOW_LARGE).is_ok_and(|v| v == "1");
+    if amount.is_finite() && (amount <= limit || allowed) {
+        return Ok(());
+    }
+    if !amount.is_finite() {
+        bail!("{options}: ask for more {what} than can be counted");
+    }
+    bail!(
+        "{options}: ask for {amount:.3e} {what}, over the limit of {limit} (set {ALLOW_LARGE}=1 to run it anyway)"
+    )
 }

@@ -106,6 +106,12 @@ pub fn run_test(
     test: &FluctuationTest,
     run: &RunArgs,
 ) -> anyhow::Result<()> {
+    check::work(
+        test.duration(),
+        check::MAX_SIMULATED_S,
+        "simulated seconds",
+        "--speed-deg-per-min, --revolutions, --run-in-deg",
+    )?;
     let name = test.kind().name();
     if p.axis == rtid::model::Axis::Linear {
         anyhow::bail!(

@@ -86,9 +86,25 @@ impl Args {
             bail!("--to-hz {to} is below --from-hz {from}");
         }
         check::non_negative(self.refine_step_hz, "--refine-step-hz")?;
+        if self.refine_step_hz > 0.0 {
+            let around = 2.0 * FrequencyTest::default().refine_half_width_hz / self.refine_step_hz;
+            check::work(
+                around,
+                check::MAX_POINTS,
+                "frequencies around each resonance",
+                "--refine-step-hz",
+            )?;
+        }
         check::finite(self.preload_nm, "--preload-nm")?;
         check::non_negative(self.noise_percent, "--noise-percent")?;
-        let count = ((to - from) / step + 1e-9).floor() as usize;
+        let count = ((to - from) / step + 1e-9).floor();
+        check::work(
+            count + 1.0,
+            check::MAX_POINTS,
+            "frequencies",
+            "--from-hz, --to-hz, --step-hz",
+        )?;
+        let count = count as usize;
         Ok(FrequencyTest {
             frequencies_hz: (0..=count).map(|i| from + step * i as f64).collect(),
             amplitude_nm: check::positive(self.amplitude_nm, "--amplitude-nm")?,

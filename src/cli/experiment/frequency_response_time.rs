@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 
-use super::check::positive;
+use super::check::{self, positive};
 use super::Common;
 use crate::cli::progress;
 use rtid::experiments::frequency_response_estimate::{
@@ -219,6 +219,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         table_noise_rad: (a.noise_arcsec / 3600.0).to_radians(),
         seed: a.seed,
     };
+    check::work(
+        test.duration(),
+        check::MAX_SIMULATED_S,
+        "simulated seconds",
+        "--duration-s (or --periods × --period-s, frequencies × --dwell-s)",
+    )?;
+    check::work(
+        test.duration() * test.sample_rate_hz,
+        1e8,
+        "samples",
+        "--sample-rate-hz with the record's length",
+    )?;
     a.common.create_out()?;
     let bar = progress::bar(test.duration().ceil() as u64, "simulated s", a.common.quiet);
     let rec = record::run(&p, &test, |done, _| bar.set_position(done as u64))?;

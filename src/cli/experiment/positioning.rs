@@ -77,6 +77,12 @@ pub struct Args {
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
     let test = test(&a, p.axis)?;
+    check::work(
+        test.duration(),
+        check::MAX_SIMULATED_S,
+        "simulated seconds",
+        "--runs, --target-step-deg/mm, --travel-mm, --speed-*, --dwell-s",
+    )?;
     a.common.create_out()?;
     run_positioning(&a, &p, test)
 }
@@ -93,6 +99,12 @@ fn test(a: &Args, axis: Axis) -> anyhow::Result<positioning::PositioningTest> {
         Axis::Rotary => rotary(a)?,
         Axis::Linear => linear(a)?,
     };
+    check::work(
+        2.0 * targets.len() as f64 * a.runs as f64,
+        check::MAX_POINTS,
+        "readings",
+        "--runs with the targets",
+    )?;
     Ok(positioning::PositioningTest {
         targets,
         runs: a.runs,
@@ -123,6 +135,12 @@ fn rotary(a: &Args) -> anyhow::Result<(Vec<f64>, f64, f64)> {
     let speed = check::positive(a.speed_deg_per_min.unwrap_or(3600.0), "--speed-deg-per-min")?;
     let noise = a.noise_arcsec.unwrap_or(0.0);
     check::non_negative(noise, "--noise-arcsec")?;
+    if 360.0 / step > 1000.0 {
+        bail!(
+            "--target-step-deg {}: over 1000 targets in a revolution",
+            rtid::names::Num(step)
+        );
+    }
     let count = (360.0 / step).floor() as usize;
     Ok((
         (0..=count)
@@ -149,7 +167,11 @@ fn linear(a: &Args) -> anyhow::Result<(Vec<f64>, f64, f64)> {
     let noise = a.noise_um.unwrap_or(0.0);
     check::non_negative(noise, "--noise-um")?;
     if travel / step > 1000.0 {
-        bail!("--travel-mm {travel} / --target-step-mm {step}: over 1000 targets");
+        bail!(
+            "--travel-mm {} / --target-step-mm {}: over 1000 targets",
+            rtid::names::Num(travel),
+            rtid::names::Num(step)
+        );
     }
     let count = (travel / step + 1e-9).floor() as usize;
     Ok((

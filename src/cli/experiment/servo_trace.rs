@@ -16,7 +16,7 @@ use rtid::io::experiment_file::{Axis, CommandUnit, Data, Experiment, Kind, Manif
 use rtid::model::Params;
 use rtid::report::servo_trace as figures;
 
-use super::Common;
+use super::{check, Common};
 use crate::cli::progress;
 
 pub const LONG_ABOUT: &str = "\
@@ -100,6 +100,12 @@ fn moves(a: &Args) -> anyhow::Result<TrapezoidalMoves> {
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
     let m = moves(&a)?;
+    check::work(
+        m.duration(),
+        check::MAX_SIMULATED_S,
+        "simulated seconds",
+        "--moves, --acceleration, --dwell-s",
+    )?;
     a.common.create_out()?;
     let bar = progress::bar(1, "servo trace", a.common.quiet);
     let trace = virtual_trace(&p, &m, None)?;

@@ -74,6 +74,12 @@ pub struct Args {
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
     let test = test(&a, p.axis)?;
+    check::work(
+        test.duration(),
+        check::MAX_SIMULATED_S,
+        "simulated seconds",
+        "--period-s, --periods",
+    )?;
     a.common.create_out()?;
     run_torque_curve(&a, &p, test)
 }
