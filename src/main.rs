@@ -9,15 +9,34 @@ mod cli;
 
 fn main() -> ExitCode {
     quiet_on_broken_pipe();
+    cli::interrupt::install();
     let matches = negative_numbers(cli::Cli::command()).get_matches();
     let cli = cli::Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     match cli::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", one_line(&e));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The error and its causes on one line, each cause once: many errors already say
+/// their source in their own message, and anyhow's chain would repeat it ("not a
+/// regular file: not a regular file").
+fn one_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
 }
 
 /// Every option and subcommand, recursively, takes a negative number as its value:

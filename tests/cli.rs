@@ -1607,3 +1607,164 @@ fn a_negative_value_names_its_option() {
     );
     assert!(out.status.success(), "{}", stderr(&out));
 }
+
+/// Ctrl-C (a real SIGINT) at several moments of an identification, then `--resume`:
+/// the same parameters as the run that was never interrupted, at every fidelity
+/// (issue 13). A moment after the run has finished resumes a finished checkpoint.
+#[test]
+fn an_identification_stopped_by_sigint_resumes_to_the_uninterrupted_result() {
+    use std::process::{Command, Stdio};
+    let dir = tempdir();
+    let fr =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/worm-gear/frequency_response.json");
+    let fr = fr.to_str().unwrap();
+    let args = |model: &'static str| -> Vec<String> {
+        [
+            "identify",
+            fr,
+            "--preset",
+            "worm-gear",
+            "--set",
+            "Kw=4.34e5",
+            "--set",
+            "Kg=1190",
+            "--model",
+            model,
+            "--quiet",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    };
+    let parameters = |path: &Path| -> Vec<f64> {
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        ["Kw", "Kg"]
+            .iter()
+            .map(|n| v["parameters"][n].as_f64().unwrap())
+            .collect()
+    };
+    for model in ["linear", "nonlinear"] {
+        let mut whole = args(model);
+        whole.extend(["--out".into(), "whole.json".into()]);
+        let whole: Vec<&str> = whole.iter().map(String::as_str).collect();
+        rtid_ok(&whole, dir.path());
+        let want = parameters(&dir.path().join("whole.json"));
+        for delay_ms in [100, 400, 3000] {
+            let ck = dir.path().join(format!("{model}-{delay_ms}.ck.json"));
+            let _ = std::fs::remove_file(&ck);
+            let mut first = args(model);
+            first.extend([
+                "--checkpoint".into(),
+                ck.to_str().unwrap().into(),
+                "--out".into(),
+                "first.json".into(),
+            ]);
+            let child = Command::new(env!("CARGO_BIN_EXE_rtid"))
+                .args(&first)
+                .current_dir(dir.path())
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap();
+            std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+            // SAFETY: a signal to the child this test started and still owns.
+            unsafe {
+                libc::kill(child.id() as i32, libc::SIGINT);
+            }
+            let out = child.wait_with_output().unwrap();
+            assert!(
+                out.status.success(),
+                "{model} @ {delay_ms} ms: {}",
+                stderr(&out)
+            );
+            let mut again = first.clone();
+            again.push("--resume".into());
+            let again: Vec<&str> = again.iter().map(String::as_str).collect();
+            rtid_ok(&again, dir.path());
+            let got = parameters(&dir.path().join("first.json"));
+            for (g, w) in got.iter().zip(&want) {
+                assert!(
+                    ((g - w) / w).abs() < 1e-9,
+                    "{model} @ {delay_ms} ms: {got:?} against {want:?}"
+                );
+            }
+        }
+    }
+}
+
+/// A long simulation stopped by SIGINT or SIGTERM exits with 130 and leaves no
+/// half-written temporary file behind (issue 13).
+#[test]
+fn an_interrupted_simulation_leaves_no_temporary_file() {
+    use std::process::{Command, Stdio};
+    for signal in [libc::SIGINT, libc::SIGTERM] {
+        let dir = tempdir();
+        let child = Command::new(env!("CARGO_BIN_EXE_rtid"))
+            .args([
+                "simulate",
+                "--preset",
+                "worm-gear",
+                "--input",
+                "sine:freq_hz=100,amp_nm=5",
+                "--duration-s",
+                "100",
+                "--sample-s",
+                "1e-5",
+                "--out",
+                "run.csv",
+            ])
+            .current_dir(dir.path())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let started = std::time::Instant::now();
+        while std::fs::read_dir(dir.path()).unwrap().count() == 0 {
+            assert!(
+                started.elapsed().as_secs() < 30,
+                "no temporary file appeared"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        // SAFETY: a signal to the child this test started and still owns.
+        unsafe {
+            libc::kill(child.id() as i32, signal);
+        }
+        let out = child.wait_with_output().unwrap();
+        assert_eq!(out.status.code(), Some(130), "signal {signal}");
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert!(left.is_empty(), "signal {signal}: {left:?}");
+    }
+}
+
+/// A manifest reads its data from its own folder only, and never a device.
+#[test]
+fn a_manifest_data_path_outside_its_folder_or_a_device_is_refused() {
+    let dir = tempdir();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/worm-gear");
+    let manifest = std::fs::read_to_string(root.join("torque_curve.json")).unwrap();
+    for (name, data) in [("up.json", "../../etc/passwd"), ("abs.json", "/dev/zero")] {
+        let text = manifest.replace("\"torque_curve.csv\"", &format!("\"{data}\""));
+        assert_ne!(text, manifest);
+        std::fs::write(dir.path().join(name), text).unwrap();
+        let out = rtid(&["evaluate", name], dir.path());
+        assert_one_line_error(&out, &[name, "data", "folder"]);
+    }
+    let out = rtid(
+        &[
+            "simulate",
+            "--preset",
+            "worm-gear",
+            "--input",
+            "file:/dev/zero",
+            "--duration-s",
+            "0.01",
+            "--out",
+            "r.csv",
+        ],
+        dir.path(),
+    );
+    let line = assert_one_line_error(&out, &["/dev/zero", "regular file"]);
+    assert_eq!(line.matches("regular file").count(), 1, "said once: {line}");
+}

@@ -426,14 +426,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 /// Ctrl-C stops the search (the best point is still written); a second one quits.
 fn stop_on_ctrl_c(monitor: &Arc<Monitor>) {
     let m = Arc::clone(monitor);
-    // A second handler cannot be installed (a process installs one): then Ctrl-C
-    // simply ends the process, as it would without rtid's handling.
-    let _ = ctrlc::set_handler(move || {
+    super::interrupt::on_interrupt(move || {
         if m.stopped() {
-            std::process::exit(130);
+            return false;
         }
         m.stop();
         eprintln!("\nstopping: finishing the current evaluations, then writing the best result (Ctrl-C again to quit)");
+        true
     });
 }
 

@@ -6,6 +6,7 @@ mod evaluate;
 mod experiment;
 mod identify;
 mod inputs;
+pub mod interrupt;
 mod model_args;
 mod modes;
 mod params_cmd;

@@ -107,7 +107,7 @@ pub enum CompareError {
 
 /// Whether the JSON file at `path` is an experiment manifest (an object with `kind`).
 fn is_manifest(path: &Path) -> Result<bool, CompareError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ExperimentFileError::Io {
+    let text = crate::io::read_input(path).map_err(|source| ExperimentFileError::Io {
         path: path.to_path_buf(),
         source,
     })?;

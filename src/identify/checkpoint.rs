@@ -134,7 +134,7 @@ impl Checkpoint {
     /// Reads a checkpoint of the problem `expected`: refused, naming what differs,
     /// if it belongs to another one, or if its values do not fit the problem.
     pub fn read(path: &Path, expected: &Fingerprint) -> Result<Checkpoint, CheckpointError> {
-        let text = std::fs::read_to_string(path).map_err(|source| CheckpointError::Read {
+        let text = crate::io::read_input(path).map_err(|source| CheckpointError::Read {
             path: path.into(),
             source,
         })?;

@@ -322,6 +322,14 @@ pub fn read(path: &Path) -> Result<Experiment, ExperimentFileError> {
             data_path: None,
         });
     }
+    if let Some(data) = &manifest.data {
+        if !inside_folder(Path::new(data)) {
+            return Err(manifest_error(
+                path,
+                &format!("`data` = \"{data}\" must name a file in the manifest's folder or below it (a relative path without `..`)"),
+            ));
+        }
+    }
     let data_path = data_path(path, &manifest);
     let data = table::Table::read(&data_path, path)?.data(manifest.kind)?;
     check_against_data(&manifest, &data).map_err(|m| manifest_error(path, &m))?;
@@ -335,7 +343,7 @@ pub fn read(path: &Path) -> Result<Experiment, ExperimentFileError> {
 
 /// Reads and checks a manifest alone (the CSV is not opened).
 pub fn read_manifest(path: &Path) -> Result<Manifest, ExperimentFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ExperimentFileError::Io {
+    let text = super::read_input(path).map_err(|source| ExperimentFileError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -375,6 +383,15 @@ pub fn data_path(path: &Path, manifest: &Manifest) -> PathBuf {
         Some(data) => path.parent().unwrap_or(Path::new("")).join(data),
         None => path.with_extension("csv"),
     }
+}
+
+/// Whether a relative `data` path stays in the manifest's folder: no root, no drive,
+/// no `..`.
+fn inside_folder(data: &Path) -> bool {
+    use std::path::Component;
+    data.components()
+        .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+        && data.components().next().is_some()
 }
 
 fn manifest_error(path: &Path, message: &str) -> ExperimentFileError {

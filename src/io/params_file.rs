@@ -32,7 +32,7 @@ pub enum ParamsFileError {
 
 /// Reads and validates a parameter file.
 pub fn read(path: &Path) -> Result<Params, ParamsFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ParamsFileError::Io {
+    let text = super::read_input(path).map_err(|source| ParamsFileError::Io {
         path: path.to_path_buf(),
         source,
     })?;

@@ -30,11 +30,12 @@ pub fn read(path: &Path) -> Result<(Vec<f64>, Vec<f64>), TorqueFileError> {
     let mut reader = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
         .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| TorqueFileError::Io {
-            path: path.to_path_buf(),
-            source: std::io::Error::other(e.to_string()),
-        })?;
+        .from_reader(
+            super::open_input(path).map_err(|source| TorqueFileError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?,
+        );
     let headers = reader.headers().map_err(|e| bad(1, e.to_string()))?.clone();
     let column = |name: &str| {
         headers.iter().position(|h| h == name).ok_or_else(|| {

@@ -32,7 +32,7 @@ struct Col {
 impl Table {
     /// Reads the CSV at `path`, the data file of the manifest at `manifest`.
     pub(super) fn read(path: &Path, manifest: &Path) -> Result<Table, Error> {
-        let file = std::fs::File::open(path).map_err(|source| Error::MissingData {
+        let file = crate::io::open_input(path).map_err(|source| Error::MissingData {
             manifest: manifest.to_path_buf(),
             data: path.to_path_buf(),
             source,
