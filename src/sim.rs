@@ -42,9 +42,9 @@ pub enum SimError {
     Params(#[from] ParamError),
     #[error(transparent)]
     Controller(#[from] ControllerError),
-    #[error("integration step dt = {dt} s must be positive and finite")]
+    #[error("integration step dt = {} s must be positive and finite", crate::names::Num(*dt))]
     BadStep { dt: f64 },
-    #[error("integration step dt = {dt} s is too large for the stiffest mode of this model (|λ| = {rate:.4e} rad/s): use dt ≤ {max:.3e} s")]
+    #[error("integration step dt = {} s is too large for the stiffest mode of this model (|λ| = {rate:.4e} rad/s): use dt ≤ {max:.3e} s", crate::names::Num(*dt))]
     StepTooLarge { dt: f64, rate: f64, max: f64 },
     #[error("control period Tc = {tc} s is not a whole number of integration steps dt = {dt} s")]
     ControlPeriod { tc: f64, dt: f64 },
@@ -394,13 +394,24 @@ impl<const L: usize> LaneSimulation<L> {
 }
 
 /// "motor_angle_rad = …, …" for error messages.
+/// The states that left the finite numbers (or the largest, if none did), briefly.
 fn describe(y: &[f64; NSTATE]) -> String {
-    let mut s = String::new();
-    for (name, v) in STATE_NAMES.iter().zip(y) {
-        if !s.is_empty() {
-            s.push_str(", ");
-        }
-        let _ = write!(s, "{name} = {v:.6e}");
+    let bad: Vec<&str> = STATE_NAMES
+        .iter()
+        .zip(y)
+        .filter(|(_, v)| !v.is_finite())
+        .map(|(n, _)| *n)
+        .collect();
+    if !bad.is_empty() {
+        let more = if bad.len() > 2 { ", …" } else { "" };
+        return format!("{} not finite{more}", bad[..bad.len().min(2)].join(", "));
     }
+    let (name, v) = STATE_NAMES
+        .iter()
+        .zip(y)
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .map_or(("state", 0.0), |(n, v)| (*n, *v));
+    let mut s = String::new();
+    let _ = write!(s, "{name} = {v:.3e}");
     s
 }

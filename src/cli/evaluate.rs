@@ -84,6 +84,23 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     inputs.extend(exp.data_path.as_deref());
     inputs.extend(a.model.params.as_deref());
     super::inputs::refuse_overwrite("--plot", &plot, &inputs)?;
+    report(&a, &exp, &plot).map_err(|e| {
+        // Every error names the file evaluated.
+        let file = a.file.display().to_string();
+        if format!("{e:#}").contains(&file) {
+            e
+        } else {
+            e.context(file)
+        }
+    })
+}
+
+/// The evaluation of `exp`, printed, with its plot at `plot`.
+fn report(
+    a: &Args,
+    exp: &experiment_file::Experiment,
+    plot: &std::path::Path,
+) -> anyhow::Result<()> {
     match exp.manifest.kind {
         Kind::Positioning => positioning::report(&exp, &plot, a.json),
         Kind::FrequencyResponse => frequency_response::report(&exp, &plot, a.json),

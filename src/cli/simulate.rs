@@ -241,6 +241,9 @@ impl Args {
                 self.sample_s
             );
         }
+        if let Some(dt) = self.dt_s {
+            check::positive(dt, "--dt-s")?;
+        }
         if !self.load_nm.is_finite() {
             bail!("--load-nm {}: must be a finite torque in N·m", self.load_nm);
         }
@@ -257,7 +260,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     super::inputs::refuse_overwrite("--out", &a.out, &inputs)?;
     let mut sim = match a.dt_s {
-        Some(dt) => Simulation::new(&p, dt)?,
+        Some(dt) => Simulation::new(&p, dt).context("--dt-s")?,
         None => Simulation::with_default_step(&p)?,
     };
     sim.set_load(a.load_nm);
@@ -286,7 +289,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         closed,
         |rec| drive(&mut sim, &p, &a.input, recorded.take(), a.duration_s, rec),
         every,
-    )?;
+    )
+    .with_context(|| {
+        format!(
+            "the run of --input with --load-nm {}",
+            rtid::names::Num(a.load_nm)
+        )
+    })?;
     let wall = started.elapsed().as_secs_f64();
     print_summary(&a, &sim, p.ratio(), wall)
 }

@@ -532,6 +532,10 @@ fn angle_extrema(time: &[f64], angle: &[f64]) -> Vec<(f64, f64)> {
 fn line_at(curve: &TorqueCurve, a: f64, b: f64, t: f64) -> Option<f64> {
     let lo = curve.time.partition_point(|&x| x < a);
     let hi = curve.time.partition_point(|&x| x <= b);
+    // A time column that is not ascending gives no window.
+    if hi <= lo {
+        return None;
+    }
     let (x, y) = (&curve.time[lo..hi], &curve.motor_torque[lo..hi]);
     if x.len() < 2 {
         return None;

@@ -408,7 +408,10 @@ impl Params {
                         meaning: s.meaning,
                     })
                 }
-                (Ok(()), Some(v)) => check(s, v, self.axis)?,
+                (Ok(()), Some(v)) => {
+                    check(s, v, self.axis)?;
+                    in_range(s, v)?;
+                }
             }
         }
         self.check_consistency()
@@ -429,7 +432,10 @@ impl Params {
             return Err(ParamError::Inconsistent {
                 name: "unbalance_radius",
                 value: 0.0,
-                reason: "an unbalance mass needs a radius > 0".into(),
+                reason: format!(
+                    "unbalance_mass = {} kg needs a radius > 0",
+                    Num(self.unbalance_mass)
+                ),
             });
         }
         let c = &self.controller;
@@ -458,6 +464,28 @@ fn applicable(s: &ParamSpec, p: &Params) -> Result<(), ParamError> {
     } else {
         Ok(())
     }
+}
+
+/// The magnitudes a nonzero parameter may have, in its SI unit: wider than any
+/// drive's (a 1e-9 kg·m² rotor, a 1e12 N/m bearing), narrow enough that a typo or a
+/// unit slip (1e308, 1e-300) is named here rather than met as a hang or a NaN.
+pub const MAGNITUDE_RANGE: (f64, f64) = (1e-15, 1e15);
+
+/// Refuses a nonzero value outside [`MAGNITUDE_RANGE`].
+fn in_range(s: &ParamSpec, value: f64) -> Result<(), ParamError> {
+    let (lo, hi) = MAGNITUDE_RANGE;
+    let a = value.abs();
+    if a == 0.0 || (lo..=hi).contains(&a) {
+        return Ok(());
+    }
+    Err(ParamError::Inconsistent {
+        name: s.name,
+        value,
+        reason: format!(
+            "{} — outside the {lo:e}…{hi:e} {} any drive has: a typo or a unit slip?",
+            s.meaning, s.unit
+        ),
+    })
 }
 
 fn check(s: &ParamSpec, value: f64, axis: Axis) -> Result<(), ParamError> {

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::bail;
+use anyhow::{bail, Context};
 
 use super::check;
 use super::Common;
@@ -85,6 +85,13 @@ impl Args {
         if to < from {
             bail!("--to-hz {to} is below --from-hz {from}");
         }
+        let shortest = 1.0 / FrequencyTest::default().max_duration_s;
+        if from < shortest {
+            bail!(
+                "--from-hz {}: below {shortest} Hz, where a cycle no longer fits the test's time at one frequency",
+                rtid::names::Num(from)
+            );
+        }
         check::non_negative(self.refine_step_hz, "--refine-step-hz")?;
         if self.refine_step_hz > 0.0 {
             let around = 2.0 * FrequencyTest::default().refine_half_width_hz / self.refine_step_hz;
@@ -125,7 +132,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let expected = test.frequencies_hz.len() as u64
             + 6 * (1 + (test.refine_half_width_hz / test.refine_step_hz.max(1e-9)) as u64);
         let bar = progress::bar(expected, "frequencies", a.common.quiet);
-        let points = fr::sweep(&p, &test, &|| bar.inc(1))?;
+        let points = fr::sweep(&p, &test, &|| bar.inc(1)).with_context(|| {
+            format!(
+                "the test at --amplitude-nm {} --preload-nm {}",
+                rtid::names::Num(test.amplitude_nm),
+                rtid::names::Num(test.preload_nm)
+            )
+        })?;
         bar.finish_and_clear();
         points
     };

@@ -1,0 +1,442 @@
+//! The project's own corpus of malformed and hostile inputs (issue 13), generated
+//! here and run through the real binary: every experiment-file kind with its manifest
+//! and its CSV mutated, every model parameter set to extreme values, numeric options
+//! given absurd values. Each run must end within its time limit, without a panic,
+//! with exit 0 and finite output, or with a clear error: one line `error: …` (exit 1)
+//! naming the culprit, or clap's usage error naming the option (exit 2).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const LIMIT: Duration = Duration::from_secs(60);
+
+/// What a run did.
+struct Run {
+    code: Option<i32>,
+    stdout: String,
+    stderr: String,
+}
+
+/// Runs `rtid ARGS` in `dir`, killed (and reported as a hang) after [`LIMIT`].
+fn rtid(args: &[String], dir: &Path) -> Run {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rtid"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the rtid binary runs");
+    let started = Instant::now();
+    while child.try_wait().expect("wait").is_none() {
+        if started.elapsed() > LIMIT {
+            let _ = child.kill();
+            panic!("rtid {args:?} hangs (over {LIMIT:?})");
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let out = child.wait_with_output().expect("output");
+    Run {
+        code: out.status.code(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// The failures of a corpus, reported together at the end.
+#[derive(Default)]
+struct Failures(Vec<String>);
+
+impl Failures {
+    /// Checks one run (see [`check`]), keeping its failure.
+    fn check(&mut self, args: &[String], run: &Run, culprit: &str) {
+        let r =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| check(args, run, culprit)));
+        if let Err(e) = r {
+            let message = e
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            self.0.push(message);
+        }
+    }
+
+    fn assert_none(self, cases: usize) {
+        assert!(
+            self.0.is_empty(),
+            "{} of {cases} cases failed:\n\n{}",
+            self.0.len(),
+            self.0
+                .iter()
+                .take(12)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join("\n\n")
+        );
+    }
+}
+
+/// The checks every run passes; `culprit` must appear in an error.
+fn check(args: &[String], run: &Run, culprit: &str) {
+    let what = format!(
+        "rtid {args:?}\nstdout: {}\nstderr: {}",
+        run.stdout, run.stderr
+    );
+    assert!(!run.stderr.contains("panicked"), "panic: {what}");
+    match run.code {
+        Some(0) => {
+            for bad in ["NaN", "inf"] {
+                assert!(
+                    !run.stdout.contains(bad),
+                    "`{bad}` in the output of a successful run: {what}"
+                );
+            }
+            if let Ok(v) = serde_json::from_str::<serde_json::Value>(&run.stdout) {
+                assert!(!nan_in(&v), "a NaN written as null among numbers: {what}");
+            }
+        }
+        Some(1) => {
+            let lines: Vec<&str> = run.stderr.lines().collect();
+            assert_eq!(lines.len(), 1, "one line: {what}");
+            assert!(lines[0].starts_with("error: "), "{what}");
+            assert!(lines[0].contains(culprit), "`{culprit}` not named: {what}");
+            assert!(lines[0].len() < 600, "a short message: {what}");
+            assert!(!lines[0].contains(".tmp"), "a temporary name: {what}");
+        }
+        Some(2) => assert!(
+            run.stderr.contains(culprit),
+            "clap's error does not name `{culprit}`: {what}"
+        ),
+        other => panic!("exit {other:?}: {what}"),
+    }
+}
+
+/// Whether a JSON value holds a null among numbers (how serde_json writes a NaN); a
+/// null field alone is an absent value.
+fn nan_in(v: &serde_json::Value) -> bool {
+    use serde_json::Value;
+    match v {
+        Value::Array(items) => {
+            (items.iter().any(Value::is_null) && items.iter().any(Value::is_number))
+                || items.iter().any(nan_in)
+        }
+        Value::Object(map) => map.values().any(nan_in),
+        _ => false,
+    }
+}
+
+fn strings(v: &[&str]) -> Vec<String> {
+    v.iter().map(|s| s.to_string()).collect()
+}
+
+fn fixture(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(relative)
+}
+
+/// Mutations of a JSON manifest's text: each a new text.
+fn manifest_mutations(text: &str) -> Vec<String> {
+    let mut out = vec![
+        String::new(),
+        "{".into(),
+        "[]".into(),
+        "null".into(),
+        "\u{0}\u{1}\u{2}binary".into(),
+        text.replace("\"kind\"", "\"kinds\""),
+        text.replace("\"data\"", "\"dada\""),
+        text.replacen(':', ": \"x\", \"y\":", 1),
+        text.replace('}', "},"),
+        format!("{text}\n{{}}"),
+    ];
+    for cut in [1, text.len() / 3, text.len() / 2, text.len() - 2] {
+        out.push(text[..cut.min(text.len())].to_string());
+    }
+    // Every number replaced in turn by hostile values.
+    let numbers: Vec<(usize, usize)> = number_spans(text);
+    for (k, &(a, b)) in numbers.iter().enumerate().take(8) {
+        for value in ["-1", "0", "1e308", "-1e308", "1e-320", "\"5\"", "true"] {
+            let _ = k;
+            out.push(format!("{}{value}{}", &text[..a], &text[b..]));
+        }
+    }
+    out
+}
+
+/// Byte spans of the JSON numbers in `text` (outside strings).
+fn number_spans(text: &str) -> Vec<(usize, usize)> {
+    let bytes = text.as_bytes();
+    let (mut out, mut i, mut in_string) = (Vec::new(), 0, false);
+    while i < bytes.len() {
+        let c = bytes[i];
+        if c == b'"' {
+            in_string = !in_string;
+            i += 1;
+            continue;
+        }
+        if !in_string && (c == b'-' || c.is_ascii_digit()) {
+            let start = i;
+            while i < bytes.len()
+                && (bytes[i].is_ascii_alphanumeric() || b"+-.".contains(&bytes[i]))
+            {
+                i += 1;
+            }
+            out.push((start, i));
+            continue;
+        }
+        i += 1;
+    }
+    out
+}
+
+/// Mutations of a CSV's text.
+fn csv_mutations(text: &str) -> Vec<String> {
+    let lines: Vec<&str> = text.lines().collect();
+    let header = lines.iter().position(|l| !l.starts_with('#')).unwrap_or(0);
+    let body = |f: &dyn Fn(usize, &str) -> String| -> String {
+        lines
+            .iter()
+            .enumerate()
+            .map(|(i, l)| if i > header { f(i, l) } else { l.to_string() })
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let at = header + 3;
+    let replace_cell = |value: &'static str| {
+        body(&move |i, l| {
+            if i == at {
+                let mut cells: Vec<&str> = l.split(',').collect();
+                let last = cells.len() - 1;
+                cells[last] = value;
+                cells.join(",")
+            } else {
+                l.to_string()
+            }
+        })
+    };
+    let mut out = vec![
+        String::new(),
+        lines[..=header].join("\n"),
+        lines[header + 1..].join("\n"),
+        text.replacen(lines[header], &lines[header].replace(',', ";"), 1),
+        text.replacen(
+            lines[header],
+            &format!("{},{}", lines[header], "extra_nm"),
+            1,
+        ),
+        text.replacen(lines[header], "time_s", 1),
+        body(&|i, l| {
+            if i == at {
+                String::new()
+            } else {
+                l.to_string()
+            }
+        }),
+        body(&|i, l| {
+            if i == at {
+                format!("{l},7")
+            } else {
+                l.to_string()
+            }
+        }),
+        body(&|i, l| {
+            if i == at {
+                l.split(',').next().unwrap_or("").to_string()
+            } else {
+                l.to_string()
+            }
+        }),
+        body(&|i, l| {
+            if i == at {
+                lines[at - 1].to_string()
+            } else {
+                l.to_string()
+            }
+        }),
+        body(&|i, l| {
+            if i == at {
+                lines[at + 1].to_string()
+            } else {
+                l.to_string()
+            }
+        }),
+        format!("{}\n1,2", text),
+        text[..text.len() * 2 / 3].to_string(),
+        format!("\u{feff}{text}"),
+    ];
+    for value in [
+        "nan", "NaN", "inf", "-inf", "1e309", "", "abc", "0x10", "1,5", "\"2\"",
+    ] {
+        out.push(replace_cell(value));
+    }
+    out
+}
+
+/// A copy of an experiment (manifest and CSV) in `dir`, with one of them replaced.
+fn write_case(dir: &Path, manifest: &Path, text: Option<&str>, csv: Option<&str>) -> String {
+    let m = std::fs::read_to_string(manifest).unwrap();
+    let stem = manifest.file_stem().unwrap().to_str().unwrap();
+    let data = manifest.with_extension("csv");
+    let name = format!("{stem}.json");
+    std::fs::write(dir.join(&name), text.unwrap_or(&m)).unwrap();
+    if data.exists() {
+        let c = std::fs::read_to_string(&data).unwrap();
+        std::fs::write(dir.join(format!("{stem}.csv")), csv.unwrap_or(&c)).unwrap();
+    }
+    name
+}
+
+#[test]
+fn malformed_experiment_files_fail_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut cases = 0;
+    let mut failures = Failures::default();
+    for relative in [
+        "worm-gear/frequency_response.json",
+        "worm-gear/torque_curve.json",
+        "worm-gear/unbalance.json",
+        "real/emps/emps_estimation.json",
+        "paper/worm-gear.json",
+    ] {
+        let manifest = fixture(relative);
+        let text = std::fs::read_to_string(&manifest).unwrap();
+        for m in manifest_mutations(&text) {
+            let case = tempfile::tempdir_in(dir.path()).unwrap();
+            let name = write_case(case.path(), &manifest, Some(&m), None);
+            let args = strings(&["evaluate", &name, "--json", "--plot", "p.svg"]);
+            failures.check(&args, &rtid(&args, case.path()), &name);
+            cases += 1;
+        }
+        let data = manifest.with_extension("csv");
+        if data.exists() && !relative.starts_with("real/") {
+            let csv = std::fs::read_to_string(&data).unwrap();
+            let csv_name = data.file_name().unwrap().to_str().unwrap().to_string();
+            for c in csv_mutations(&csv) {
+                let case = tempfile::tempdir_in(dir.path()).unwrap();
+                let name = write_case(case.path(), &manifest, None, Some(&c));
+                let args = strings(&["evaluate", &name, "--json", "--plot", "p.svg"]);
+                let run = rtid(&args, case.path());
+                // A data error names the CSV (the file, then its line and column).
+                check(
+                    &args,
+                    &run,
+                    if run.code == Some(1) {
+                        &csv_name
+                    } else {
+                        &name
+                    },
+                );
+                cases += 1;
+            }
+        }
+    }
+    assert!(cases >= 150, "{cases} cases");
+    failures.assert_none(cases);
+}
+
+#[test]
+fn extreme_parameter_values_fail_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let names = [
+        "Jm",
+        "Jw",
+        "Jt",
+        "Mw",
+        "Cm",
+        "Cw",
+        "Cb",
+        "Ct",
+        "Cig",
+        "Ciw",
+        "fm",
+        "fw",
+        "ft",
+        "Kg",
+        "Kw",
+        "Kb",
+        "Rg",
+        "Rw",
+        "r",
+        "theta_bg",
+        "theta_bw",
+        "W",
+        "fluct_order",
+        "unbalance_mass",
+        "encoder_delay",
+    ];
+    let mut cases = 0;
+    let mut failures = Failures::default();
+    for name in names {
+        for value in ["-1", "0", "1e308", "1e-300", "nan", "inf", "x"] {
+            let set = format!("{name}={value}");
+            let args = strings(&["modes", "--preset", "worm-gear", "--set", &set, "--json"]);
+            failures.check(&args, &rtid(&args, dir.path()), name);
+            cases += 1;
+        }
+    }
+    assert!(cases >= 150, "{cases} cases");
+    failures.assert_none(cases);
+}
+
+#[test]
+fn absurd_option_values_fail_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let fr = [
+        "experiment",
+        "frequency-response",
+        "--preset",
+        "worm-gear",
+        "--from-hz",
+        "100",
+        "--to-hz",
+        "120",
+        "--out",
+        "o",
+        "--quiet",
+    ];
+    let sim = [
+        "simulate",
+        "--preset",
+        "worm-gear",
+        "--input",
+        "sine:freq_hz=100,amp_nm=5",
+        "--duration-s",
+        "0.01",
+        "--out",
+        "r.csv",
+    ];
+    let cases: &[(&[&str], &[&str])] = &[
+        (
+            &fr,
+            &[
+                "--amplitude-nm",
+                "--preload-nm",
+                "--step-hz",
+                "--refine-step-hz",
+                "--noise-percent",
+                "--from-hz",
+                "--to-hz",
+            ],
+        ),
+        (&sim, &["--duration-s", "--sample-s", "--dt-s", "--load-nm"]),
+    ];
+    let mut n = 0;
+    let mut failures = Failures::default();
+    for (base, options) in cases {
+        for option in *options {
+            for value in ["-1", "0", "nan", "inf", "1e308", "1e-300", "abc"] {
+                let mut args = strings(base);
+                if let Some(i) = args.iter().position(|a| a == option) {
+                    args[i + 1] = value.to_string();
+                } else {
+                    args.extend([option.to_string(), value.to_string()]);
+                }
+                failures.check(&args, &rtid(&args, dir.path()), option);
+                n += 1;
+            }
+        }
+    }
+    assert!(n >= 70, "{n} cases");
+    failures.assert_none(n);
+}
