@@ -102,16 +102,16 @@ fn report(
     plot: &std::path::Path,
 ) -> anyhow::Result<()> {
     match exp.manifest.kind {
-        Kind::Positioning => positioning::report(&exp, &plot, a.json),
-        Kind::FrequencyResponse => frequency_response::report(&exp, &plot, a.json),
-        Kind::TorqueCurve => torque_curve::report(&exp, &plot, a.json),
-        Kind::Fluctuation | Kind::Unbalance => fluctuation::report(&exp, &plot, a.json),
+        Kind::Positioning => positioning::report(exp, plot, a.json),
+        Kind::FrequencyResponse => frequency_response::report(exp, plot, a.json),
+        Kind::TorqueCurve => torque_curve::report(exp, plot, a.json),
+        Kind::Fluctuation | Kind::Unbalance => fluctuation::report(exp, plot, a.json),
         Kind::ServoTrace => {
             let model = a.model.given().then(|| a.model.load()).transpose()?;
-            servo_trace::report(&exp, &plot, a.json, model)
+            servo_trace::report(exp, plot, a.json, model)
         }
         Kind::FrequencyResponseTime => {
-            frequency_response_time::report_with(&exp, &plot, a.json, &a.estimate.options())
+            frequency_response_time::report_with(exp, plot, a.json, &a.estimate.options())
         }
         other => bail!(
             "{}: evaluating `{}` experiments is not part of this version yet",
