@@ -1503,7 +1503,7 @@ fn absurd_sizes_and_values_are_refused_before_any_work() {
                 "--out",
                 "r.csv",
             ],
-            &["theta_w", "rad/s", "typo"],
+            &["Kw = 1e308", "typo"],
         ),
         (
             &[
@@ -1519,11 +1519,15 @@ fn absurd_sizes_and_values_are_refused_before_any_work() {
                 "--out",
                 "r.csv",
             ],
-            &["rad/s", "typo"],
+            &["r = 1e-300", "typo"],
+        ),
+        (
+            &["modes", "--preset", "worm-gear", "--set", "Jm=1e-14"],
+            &["theta_m", "rad/s", "typo"],
         ),
         (
             &["modes", "--preset", "worm-gear", "--set", "Kw=1e308"],
-            &["theta_w", "rad/s"],
+            &["Kw = 1e308"],
         ),
         (
             &[
