@@ -1522,6 +1522,21 @@ fn absurd_sizes_and_values_are_refused_before_any_work() {
             &["r = 1e-300", "typo"],
         ),
         (
+            &[
+                "experiment",
+                "frequency-response-time",
+                "--preset",
+                "worm-gear",
+                "--excitation",
+                "stepped-sine",
+                "--step-hz",
+                "1e-300",
+                "--out",
+                "a",
+            ],
+            &["--step-hz", "frequencies"],
+        ),
+        (
             &["modes", "--preset", "worm-gear", "--set", "Jm=1e-14"],
             &["theta_m", "rad/s", "typo"],
         ),

@@ -14,6 +14,7 @@ use rtid::experiments::frequency_response_estimate::{
 use rtid::experiments::frequency_response_record::{self as record, Excitation, RecordTest};
 use rtid::experiments::multisine::LineSet;
 use rtid::io::experiment_file::{self, Experiment};
+use rtid::names::Num;
 use std::fmt::Write as _;
 
 pub const LONG_ABOUT: &str = "\
@@ -160,77 +161,7 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
-    let (from, to) = (a.from_hz, a.to_hz);
-    if !(from >= 0.0 && to > from && to.is_finite()) {
-        bail!("--from-hz {from} --to-hz {to}: need 0 ≤ from < to");
-    }
-    if !(a.noise_arcsec >= 0.0 && a.noise_arcsec.is_finite()) {
-        bail!(
-            "--noise-arcsec {}: must be zero or positive",
-            a.noise_arcsec
-        );
-    }
-    if !a.preload_nm.is_finite() {
-        bail!("--preload-nm {}: must be a finite torque", a.preload_nm);
-    }
-    let excitation = match a.excitation {
-        ExcitationKind::SteppedSine => {
-            let step = positive(a.step_hz, "--step-hz")?;
-            let first = positive(from, "--from-hz")?;
-            let count = ((to - first) / step + 1e-9).floor() as usize;
-            Excitation::SteppedSine {
-                frequencies_hz: (0..=count).map(|i| first + step * i as f64).collect(),
-                dwell_s: positive(a.dwell_s, "--dwell-s")?,
-            }
-        }
-        ExcitationKind::Noise => Excitation::Noise {
-            seed: a.seed,
-            from_hz: from,
-            to_hz: to,
-        },
-        ExcitationKind::Chirp => Excitation::Chirp {
-            from_hz: from,
-            to_hz: to,
-        },
-        ExcitationKind::Multisine => Excitation::Multisine {
-            period_s: positive(a.period_s, "--period-s")?,
-            periods: a.periods,
-            from_hz: positive(from, "--from-hz")?,
-            to_hz: to,
-            lines: match a.lines {
-                LinesArg::Full => LineSet::Full,
-                LinesArg::Odd => LineSet::Odd,
-                LinesArg::RandomOdd => LineSet::RandomOdd {
-                    group: 4,
-                    seed: a.seed,
-                },
-            },
-        },
-    };
-    if a.excitation == ExcitationKind::Multisine && a.periods < 3 {
-        bail!("--periods {}: need 3 or more (the first is dropped as transient, and the noise needs two)", a.periods);
-    }
-    let test = RecordTest {
-        excitation,
-        amplitude_nm: positive(a.amplitude_nm, "--amplitude-nm")?,
-        preload_nm: a.preload_nm,
-        duration_s: positive(a.duration_s, "--duration-s")?,
-        sample_rate_hz: positive(a.sample_rate_hz, "--sample-rate-hz")?,
-        table_noise_rad: (a.noise_arcsec / 3600.0).to_radians(),
-        seed: a.seed,
-    };
-    check::work(
-        test.duration(),
-        check::MAX_SIMULATED_S,
-        "simulated seconds",
-        "--duration-s (or --periods × --period-s, frequencies × --dwell-s)",
-    )?;
-    check::work(
-        test.duration() * test.sample_rate_hz,
-        1e8,
-        "samples",
-        "--sample-rate-hz with the record's length",
-    )?;
+    let test = a.test()?;
     a.common.create_out()?;
     let bar = progress::bar(test.duration().ceil() as u64, "simulated s", a.common.quiet);
     let rec = record::run(&p, &test, |done, _| bar.set_position(done as u64))?;
@@ -246,6 +177,97 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.common.json,
         &a.estimate.options(),
     )
+}
+
+impl Args {
+    /// The test the flags describe, checked (and its work estimated) before anything
+    /// runs.
+    fn test(&self) -> anyhow::Result<RecordTest> {
+        let (from, to) = (self.from_hz, self.to_hz);
+        if !(from >= 0.0 && to > from && to.is_finite()) {
+            bail!(
+                "--from-hz {} --to-hz {}: need 0 ≤ from < to",
+                Num(from),
+                Num(to)
+            );
+        }
+        check::non_negative(self.noise_arcsec, "--noise-arcsec")?;
+        check::finite(self.preload_nm, "--preload-nm")?;
+        let test = RecordTest {
+            excitation: self.excitation()?,
+            amplitude_nm: positive(self.amplitude_nm, "--amplitude-nm")?,
+            preload_nm: self.preload_nm,
+            duration_s: positive(self.duration_s, "--duration-s")?,
+            sample_rate_hz: positive(self.sample_rate_hz, "--sample-rate-hz")?,
+            table_noise_rad: (self.noise_arcsec / 3600.0).to_radians(),
+            seed: self.seed,
+        };
+        check::work(
+            test.duration(),
+            check::MAX_SIMULATED_S,
+            "simulated seconds",
+            "--duration-s (or --periods × --period-s, frequencies × --dwell-s)",
+        )?;
+        check::work(
+            test.duration() * test.sample_rate_hz,
+            1e8,
+            "samples",
+            "--sample-rate-hz with the record's length",
+        )?;
+        Ok(test)
+    }
+
+    /// The excitation the flags describe.
+    fn excitation(&self) -> anyhow::Result<Excitation> {
+        let (from, to) = (self.from_hz, self.to_hz);
+        Ok(match self.excitation {
+            ExcitationKind::SteppedSine => {
+                let step = positive(self.step_hz, "--step-hz")?;
+                let first = positive(from, "--from-hz")?;
+                let count = ((to - first) / step + 1e-9).floor();
+                check::work(
+                    count + 1.0,
+                    check::MAX_POINTS,
+                    "frequencies",
+                    "--from-hz, --to-hz, --step-hz",
+                )?;
+                Excitation::SteppedSine {
+                    frequencies_hz: (0..=count as usize)
+                        .map(|i| first + step * i as f64)
+                        .collect(),
+                    dwell_s: positive(self.dwell_s, "--dwell-s")?,
+                }
+            }
+            ExcitationKind::Noise => Excitation::Noise {
+                seed: self.seed,
+                from_hz: from,
+                to_hz: to,
+            },
+            ExcitationKind::Chirp => Excitation::Chirp {
+                from_hz: from,
+                to_hz: to,
+            },
+            ExcitationKind::Multisine => {
+                if self.periods < 3 {
+                    bail!("--periods {}: need 3 or more (the first is dropped as transient, and the noise needs two)", self.periods);
+                }
+                Excitation::Multisine {
+                    period_s: positive(self.period_s, "--period-s")?,
+                    periods: self.periods,
+                    from_hz: positive(from, "--from-hz")?,
+                    to_hz: to,
+                    lines: match self.lines {
+                        LinesArg::Full => LineSet::Full,
+                        LinesArg::Odd => LineSet::Odd,
+                        LinesArg::RandomOdd => LineSet::RandomOdd {
+                            group: 4,
+                            seed: self.seed,
+                        },
+                    },
+                }
+            }
+        })
+    }
 }
 
 /// `FILE.svg` → `FILE-coherence.svg`.
