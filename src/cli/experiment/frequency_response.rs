@@ -104,16 +104,8 @@ impl Args {
         }
         check::finite(self.preload_nm, "--preload-nm")?;
         check::non_negative(self.noise_percent, "--noise-percent")?;
-        let count = ((to - from) / step + 1e-9).floor();
-        check::work(
-            count + 1.0,
-            check::MAX_POINTS,
-            "frequencies",
-            "--from-hz, --to-hz, --step-hz",
-        )?;
-        let count = count as usize;
         Ok(FrequencyTest {
-            frequencies_hz: (0..=count).map(|i| from + step * i as f64).collect(),
+            frequencies_hz: check::frequency_grid(from, to, step)?,
             amplitude_nm: check::positive(self.amplitude_nm, "--amplitude-nm")?,
             preload_nm: self.preload_nm,
             refine_step_hz: self.refine_step_hz,

@@ -224,17 +224,8 @@ impl Args {
             ExcitationKind::SteppedSine => {
                 let step = positive(self.step_hz, "--step-hz")?;
                 let first = positive(from, "--from-hz")?;
-                let count = ((to - first) / step + 1e-9).floor();
-                check::work(
-                    count + 1.0,
-                    check::MAX_POINTS,
-                    "frequencies",
-                    "--from-hz, --to-hz, --step-hz",
-                )?;
                 Excitation::SteppedSine {
-                    frequencies_hz: (0..=count as usize)
-                        .map(|i| first + step * i as f64)
-                        .collect(),
+                    frequencies_hz: check::frequency_grid(first, to, step)?,
                     dwell_s: positive(self.dwell_s, "--dwell-s")?,
                 }
             }
