@@ -28,6 +28,25 @@ mod support {
         String::from_utf8(out.stderr.clone()).expect("stderr is UTF-8")
     }
 
+    /// Starts `rtid ARGS…` in `dir`, sends it SIGINT (Ctrl-C) after `delay_ms` and
+    /// waits for it to end.
+    pub fn interrupted<S: AsRef<std::ffi::OsStr>>(args: &[S], dir: &Path, delay_ms: u64) -> Output {
+        use std::process::Stdio;
+        let child = Command::new(env!("CARGO_BIN_EXE_rtid"))
+            .args(args)
+            .current_dir(dir)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the rtid binary runs");
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        // SAFETY: a signal to the child this test started and still owns.
+        unsafe {
+            libc::kill(child.id() as i32, libc::SIGINT);
+        }
+        child.wait_with_output().expect("rtid ends")
+    }
+
     /// Runs `rtid ARGS…`, requires exit code 0 and returns stdout.
     pub fn rtid_ok(args: &[&str], dir: &Path) -> String {
         let out = rtid(args, dir);
@@ -1632,7 +1651,6 @@ fn a_negative_value_names_its_option() {
 /// (issue 13). A moment after the run has finished resumes a finished checkpoint.
 #[test]
 fn an_identification_stopped_by_sigint_resumes_to_the_uninterrupted_result() {
-    use std::process::{Command, Stdio};
     let dir = tempdir();
     let fr =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/worm-gear/frequency_response.json");
@@ -1679,19 +1697,7 @@ fn an_identification_stopped_by_sigint_resumes_to_the_uninterrupted_result() {
                 "--out".into(),
                 "first.json".into(),
             ]);
-            let child = Command::new(env!("CARGO_BIN_EXE_rtid"))
-                .args(&first)
-                .current_dir(dir.path())
-                .stdout(Stdio::null())
-                .stderr(Stdio::piped())
-                .spawn()
-                .unwrap();
-            std::thread::sleep(std::time::Duration::from_millis(delay_ms));
-            // SAFETY: a signal to the child this test started and still owns.
-            unsafe {
-                libc::kill(child.id() as i32, libc::SIGINT);
-            }
-            let out = child.wait_with_output().unwrap();
+            let out = interrupted(&first, dir.path(), delay_ms);
             assert!(
                 out.status.success(),
                 "{model} @ {delay_ms} ms: {}",
@@ -1786,4 +1792,66 @@ fn a_manifest_data_path_outside_its_folder_or_a_device_is_refused() {
     );
     let line = assert_one_line_error(&out, &["/dev/zero", "regular file"]);
     assert_eq!(line.matches("regular file").count(), 1, "said once: {line}");
+}
+
+/// A sweep stopped by a real SIGINT twice and resumed each time gives the bytes of
+/// a sweep run straight through (issue 13): the rows finished before each stop are
+/// kept, a row cut off mid-write is dropped and computed again.
+#[test]
+#[cfg_attr(
+    not(feature = "slow-tests"),
+    ignore = "slow tier: three sweeps of ~4 s"
+)]
+fn a_sweep_stopped_by_sigint_resumes_to_the_bytes_of_a_straight_run() {
+    let dir = tempdir();
+    let args = |out: &str| -> Vec<String> {
+        [
+            "sweep",
+            "--preset",
+            "worm-gear",
+            "--vary",
+            "Jt=0.08..0.14:10",
+            "--vary",
+            "Kw=1e5..1e6:log:8",
+            "--outputs",
+            "torque_rms",
+            "--quiet",
+            "--out",
+            out,
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    };
+    let straight: Vec<String> = args("straight.csv");
+    rtid_ok(
+        &straight.iter().map(String::as_str).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    let mut rows_seen = Vec::new();
+    for (k, delay_ms) in [700, 1500].into_iter().enumerate() {
+        let mut a = args("stopped.csv");
+        if k > 0 {
+            a.push("--resume".into());
+        }
+        let out = interrupted(&a, dir.path(), delay_ms);
+        assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
+        let text = std::fs::read_to_string(dir.path().join("stopped.csv")).unwrap();
+        rows_seen.push(text.lines().filter(|l| !l.starts_with('#')).count() - 1);
+    }
+    assert!(
+        rows_seen[0] > 0 && rows_seen[1] > rows_seen[0] && rows_seen[1] < 80,
+        "rows after each stop: {rows_seen:?}"
+    );
+    let mut resume = args("stopped.csv");
+    resume.push("--resume".into());
+    rtid_ok(
+        &resume.iter().map(String::as_str).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("stopped.csv")).unwrap(),
+        std::fs::read(dir.path().join("straight.csv")).unwrap(),
+        "the resumed sweep differs from the straight one"
+    );
 }

@@ -5,6 +5,8 @@
 //! with exit 0 and finite output, or with a clear error: one line `error: …` (exit 1)
 //! naming the culprit, or clap's usage error naming the option (exit 2).
 
+mod support;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -154,38 +156,12 @@ fn manifest_mutations(text: &str) -> Vec<String> {
         out.push(text[..cut.min(text.len())].to_string());
     }
     // Every number replaced in turn by hostile values.
-    let numbers: Vec<(usize, usize)> = number_spans(text);
+    let numbers: Vec<(usize, usize)> = support::number_spans(text);
     for (k, &(a, b)) in numbers.iter().enumerate().take(8) {
         for value in ["-1", "0", "1e308", "-1e308", "1e-320", "\"5\"", "true"] {
             let _ = k;
             out.push(format!("{}{value}{}", &text[..a], &text[b..]));
         }
-    }
-    out
-}
-
-/// Byte spans of the JSON numbers in `text` (outside strings).
-fn number_spans(text: &str) -> Vec<(usize, usize)> {
-    let bytes = text.as_bytes();
-    let (mut out, mut i, mut in_string) = (Vec::new(), 0, false);
-    while i < bytes.len() {
-        let c = bytes[i];
-        if c == b'"' {
-            in_string = !in_string;
-            i += 1;
-            continue;
-        }
-        if !in_string && (c == b'-' || c.is_ascii_digit()) {
-            let start = i;
-            while i < bytes.len()
-                && (bytes[i].is_ascii_alphanumeric() || b"+-.".contains(&bytes[i]))
-            {
-                i += 1;
-            }
-            out.push((start, i));
-            continue;
-        }
-        i += 1;
     }
     out
 }
@@ -406,7 +382,23 @@ fn absurd_option_values_fail_cleanly() {
         "--out",
         "r.csv",
     ];
+    let data = fixture("worm-gear/frequency_response.json");
+    let identify = [
+        "identify",
+        data.to_str().unwrap(),
+        "--preset",
+        "worm-gear",
+        "--fit",
+        "Kw,Kg",
+        "--model",
+        "linear",
+        "--starts",
+        "1",
+        "--max-iters",
+        "3",
+    ];
     let cases: &[(&[&str], &[&str])] = &[
+        (&identify, &["--max-iters", "--starts"]),
         (
             &fr,
             &[
@@ -437,6 +429,6 @@ fn absurd_option_values_fail_cleanly() {
             }
         }
     }
-    assert!(n >= 70, "{n} cases");
+    assert!(n >= 84, "{n} cases");
     failures.assert_none(n);
 }

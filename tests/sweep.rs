@@ -249,6 +249,81 @@ fn the_merge_of_n_shards_equals_the_unsharded_sweep() {
     assert_eq!(indices.rows.len(), s.output_columns().len() * 3);
 }
 
+/// Replaces, in the sweep file `path`, the first data row's cell `column` by `value`.
+fn tamper(path: &Path, column: usize, value: &str) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let row = lines.iter().position(|l| l.starts_with("index,")).unwrap() + 1;
+    let mut cells: Vec<&str> = lines[row].split(',').collect();
+    cells[column] = value;
+    lines[row] = cells.join(",");
+    std::fs::write(path, lines.join("\n") + "\n").unwrap();
+}
+
+#[test]
+fn a_resumed_or_merged_file_with_a_nan_or_a_changed_point_is_refused_naming_it() {
+    let s = morris_sweep();
+    let dir = tempfile::tempdir().unwrap();
+    let resume = |path: &Path| {
+        let opts = RunOptions {
+            resume: true,
+            ..RunOptions::default()
+        };
+        sweep::run(&s, path, &opts).unwrap_err().to_string()
+    };
+    let partial = |name: &str| {
+        let path = dir.path().join(name);
+        let opts = RunOptions {
+            limit: Some(5),
+            ..RunOptions::default()
+        };
+        sweep::run(&s, &path, &opts).unwrap();
+        path
+    };
+    // An output cell (column 4: the first output after index and three factors).
+    let nan = partial("nan.csv");
+    tamper(&nan, 4, "NaN");
+    let err = resume(&nan);
+    assert!(
+        err.contains("nan.csv, line 4") && err.contains("`NaN` is not a finite number"),
+        "{err}"
+    );
+    // A factor value that is not the design's.
+    let moved = partial("moved.csv");
+    tamper(&moved, 1, "123456");
+    let err = resume(&moved);
+    assert!(
+        err.contains("moved.csv") && err.contains("design point"),
+        "{err}"
+    );
+    // The same in a shard to merge.
+    let shards: Vec<_> = (0..2)
+        .map(|i| {
+            let path = dir.path().join(format!("shard-{i}.csv"));
+            let opts = RunOptions {
+                shard: Some(Shard { index: i, count: 2 }),
+                ..RunOptions::default()
+            };
+            sweep::run(&s, &path, &opts).unwrap();
+            path
+        })
+        .collect();
+    tamper(&shards[1], 2, "1e400");
+    let err = sweep::load_complete(&shards).unwrap_err().to_string();
+    assert!(
+        err.contains("shard-1.csv, line 5") && err.contains("`1e400`"),
+        "{err}"
+    );
+    tamper(&shards[1], 2, "5e7");
+    let err = sweep::load_complete(&shards).unwrap_err().to_string();
+    assert!(
+        err.contains("shard-1.csv: row ") && err.contains("design point"),
+        "{err}"
+    );
+    let err = sweep::load_complete(&shards[..1]).unwrap_err().to_string();
+    assert!(err.contains("shard-0.csv: missing shard 1/2"), "{err}");
+}
+
 /// Runs the real binary in `dir`.
 fn rtid(args: &[&str], dir: &Path) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_rtid"))

@@ -225,7 +225,7 @@ impl From<FidelityArg> for FidelityChoice {
 }
 
 /// Parses `NAME=LO..HI`.
-fn parse_bound(s: &str) -> anyhow::Result<(String, Bound)> {
+pub(super) fn parse_bound(s: &str) -> anyhow::Result<(String, Bound)> {
     let (name, range) = s
         .split_once('=')
         .with_context(|| format!("--bound {s}: expected NAME=LO..HI, e.g. Kw=1e5..1e7"))?;
@@ -233,9 +233,10 @@ fn parse_bound(s: &str) -> anyhow::Result<(String, Bound)> {
         .split_once("..")
         .with_context(|| format!("--bound {s}: expected LO..HI after `=`, e.g. 1e5..1e7"))?;
     let num = |t: &str| -> anyhow::Result<f64> {
-        t.trim()
-            .parse()
-            .map_err(|_| anyhow::anyhow!("--bound {s}: `{t}` is not a number"))
+        match t.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(anyhow::anyhow!("--bound {s}: `{t}` is not a finite number")),
+        }
     };
     Ok((
         name.trim().to_string(),
@@ -261,6 +262,10 @@ impl Args {
         anyhow::ensure!(
             self.starts != Some(0),
             "--starts 0: at least one start is needed"
+        );
+        anyhow::ensure!(
+            self.max_iters > 0,
+            "--max-iters 0: each local search needs at least one iteration"
         );
         Ok(Config {
             experiments,

@@ -11,6 +11,8 @@ mod model_args;
 mod modes;
 mod params_cmd;
 mod progress;
+#[cfg(test)]
+mod properties;
 mod simulate;
 mod sweep;
 

@@ -54,11 +54,10 @@ pub fn parse_assignment(s: &str) -> anyhow::Result<(&str, f64)> {
     let Some((name, value)) = s.split_once('=') else {
         bail!("--set {s}: expected NAME=VALUE, e.g. Kw=3.5e5");
     };
-    let v: f64 = value
-        .trim()
-        .parse()
-        .with_context(|| format!("--set {s}: `{value}` is not a number"))?;
-    Ok((name.trim(), v))
+    match value.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok((name.trim(), v)),
+        _ => bail!("--set {s}: `{value}` is not a finite number"),
+    }
 }
 
 #[cfg(test)]
@@ -85,7 +84,7 @@ mod tests {
     fn bad_assignments_are_named() {
         for (set, expect) in [
             ("Kw", "expected NAME=VALUE"),
-            ("Kw=abc", "`abc` is not a number"),
+            ("Kw=abc", "`abc` is not a finite number"),
             ("Kx=1", "unknown parameter `Kx`"),
             ("Kw=-1", "Kw = -1"),
             ("Kg=1", "does not apply"),

@@ -182,7 +182,9 @@ pub fn demodulate(
     let t0 = time[0];
     let record_s = time[n - 1] - t0 + period.min(1e9);
     let needed_s = frequencies_hz.len() as f64 * dwell_s;
-    if record_s < needed_s * (1.0 - 1e-9) {
+    // Within half a sample: a last time stamp jittered within the sampling tolerance
+    // still covers the last dwell (its samples are all there).
+    if record_s < needed_s - 0.5 * period.min(needed_s) {
         return Err(SteppedSineError::TooShort {
             record_s,
             count: frequencies_hz.len(),
@@ -241,6 +243,7 @@ pub fn demodulate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::experiment_file::SAMPLING_TOLERANCE;
 
     #[test]
     fn the_fit_ignores_offset_and_drift_and_has_no_residual() {
@@ -287,6 +290,17 @@ mod tests {
             assert!((q.torque_amplitude_nm - 5.0).abs() < 1e-6, "{q:?}");
         }
         assert_eq!(p[1].cycles, 18);
+        let mut jittered = time.clone();
+        let step = time[1] - time[0];
+        *jittered.last_mut().unwrap() -= 0.9 * SAMPLING_TOLERANCE * step;
+        let q = demodulate(
+            &jittered, &torque, &motor, &table, ratio, &freqs, dwell, &opts,
+        );
+        assert_eq!(
+            q.unwrap().len(),
+            freqs.len(),
+            "a jittered last time stamp is accepted"
+        );
         let long = [20.0, 73.0, 90.0];
         let e = demodulate(&time, &torque, &motor, &table, ratio, &long, dwell, &opts);
         assert!(matches!(e, Err(SteppedSineError::TooShort { .. })), "{e:?}");

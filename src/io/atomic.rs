@@ -49,11 +49,12 @@ pub fn write(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = temporary_in(dir)?;
+    let tmp = temporary_in(dir)?;
     let _live = Live::of(&tmp);
-    tmp.write_all(bytes)?;
+    tmp.as_file().write_all(bytes)?;
     tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
+    tmp.persist(path)
+        .map_err(|e| without_temporary_name(e.error))?;
     Ok(())
 }
 
@@ -75,7 +76,8 @@ pub fn write_with<E: From<std::io::Error>>(
         w.flush()?;
     }
     tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
+    tmp.persist(path)
+        .map_err(|e| without_temporary_name(e.error))?;
     Ok(())
 }
 
@@ -88,12 +90,32 @@ fn temporary_in(dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    builder.tempfile_in(dir)
+    builder.tempfile_in(dir).map_err(without_temporary_name)
+}
+
+/// The error `e` without the temporary file's name that `tempfile` appends ("… at
+/// path \"dir/.tmpXYZ\""): the user asked for the target, and the temporary name
+/// means nothing to them. (`tempfile` keeps the cause private, so the text is cut.)
+fn without_temporary_name(e: std::io::Error) -> std::io::Error {
+    let text = e.to_string();
+    match text.rsplit_once(" at path \"") {
+        Some((cause, _)) => std::io::Error::new(e.kind(), cause.to_string()),
+        None => e,
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_error_does_not_name_the_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("missing").join("out.json");
+        let e = write(&path, b"{}").unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::NotFound);
+        assert!(!e.to_string().contains(".tmp"), "{e}");
+    }
 
     #[test]
     fn a_failed_fill_leaves_the_old_file() {

@@ -276,12 +276,12 @@ pub fn run(sweep: &Sweep, out: &Path, opts: &RunOptions) -> Result<RunReport, Sw
         .filter(|&i| opts.shard.map_or(true, |s| s.contains(i)))
         .collect();
     if let Some(&stray) = done.keys().find(|i| mine.binary_search(i).is_err()) {
-        return Err(SweepError::Stream(StreamError::BadRow {
+        return Err(SweepError::Stream(StreamError::BadFile {
             path: out.into(),
-            line: 0,
             reason: format!("row {stray} is not a point of this sweep or shard"),
         }));
     }
+    check_design_values(&design, &done, |_| out)?;
     let resumed = done.len();
     let mut todo: Vec<usize> = mine
         .iter()
@@ -321,14 +321,43 @@ pub fn run(sweep: &Sweep, out: &Path, opts: &RunOptions) -> Result<RunReport, Sw
     })
 }
 
+/// Checks that the factor values of each row read from a file are the design's at
+/// its index, as written (`file_of(i)`: the file row `i` came from). A row edited by
+/// hand or left by another design would otherwise be analysed as this one's.
+fn check_design_values<'a>(
+    design: &Design,
+    rows: &BTreeMap<usize, Vec<String>>,
+    file_of: impl Fn(usize) -> &'a Path,
+) -> Result<(), StreamError> {
+    for (&i, row) in rows {
+        if i >= design.len() {
+            continue;
+        }
+        let expected = design.values.row(i);
+        let written = row.iter().skip(1).take(expected.len());
+        if !expected.iter().map(|v| v.to_string()).eq(written.cloned()) {
+            return Err(StreamError::BadFile {
+                path: file_of(i).to_path_buf(),
+                reason: format!(
+                    "row {i}: its factor values are not this sweep's design point {i} \
+                     (edited by hand, or from another design): remove the row or the file"
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Reads a finished sweep file (or merges shard files) and checks that every design
 /// point has its row. Returns the sweep and the rows.
 pub fn load_complete(
     paths: &[std::path::PathBuf],
 ) -> Result<(Sweep, BTreeMap<usize, Vec<String>>), SweepError> {
-    let file = stream::merge(paths)?;
+    let (file, sources) = stream::merge(paths)?;
     let sweep = Sweep::from_config(&file.config, &paths[0])?;
-    let n = sweep.design()?.len();
+    let design = sweep.design()?;
+    check_design_values(&design, &file.rows, |i| &sources[i % sources.len()])?;
+    let n = design.len();
     let missing: Vec<usize> = (0..n).filter(|i| !file.rows.contains_key(i)).collect();
     if let Some(&first) = missing.first() {
         return Err(SweepError::Incomplete {

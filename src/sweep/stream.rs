@@ -84,6 +84,8 @@ pub enum StreamError {
         line: usize,
         reason: String,
     },
+    #[error("{path}: {reason}")]
+    BadFile { path: PathBuf, reason: String },
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> StreamError + '_ {
@@ -126,9 +128,8 @@ pub fn read(path: &Path) -> Result<(SweepFile, bool), StreamError> {
         Some(i) => i + 1,
         None => 0,
     };
-    let text = std::str::from_utf8(&bytes[..complete]).map_err(|e| StreamError::BadRow {
+    let text = std::str::from_utf8(&bytes[..complete]).map_err(|e| StreamError::BadFile {
         path: path.into(),
-        line: 0,
         reason: format!("not UTF-8 text: {e}"),
     })?;
     let mut lines = text.lines();
@@ -176,6 +177,7 @@ pub fn read(path: &Path) -> Result<(SweepFile, bool), StreamError> {
         let index: usize = fields[0]
             .parse()
             .map_err(|_| bad(line, format!("index `{}` is not a whole number", fields[0])))?;
+        check_numbers(&columns, &fields).map_err(|reason| bad(line, reason))?;
         if let Some(old) = rows.insert(index, fields) {
             if old != rows[&index] {
                 return Err(bad(
@@ -194,6 +196,26 @@ pub fn read(path: &Path) -> Result<(SweepFile, bool), StreamError> {
         },
         complete < bytes.len(),
     ))
+}
+
+/// Checks that every cell of a row but the index and the `error` text is a finite
+/// number or empty (an output that could not be computed): a NaN or a stray word in
+/// a resumed or merged file would otherwise reach the analysis.
+fn check_numbers(columns: &[String], fields: &[String]) -> Result<(), String> {
+    let numbers = columns
+        .iter()
+        .zip(fields)
+        .skip(1)
+        .filter(|(c, _)| c.as_str() != "error");
+    for (column, cell) in numbers {
+        let finite = cell.parse::<f64>().is_ok_and(f64::is_finite);
+        if !(cell.is_empty() || finite) {
+            return Err(format!(
+                "column `{column}`: `{cell}` is not a finite number"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// An open sweep file receiving rows as they finish.
@@ -293,15 +315,14 @@ pub fn finish(
 
 /// Reads the shard files `paths` and checks that they are the n shards of one sweep:
 /// same configuration and columns, each shard once. Returns the config, the columns
-/// and every row.
-pub fn merge(paths: &[PathBuf]) -> Result<SweepFile, StreamError> {
+/// and every row, and the file of each shard (by shard index).
+pub fn merge(paths: &[PathBuf]) -> Result<(SweepFile, Vec<PathBuf>), StreamError> {
     let mut merged: Option<SweepFile> = None;
     let mut seen: Vec<Option<PathBuf>> = Vec::new();
     for path in paths {
         let (file, partial) = read(path)?;
-        let bad = |reason: String| StreamError::BadRow {
+        let bad = |reason: String| StreamError::BadFile {
             path: path.clone(),
-            line: 0,
             reason,
         };
         if partial {
@@ -351,25 +372,24 @@ pub fn merge(paths: &[PathBuf]) -> Result<SweepFile, StreamError> {
             }
         }
     }
+    let merged = merged.ok_or_else(|| StreamError::BadFile {
+        path: PathBuf::from("sweep merge"),
+        reason: "no shard files given".into(),
+    })?;
     let missing: Vec<String> = seen
         .iter()
         .enumerate()
         .filter(|(_, p)| p.is_none())
         .map(|(i, _)| format!("{i}/{}", seen.len()))
         .collect();
-    let merged = merged.ok_or_else(|| StreamError::BadRow {
-        path: PathBuf::from("(no files)"),
-        line: 0,
-        reason: "no shard files given".into(),
-    })?;
     if !missing.is_empty() {
-        return Err(StreamError::BadRow {
-            path: paths[0].clone(),
-            line: 0,
-            reason: format!("shards {} are missing", missing.join(", ")),
+        let given: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+        return Err(StreamError::BadFile {
+            path: PathBuf::from(given.join(", ")),
+            reason: format!("missing shard {}", missing.join(", ")),
         });
     }
-    Ok(merged)
+    Ok((merged, seen.into_iter().flatten().collect()))
 }
 
 #[cfg(test)]

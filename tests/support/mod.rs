@@ -114,3 +114,29 @@ pub fn values(p: &Params, names: &[&'static str]) -> Vec<(&'static str, f64)> {
         .map(|n| (*n, p.get(n).unwrap().expect("the parameter applies")))
         .collect()
 }
+
+/// Byte spans of the JSON numbers in `text` (outside strings).
+pub fn number_spans(text: &str) -> Vec<(usize, usize)> {
+    let bytes = text.as_bytes();
+    let (mut out, mut i, mut in_string) = (Vec::new(), 0, false);
+    while i < bytes.len() {
+        let c = bytes[i];
+        if c == b'"' {
+            in_string = !in_string;
+            i += 1;
+            continue;
+        }
+        if !in_string && (c == b'-' || c.is_ascii_digit()) {
+            let start = i;
+            while i < bytes.len()
+                && (bytes[i].is_ascii_alphanumeric() || b"+-.".contains(&bytes[i]))
+            {
+                i += 1;
+            }
+            out.push((start, i));
+            continue;
+        }
+        i += 1;
+    }
+    out
+}

@@ -68,9 +68,10 @@ fn parse_move(s: &str) -> anyhow::Result<MoveTo> {
         .split_once('@')
         .with_context(|| format!("--moves {s}: expected TARGET@SPEED, e.g. 0.1@0.2"))?;
     let num = |t: &str| -> anyhow::Result<f64> {
-        t.trim()
-            .parse()
-            .map_err(|_| anyhow::anyhow!("--moves {s}: `{t}` is not a number"))
+        match t.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(anyhow::anyhow!("--moves {s}: `{t}` is not a finite number")),
+        }
     };
     Ok(MoveTo {
         target: num(target)?,
