@@ -1855,3 +1855,49 @@ fn a_sweep_stopped_by_sigint_resumes_to_the_bytes_of_a_straight_run() {
         "the resumed sweep differs from the straight one"
     );
 }
+
+/// `--profile` puts each fitted parameter's interval and points in the result, with a
+/// plot each; a name that is not fitted is refused naming it (issue 14).
+#[test]
+fn identify_profile_writes_intervals_points_and_plots() {
+    let dir = tempdir();
+    let fr = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/worm-gear-noisy/frequency_response.json");
+    let fr = fr.to_str().unwrap();
+    let base = [
+        "identify",
+        fr,
+        "--preset",
+        "worm-gear",
+        "--model",
+        "linear",
+        "--quiet",
+    ];
+    let out = rtid_ok(
+        &[&base[..], &["--profile", "--out", "fit.json"]].concat(),
+        dir.path(),
+    );
+    assert!(out.contains("95 % profile interval"), "{out}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("fit.json")).unwrap())
+            .unwrap();
+    for name in ["Kw", "Kg"] {
+        let p = &v["profiles"][name];
+        let (lo, hi) = (p["lower"].as_f64().unwrap(), p["upper"].as_f64().unwrap());
+        let fitted = v["parameters"][name].as_f64().unwrap();
+        assert!(lo < fitted && fitted < hi, "{name}: {p}");
+        assert_eq!(p["level"].as_f64(), Some(0.95));
+        let points = p["points"].as_array().unwrap();
+        assert!(points.len() >= 5 && points.iter().all(|q| q.as_array().unwrap().len() == 2));
+        let svg =
+            std::fs::read_to_string(dir.path().join(format!("fit-profile-{name}.svg"))).unwrap();
+        assert!(svg.starts_with("<svg"));
+    }
+    let out = rtid(&[&base[..], &["--profile", "Kw,Kx"]].concat(), dir.path());
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--profile Kx: not a fitted parameter (fitted: Kg, Kw)"),
+        "{err}"
+    );
+}

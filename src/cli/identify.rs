@@ -8,6 +8,7 @@ use std::time::Duration;
 use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
+use super::profile::{add_profiles, profile_table, write_profile_plots};
 use super::ModelArgs;
 use rtid::identify::comparison;
 use rtid::identify::{
@@ -73,7 +74,10 @@ cannot separate parameters (|correlation| > 0.95 or a singular JᵀJ), when a pa
 on a bound, or when the fit misses the measured resonances; --out result.json with \
 everything (parameters, initial, bounds, cost, residuals per experiment, evaluations, \
 wall_time_s, termination, uncertainty); an SVG per experiment of the fit against the data; \
---save-params FILE for `--params FILE` everywhere.
+--save-params FILE for `--params FILE` everywhere. --profile adds each fitted \
+parameter's profile likelihood: its 95 % likelihood-ratio interval (open where the data do \
+not bound it, naming the parameters that move with it), beside ±1.96 standard errors, and \
+a plot each.
 
 Examples:
   rtid identify fixtures/worm-gear/frequency_response.json --preset worm-gear --out fit.json
@@ -81,7 +85,8 @@ Examples:
       --preset worm-gear --fit Kw,Kg,fm,Cm --out fit.json --save-params worm-fit.json
   rtid identify fixtures/worm-gear/torque_curve.json fixtures/worm-gear/unbalance.json \\
       --preset worm-gear --fit fm,ft --out friction.json
-  rtid identify fixtures/paper/worm-gear.json --preset worm-gear --fit Kw,Kg,Jt --model linear
+  rtid identify fixtures/paper/worm-gear.json --preset worm-gear --fit Kw,Kg,Jt --model linear \\
+      --profile
   rtid identify fixtures/real/emps/emps_estimation.json --params fixtures/real/emps/axis.json \\
       --out emps-fit.json --save-params emps-fit-params.json
   rtid modes --params worm-fit.json";
@@ -147,6 +152,13 @@ pub struct Args {
     /// Tload), else the --preset/--params values; `given` — at those values always.
     #[arg(long, value_enum, default_value = "estimate")]
     pub start: StartArg,
+    /// Profile likelihood of these fitted parameters (comma-separated; `--profile`
+    /// alone: every fitted one): each is held at values walking out from the fit both
+    /// ways while the others are re-fitted, giving its 95 % likelihood-ratio interval
+    /// (open on a side where the profile stays flat up to the bound). In the result as
+    /// `profiles`, plotted as FILE-profile-NAME.svg beside --out.
+    #[arg(long, value_name = "NAMES", num_args = 0..=1, default_missing_value = "")]
+    pub profile: Option<String>,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
@@ -410,12 +422,22 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let _ = handle.join();
         bar.finish_and_clear();
     }
-    let Identified { result, params } = outcome?;
+    let Identified {
+        mut result,
+        params,
+        objective,
+        settings,
+    } = outcome?;
+    if let Some(names) = &a.profile {
+        let fit = (objective.as_ref(), settings);
+        add_profiles(names, &mut result, &params, fit, &monitor, a.quiet)?;
+    }
     if let Some(path) = &a.out {
         result
             .write(path)
             .with_context(|| format!("writing {}", path.display()))?;
         write_plots(path, &config.experiments, &config.base, &params)?;
+        write_profile_plots(path, &result)?;
     }
     if let Some(path) = &a.save_params {
         save_params(path, &result, params)?;
@@ -491,6 +513,9 @@ fn print_summary(r: &IdentifyResult) {
         println!("start of {}: {}", names.join(", "), e.method);
     }
     println!("{}", parameter_table(r));
+    if let Some(t) = profile_table(r) {
+        println!("{t}");
+    }
     for res in &r.residuals {
         println!(
             "{} [{}]: RMS scaled residual {:.3} (unit: {}){}",

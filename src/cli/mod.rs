@@ -10,6 +10,7 @@ pub mod interrupt;
 mod model_args;
 mod modes;
 mod params_cmd;
+mod profile;
 mod progress;
 #[cfg(test)]
 mod properties;

@@ -45,13 +45,17 @@ pub const STEP_TOLERANCE: f64 = 1e-4;
 /// changes of ~0.2 %). From a linear fit 26 % off, keeping them biased Kg by +0.8 %.
 pub const RESTART_STEP: f64 = 1e-2;
 
-/// The linear residuals plus a fixed offset (the nonlinear shift at the last point).
-struct Corrected<'a> {
-    linear: &'a dyn Objective,
-    offset: Vec<f64>,
+/// The linear residuals plus a fixed offset (the mean nonlinear shift): borrowed
+/// (`&dyn Objective`) during the corrections; owned (a [`crate::objectives::Joint`])
+/// as the smooth stand-in for the nonlinear cost that a profile of the result walks.
+pub struct Corrected<L> {
+    pub linear: L,
+    pub offset: Vec<f64>,
 }
 
-impl Objective for Corrected<'_> {
+impl<L: std::ops::Deref<Target = O> + Sync + Send, O: Objective + ?Sized> Objective
+    for Corrected<L>
+{
     fn name(&self) -> &'static str {
         "corrected linear"
     }
@@ -80,6 +84,8 @@ pub struct Outcome {
     pub record: StartRecord,
     /// Evaluations of the nonlinear test.
     pub nonlinear_evaluations: usize,
+    /// The shift of the last corrected fit, whose optimum the result is.
+    pub offset: Vec<f64>,
 }
 
 /// Runs the corrections from `from` (physical values of the fitted parameters).
@@ -111,12 +117,13 @@ pub(crate) fn polish(
     let mut met = 1;
     let mut nonlinear_evaluations = 1;
     let mut corrections = 0;
+    let mut mean: Vec<f64> = sum.clone();
     let termination = loop {
         if monitor.stopped() {
             break Termination::Interrupted;
         }
-        let mean: Vec<f64> = sum.iter().map(|s| s / met as f64).collect();
-        let Some(next) = corrected_fit(space, linear, mean, &x, settings, monitor) else {
+        mean = sum.iter().map(|s| s / met as f64).collect();
+        let Some(next) = corrected_fit(space, linear, mean.clone(), &x, settings, monitor) else {
             break Termination::CorrectionFailed {
                 at: describe(space, &x),
             };
@@ -161,6 +168,7 @@ pub(crate) fn polish(
             termination,
         },
         nonlinear_evaluations,
+        offset: mean,
     })
 }
 

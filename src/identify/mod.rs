@@ -12,7 +12,9 @@
 //!    fit off — the [`correction`]s by the nonlinear test, resumable from a
 //!    [`checkpoint`];
 //! 5. [`assess`]: residuals, [`uncertainty`] and typed [`warning`]s at the best point;
-//! 6. [`result`]: the result file; [`comparison`]: the fitted model against the data.
+//! 6. [`result`]: the result file; [`comparison`]: the fitted model against the data;
+//! 7. on request, [`profile`]: the profile likelihood of fitted parameters, each point
+//!    an identification of the others.
 //!
 //! Parallelism: starts run in parallel (rayon); inside one cost evaluation the
 //! frequencies of a nonlinear frequency response, and the Jacobian's columns, run in
@@ -27,6 +29,7 @@ pub mod correction;
 pub mod escalation;
 pub mod plan;
 pub mod problem;
+pub mod profile;
 pub mod result;
 pub mod run;
 pub mod search;

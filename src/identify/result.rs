@@ -6,6 +6,7 @@ use std::path::Path;
 use super::assess::Assessment;
 use super::config::Config;
 use super::plan::Plan;
+use super::profile::Profile;
 use super::search::StartRecord;
 use super::space::ParamSpace;
 use super::start::StartEstimate;
@@ -81,6 +82,10 @@ pub struct IdentifyResult {
     pub nonlinear_check: Option<Vec<NonlinearCheck>>,
     /// What the user should know about this fit: a code and a message each.
     pub warnings: Vec<Coded<Warning>>,
+    /// With `--profile`: each profiled parameter's likelihood-ratio interval and the
+    /// profile behind it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profiles: Option<BTreeMap<String, Profile>>,
 }
 
 impl IdentifyResult {
@@ -162,5 +167,6 @@ pub fn assemble(
         uncertainty: assessment.uncertainty,
         nonlinear_check: assessment.nonlinear_check,
         warnings: warnings.into_iter().map(Coded).collect(),
+        profiles: None,
     }
 }

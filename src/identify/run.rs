@@ -11,18 +11,26 @@ use super::config::Config;
 use super::plan::Plan;
 use super::problem::Monitor;
 use super::result::{assemble, IdentifyResult, Run};
+use super::search::Settings;
 use super::space::ParamSpace;
 use super::stages;
 use super::start::start;
 use super::warning::Warning;
 use super::IdentifyError;
 use crate::model::Params;
-use crate::objectives::ObjectiveError;
+use crate::objectives::{Objective, ObjectiveError};
 
-/// The identified parameters and the complete parameter set.
+/// The identified parameters and the complete parameter set, with the objective
+/// the result minimises and the search's settings (for a profile of the result).
 pub struct Identified {
     pub result: IdentifyResult,
     pub params: Params,
+    /// The smooth objective the result minimises: the last stage's, or after
+    /// nonlinear corrections the linear one corrected by their last shift (whose
+    /// value at `params` is near, not equal to, the result's nonlinear cost).
+    pub objective: Box<dyn Objective>,
+    /// The settings of the search stage.
+    pub settings: Settings,
 }
 
 /// Runs the identification. `monitor` carries the stop flag (Ctrl-C) and the count
@@ -78,5 +86,10 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
     Ok(Identified {
         result: assemble(config, &plan, &space, run, assessment),
         params,
+        objective: match ran.surrogate {
+            Some(s) => Box::new(s),
+            None => Box::new(ran.joint),
+        },
+        settings: plan.stages[0].settings,
     })
 }

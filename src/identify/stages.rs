@@ -5,7 +5,7 @@
 
 use super::checkpoint::Checkpointer;
 use super::config::Config;
-use super::correction;
+use super::correction::{self, Corrected};
 use super::escalation;
 use super::plan::{Plan, StagePlan};
 use super::problem::Monitor;
@@ -28,6 +28,9 @@ pub struct Ran {
     pub stages: usize,
     /// The nonlinear check of the search's result (`auto`), when it was made.
     pub check: Option<Vec<NonlinearCheck>>,
+    /// After corrections: the linear objective with their last shift, a smooth
+    /// stand-in for the nonlinear cost, minimised at the result.
+    pub surrogate: Option<Corrected<Box<Joint>>>,
 }
 
 /// Runs every stage of `plan` not finished before a resume. The best point is left
@@ -104,6 +107,7 @@ pub fn run(
             warnings: Vec::new(),
             stages: resumed.stage,
             check: None,
+            surrogate: None,
         }),
     }
 }
@@ -180,10 +184,15 @@ fn run_stage(
             parameters: space.dim(),
         });
     }
+    let mut surrogate = None;
     let starts = match stage.stage {
         Stage::Correction => {
             let linear = super::setup::build(&config.experiments, stage.stage, Fidelity::Linear)?;
             let out = correction::polish(space, &linear, &joint, from, &settings, monitor)?;
+            surrogate = Some(Corrected {
+                linear: Box::new(linear),
+                offset: out.offset,
+            });
             vec![out.record]
         }
         Stage::Search => {
@@ -201,5 +210,6 @@ fn run_stage(
         warnings,
         stages: 0,
         check: None,
+        surrogate,
     })
 }

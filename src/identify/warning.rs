@@ -71,6 +71,23 @@ pub enum Warning {
         max_miss_percent: f64,
         linear_misfit_db: f64,
     },
+    /// A profile stays below the 95 % level up to the parameter's bound on one side:
+    /// the data bound it on the other side only; `family` are the other fitted
+    /// parameters that moved along it (ratio of largest to smallest value).
+    ProfileOpen {
+        name: String,
+        side: Side,
+        bound: f64,
+        family: Vec<(String, f64)>,
+    },
+    /// A point of a profile fits better than the fit itself: the search stopped
+    /// short of the optimum.
+    ProfileBetterFit {
+        name: String,
+        value: f64,
+        cost: f64,
+        fit_cost: f64,
+    },
 }
 
 impl Warning {
@@ -91,6 +108,8 @@ impl Warning {
             Warning::RoughCost => "rough_cost",
             Warning::EstimateUnused { .. } => "estimate_unused",
             Warning::Escalated { .. } => "escalated",
+            Warning::ProfileOpen { .. } => "profile_open",
+            Warning::ProfileBetterFit { .. } => "profile_better_fit",
         }
     }
 }
@@ -168,6 +187,42 @@ impl fmt::Display for Warning {
                 "{source}: the linear fit does not explain the data — the nonlinear virtual test at its parameters puts the resonances at {} Hz (measured {} Hz), up to {max_miss_hz:.2} Hz ({max_miss_percent:.2} %) off, and the linear model's gain misses the measured curve by {linear_misfit_db:.2} dB RMS — beyond 0.5 % (a stiffness biased twice as much) or 1 dB (a flattened or misplaced peak): backlash or friction at the test's amplitude. So the result is the nonlinear fit, the linear one corrected by the nonlinear test",
                 hz(model_hz),
                 hz(measured_hz)
+            ),
+            Warning::ProfileOpen {
+                name,
+                side,
+                bound,
+                family,
+            } => {
+                write!(
+                    f,
+                    "{name}'s profile stays below the 95 % level up to its {side} bound {}: the data do not bound it on that side",
+                    crate::names::Num(*bound)
+                )?;
+                if !family.is_empty() {
+                    let moved: Vec<String> = family
+                        .iter()
+                        .map(|(n, r)| format!("{n} ×{r:.2}"))
+                        .collect();
+                    let names: Vec<&str> = family.iter().map(|(n, _)| n.as_str()).collect();
+                    write!(
+                        f,
+                        "; along the profile {} moved with it: the data determine a combination of {name}, {}, not each",
+                        moved.join(", "),
+                        names.join(", ")
+                    )?;
+                }
+                Ok(())
+            }
+            Warning::ProfileBetterFit {
+                name,
+                value,
+                cost,
+                fit_cost,
+            } => write!(
+                f,
+                "holding {name} at {} fits better than the result (cost {cost:.4e} against {fit_cost:.4e}): the search stopped short of the optimum — rerun with more --starts, or from there",
+                crate::names::Num(*value)
             ),
         }
     }

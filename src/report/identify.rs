@@ -2,6 +2,7 @@
 
 use super::figure::{Figure, Series, Style};
 use crate::identify::comparison::{Comparison, Role};
+use crate::identify::profile::{Profile, THRESHOLD};
 
 /// The measured data as markers (frequency responses) or lines, the model at the
 /// start dashed and at the identified values as a line.
@@ -27,4 +28,38 @@ pub fn comparison(c: &Comparison) -> Figure {
         ));
     }
     figure
+}
+
+/// The statistic is drawn up to this multiple of the threshold: beyond, a leap
+/// where the data stop being matched would flatten the part that matters.
+const PLOT_CAP: f64 = 5.0;
+
+/// A profile: the likelihood-ratio statistic against the held value (capped at
+/// [`PLOT_CAP`] × the threshold), the fitted points as markers joined by a line,
+/// the 95 % threshold dashed.
+pub fn profile(name: &str, p: &Profile) -> Figure {
+    let cap = PLOT_CAP * THRESHOLD;
+    let points: Vec<(f64, f64)> = p
+        .points
+        .iter()
+        .zip(&p.statistic)
+        .map(|(q, &s)| (q[0], s.min(cap)))
+        .collect();
+    let (lo, hi) = points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
+            (a.min(q.0), b.max(q.0))
+        });
+    Figure::new(
+        format!("profile likelihood of {name}"),
+        &format!("{name} (held), SI"),
+        "likelihood-ratio statistic (capped at 19.2)",
+    )
+    .with(Series::new("profile", points.clone(), Style::Line))
+    .with(Series::new("re-fitted points", points, Style::Markers))
+    .with(Series::new(
+        "95 % level (χ²₁ = 3.84)",
+        vec![(lo, THRESHOLD), (hi, THRESHOLD)],
+        Style::Dashed,
+    ))
 }
