@@ -1901,3 +1901,64 @@ fn identify_profile_writes_intervals_points_and_plots() {
         "{err}"
     );
 }
+
+/// `rtid select` ranks fits of the same data and tests nested ones; fits of other
+/// data and files that are not results are refused naming the file (issue 14).
+#[test]
+fn select_prefers_the_fit_the_data_ask_for_and_refuses_other_data() {
+    let dir = tempdir();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures");
+    let noisy = root.join("worm-gear-noisy/frequency_response.json");
+    let clean = root.join("worm-gear/frequency_response.json");
+    let fit = |data: &Path, extra: &[&str], out: &str| {
+        let base = [
+            "identify",
+            data.to_str().unwrap(),
+            "--preset",
+            "worm-gear",
+            "--model",
+            "linear",
+            "--objective",
+            "gain-curve",
+            "--quiet",
+            "--out",
+            out,
+        ];
+        rtid_ok(&[&base[..], extra].concat(), dir.path());
+    };
+    // Kg held 6 % off against Kg fitted.
+    fit(&noisy, &["--fit", "Kw", "--set", "Kg=900"], "kw.json");
+    fit(&noisy, &["--fit", "Kw,Kg"], "kw-kg.json");
+    fit(&clean, &["--fit", "Kw,Kg"], "clean.json");
+    let out = rtid_ok(&["select", "kw.json", "kw-kg.json", "--json"], dir.path());
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["criterion"], "aicc");
+    assert_eq!(v["candidates"][0]["label"], "kw-kg.json", "{v}");
+    assert!(v["candidates"][1]["delta"].as_f64().unwrap() > 10.0, "{v}");
+    let t = &v["nested"][0];
+    assert_eq!(
+        (t["restricted"].as_str(), t["full"].as_str()),
+        (Some("kw.json"), Some("kw-kg.json"))
+    );
+    assert!(t["p_value"].as_f64().unwrap() < 1e-6, "{t}");
+    let text = rtid_ok(&["select", "kw.json", "kw-kg.json"], dir.path());
+    assert!(
+        text.contains("best by AICc: kw-kg.json (Kg, Kw) — decisively preferred"),
+        "{text}"
+    );
+    for (args, culprit) in [
+        (
+            ["select", "kw.json", "clean.json"],
+            "clean.json fits other residuals than kw.json",
+        ),
+        (
+            ["select", "kw.json", noisy.to_str().unwrap()],
+            "not a result file",
+        ),
+    ] {
+        let out = rtid(&args, dir.path());
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.lines().count() == 1 && err.contains(culprit), "{err}");
+    }
+}

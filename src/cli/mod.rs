@@ -14,6 +14,7 @@ mod profile;
 mod progress;
 #[cfg(test)]
 mod properties;
+mod select;
 mod simulate;
 mod sweep;
 
@@ -42,6 +43,7 @@ Examples:
   rtid experiment positioning --preset worm-gear --out runs/worm
   rtid evaluate runs/worm/positioning.json
   rtid compare runs/worm runs/roller
+  rtid select fit-kw-kg.json fit-kw-kg-kb.json
   rtid sweep --preset worm-gear --method sobol --vary Kw=1e5..1e6:log --vary Jt=0.08..0.14 --outputs resonances --out s.csv";
 
 /// Top-level arguments.
@@ -82,6 +84,9 @@ pub enum Command {
     /// Sensitivity sweeps: grid, local, Morris, Sobol; streamed, resumable, shardable.
     #[command(long_about = sweep::LONG_ABOUT)]
     Sweep(sweep::Args),
+    /// Model selection: AIC, AICc, BIC and F-tests between identifications of the same data.
+    #[command(long_about = select::LONG_ABOUT)]
+    Select(select::Args),
 }
 
 /// Runs one parsed command line.
@@ -95,5 +100,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Evaluate(a) => evaluate::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Sweep(a) => sweep::run(a),
+        Command::Select(a) => select::run(a),
     }
 }

@@ -33,6 +33,7 @@ pub mod profile;
 pub mod result;
 pub mod run;
 pub mod search;
+pub mod selection;
 pub mod setup;
 pub mod solvers;
 pub mod space;
