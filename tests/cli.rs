@@ -1962,3 +1962,60 @@ fn select_prefers_the_fit_the_data_ask_for_and_refuses_other_data() {
         assert!(err.lines().count() == 1 && err.contains(culprit), "{err}");
     }
 }
+
+/// `rtid design` ranks candidate tests by the standard errors they would give: for
+/// ft the unbalance test above the torque curve; bad candidates name themselves
+/// (issue 14).
+#[test]
+fn design_ranks_the_unbalance_test_first_for_table_friction() {
+    let dir = tempdir();
+    let design = |candidates: &[&str], json: bool| -> Vec<String> {
+        let mut args: Vec<String> = ["design", "--preset", "worm-gear", "--fit", "ft", "--quiet"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        for c in candidates {
+            args.extend(["--candidate".to_string(), c.to_string()]);
+        }
+        if json {
+            args.push("--json".into());
+        }
+        args
+    };
+    let args = design(&["torque-curve", "unbalance:mass_kg=10,radius_m=0.1"], true);
+    let out = rtid_ok(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let c = v["candidates"].as_array().unwrap();
+    assert_eq!(c[0]["label"], "unbalance:mass_kg=10,radius_m=0.1", "{v}");
+    let (first, second) = (
+        c[0]["score"].as_f64().unwrap(),
+        c[1]["score"].as_f64().unwrap(),
+    );
+    assert!(first < second, "{v}");
+    assert!(c[0]["predicted_se"]["ft"].as_f64().unwrap() > 0.0);
+    assert_eq!(c[0]["settings"]["speed_deg_per_min"].as_f64(), Some(360.0));
+    for (candidate, culprit) in [
+        ("torquecurve", "unknown test `torquecurve`"),
+        ("unbalance:mass=3", "unknown setting `mass`"),
+        ("unbalance:mass_kg=-3", "mass_kg"),
+        (
+            "frequency-response:step_hz=nan",
+            "step_hz=`nan` is not a finite number",
+        ),
+    ] {
+        let args = design(&[candidate, "torque-curve"], false);
+        let out = rtid(
+            &args.iter().map(String::as_str).collect::<Vec<_>>(),
+            dir.path(),
+        );
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(
+            err.lines().count() == 1 && err.contains(culprit) && err.contains("--candidate"),
+            "{err}"
+        );
+    }
+}

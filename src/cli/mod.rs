@@ -2,6 +2,7 @@
 //! them into a run configuration and runs it.
 
 mod compare;
+mod design;
 mod evaluate;
 mod experiment;
 mod identify;
@@ -87,6 +88,9 @@ pub enum Command {
     /// Model selection: AIC, AICc, BIC and F-tests between identifications of the same data.
     #[command(long_about = select::LONG_ABOUT)]
     Select(select::Args),
+    /// Experiment design: candidate tests ranked by the standard errors they would give.
+    #[command(long_about = design::LONG_ABOUT)]
+    Design(design::Args),
 }
 
 /// Runs one parsed command line.
@@ -101,5 +105,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Compare(a) => compare::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Select(a) => select::run(a),
+        Command::Design(a) => design::run(a),
     }
 }

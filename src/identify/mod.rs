@@ -26,6 +26,7 @@ pub mod checkpoint;
 pub mod comparison;
 pub mod config;
 pub mod correction;
+pub mod design;
 pub mod escalation;
 pub mod plan;
 pub mod problem;

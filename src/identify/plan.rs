@@ -52,7 +52,7 @@ const FD_ROUGH: f64 = 1e-3;
 /// up) — and the nonlinear frequency response varies irregularly by ±0.03 dB near a
 /// friction-flattened peak, which a 2 % step (a 1 % shift of the peak, ~0.7 dB on its
 /// flanks) rises well above. The exact linear response is smooth: 1e-4.
-fn uncertainty_step(rough: bool, fidelity: Fidelity) -> f64 {
+pub(crate) fn uncertainty_step(rough: bool, fidelity: Fidelity) -> f64 {
     if rough {
         0.1
     } else if fidelity == Fidelity::Nonlinear {

@@ -101,7 +101,7 @@ pub(crate) fn with_residuals(
 
 /// Central-difference Jacobian of the residuals: each column ∂r/∂ln p (log
 /// parameters) or ∂r/∂p scaled by the range, the 2n evaluations in parallel.
-fn jacobian(
+pub(crate) fn jacobian(
     space: &ParamSpace,
     objective: &dyn Objective,
     values: &[f64],
