@@ -30,16 +30,6 @@ fn fit_and_profile(
     (fit, profiles, warnings)
 }
 
-/// The standard error of `name` in a fit.
-fn standard_error(fit: &Identified, name: &str) -> f64 {
-    let u = fit.result.uncertainty.as_ref().unwrap();
-    u.standard_errors
-        .iter()
-        .find(|(n, _)| n == name)
-        .and_then(|(_, s)| *s)
-        .unwrap()
-}
-
 /// Both ends closed, the truth inside, each half-width within 25 % of 1.96 standard
 /// errors (the cost is nearly quadratic where the data determine the parameter).
 fn assert_holds(fit: &Identified, profiles: &BTreeMap<String, Profile>, truth: &Params) {
@@ -51,7 +41,7 @@ fn assert_holds(fit: &Identified, profiles: &BTreeMap<String, Profile>, truth: &
             lo < want && want < hi,
             "{name}: truth {want} outside {lo}…{hi}"
         );
-        let se = standard_error(fit, name);
+        let se = fit.result.standard_error(name).unwrap();
         for half in [v - lo, hi - v] {
             let ratio = half / (1.96 * se);
             assert!(

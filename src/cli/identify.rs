@@ -549,19 +549,13 @@ fn parameter_table(r: &IdentifyResult) -> Table {
         "± standard error",
         "bounds",
     ]);
-    let se = |name: &str| {
-        r.uncertainty
-            .as_ref()
-            .and_then(|u| u.standard_errors.iter().find(|(n, _)| n == name))
-            .and_then(|(_, s)| *s)
-    };
     for (name, v) in &r.parameters {
         let b = r.bounds[name];
         t.add_row([
             name.clone(),
             format!("{:.5e}", r.initial[name]),
             format!("{v:.5e}"),
-            se(name).map_or("—".into(), |s| {
+            r.standard_error(name).map_or("—".into(), |s| {
                 format!("{s:.2e} ({:.2} %)", 100.0 * s / v.abs())
             }),
             format!("{:.3e}..{:.3e}", b[0], b[1]),

@@ -81,11 +81,7 @@ pub fn profile_table(r: &IdentifyResult) -> Option<Table> {
                 format!("{:+.2} %", 100.0 * (x - v) / v.abs())
             })
         };
-        let se = r
-            .uncertainty
-            .as_ref()
-            .and_then(|u| u.standard_errors.iter().find(|(n, _)| n == name))
-            .and_then(|(_, s)| *s);
+        let se = r.standard_error(name);
         t.add_row([
             name.clone(),
             format!("{v:.5e}"),

@@ -147,35 +147,14 @@ pub enum EstimateError {
 
 /// A multisine record, torque- or current-driven.
 fn periodic(exp: &Experiment, c: &Conditions) -> Result<Evaluation, EstimateError> {
-    let (time_s, input, excitation, motor, table) = match &exp.data {
-        Data::FrequencyResponseTime {
-            time_s,
-            motor_torque_nm,
-            motor_angle_rad,
-            table_angle_rad,
-            ..
-        } => (
-            time_s,
-            Input::Torque,
-            motor_torque_nm,
-            motor_angle_rad,
-            table_angle_rad,
-        ),
-        Data::FrequencyResponseTimeCurrent {
-            time_s,
-            motor_current_a,
-            motor_angle_rad,
-            table_angle_rad,
-            ..
-        } => (
-            time_s,
-            Input::Current,
-            motor_current_a,
-            motor_angle_rad,
-            table_angle_rad,
-        ),
-        _ => return Err(EstimateError::WrongKind),
+    let r = exp.data.time_record().ok_or(EstimateError::WrongKind)?;
+    let input = if r.current {
+        Input::Current
+    } else {
+        Input::Torque
     };
+    let (time_s, excitation, motor, table) =
+        (r.time_s, r.drive, r.motor_angle_rad, r.table_angle_rad);
     let period = sample_period(time_s).ok_or(EstimateError::TooShort(time_s.len()))?;
     let series = Series {
         sample_rate_hz: 1.0 / period,

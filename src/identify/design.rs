@@ -25,7 +25,7 @@ use serde::Serialize;
 use super::config::ExperimentSpec;
 use super::setup;
 use super::space::ParamSpace;
-use super::uncertainty::{jacobian, SINGULAR_RATIO};
+use super::uncertainty::{self, jacobian};
 use crate::experiments::fluctuation::{self, FluctuationTest};
 use crate::experiments::frequency_response::{self as fr, FrequencyTest};
 use crate::experiments::torque_curve::{self, TorqueTest};
@@ -66,7 +66,8 @@ pub struct Assessed {
     /// the candidate cannot determine the fitted set).
     pub predicted_se: BTreeMap<String, Option<f64>>,
     pub names: Vec<String>,
-    /// In the order of `names` (empty when not determined).
+    /// In the order of `names` (from the pseudo-inverse when not determined, so a
+    /// ±1 still shows).
     pub correlations: Vec<Vec<f64>>,
     /// Smallest / largest singular value of the column-scaled Jacobian.
     pub conditioning: f64,
@@ -101,11 +102,11 @@ pub struct Request<'a> {
 
 /// The candidates assessed, best first (undetermined ones last, in their order).
 pub fn rank(request: &Request, candidates: &[Candidate]) -> Result<Vec<Assessed>, DesignError> {
-    ParamSpace::new(request.params.clone(), request.fit, &[])?;
+    let space = ParamSpace::new(request.params.clone(), request.fit, &[])?;
     let mut out: Vec<Assessed> = candidates
         .par_iter()
         .map(|c| {
-            let a = assess(request, c);
+            let a = assess(request, &space, c);
             (request.on_done)();
             a
         })
@@ -118,7 +119,7 @@ pub fn rank(request: &Request, candidates: &[Candidate]) -> Result<Vec<Assessed>
 }
 
 /// One candidate: its virtual experiment, its objectives' Jacobian, the prediction.
-fn assess(request: &Request, c: &Candidate) -> Result<Assessed, DesignError> {
+fn assess(request: &Request, space: &ParamSpace, c: &Candidate) -> Result<Assessed, DesignError> {
     let objective_error = |e: &dyn std::fmt::Display| DesignError::Objective {
         label: c.label.clone(),
         message: e.to_string(),
@@ -130,10 +131,9 @@ fn assess(request: &Request, c: &Candidate) -> Result<Assessed, DesignError> {
         .rough;
     let joint =
         setup::build(specs, Stage::Search, Fidelity::Nonlinear).map_err(|e| objective_error(&e))?;
-    let space = ParamSpace::new(request.params.clone(), request.fit, &[])?;
     let step = super::plan::uncertainty_step(rough, Fidelity::Nonlinear);
-    let jac = jacobian(&space, &joint, &space.start, step).map_err(|e| objective_error(&e))?;
-    Ok(predict(request, c, &space, &jac))
+    let jac = jacobian(space, &joint, &space.start, step).map_err(|e| objective_error(&e))?;
+    Ok(predict(request, c, space, &jac))
 }
 
 /// The virtual experiment of a candidate.
@@ -173,61 +173,41 @@ fn experiment(p: &Params, c: &Candidate) -> Result<Experiment, DesignError> {
     })
 }
 
-/// Standard errors, correlations and score from the Jacobian `jac` (columns ∂r/∂ln p
-/// for a positive parameter, ∂r/∂(p/range) for a signed one, as `space` steps them).
+/// Standard errors, correlations and score from the Jacobian `jac` (as
+/// [`jacobian`] takes it) with σ = `request.noise`.
 fn predict(request: &Request, c: &Candidate, space: &ParamSpace, jac: &DMatrix<f64>) -> Assessed {
-    let k = jac.ncols();
-    let norms: Vec<f64> = (0..k).map(|j| jac.column(j).norm()).collect();
-    let scaled = DMatrix::from_fn(jac.nrows(), k, |i, j| {
-        jac[(i, j)] / norms[j].max(f64::MIN_POSITIVE)
-    });
-    let sv = scaled.singular_values();
-    let conditioning = if sv.is_empty() || jac.nrows() < k {
-        0.0
-    } else {
-        sv.min() / sv.max().max(f64::MIN_POSITIVE)
-    };
-    let fisher = jac.transpose() * jac / (request.noise * request.noise);
-    let cov = (conditioning >= SINGULAR_RATIO)
-        .then(|| fisher.try_inverse())
-        .flatten();
-    let names: Vec<String> = request.fit.to_vec();
-    // Relative: ln p's standard error is already; a signed parameter's is in units
-    // of its range.
-    let relative = |j: usize, s: f64| {
-        let b = space.bounds[j];
-        if b.log() {
-            s
-        } else {
-            s * (b.hi - b.lo) / space.start[j].abs().max(f64::MIN_POSITIVE)
-        }
-    };
-    let se = |j: usize| cov.as_ref().map(|m| relative(j, m[(j, j)].max(0.0).sqrt()));
-    let correlations = cov.as_ref().map_or_else(Vec::new, |m| {
-        (0..k)
-            .map(|i| {
-                (0..k)
-                    .map(|j| m[(i, j)] / (m[(i, i)] * m[(j, j)]).sqrt().max(f64::MIN_POSITIVE))
-                    .collect()
-            })
-            .collect()
-    });
-    let score = cov.as_ref().map(|m| match request.criterion {
-        Criterion::D => m.determinant().max(0.0).powf(0.5 / k as f64),
-        Criterion::A => (m.trace() / k as f64).max(0.0).sqrt(),
-    });
+    let u = uncertainty::from_jacobian(space, &space.start, jac, request.noise.powi(2)).uncertainty;
+    let relative: Vec<Option<f64>> = u
+        .standard_errors
+        .iter()
+        .zip(&space.start)
+        .map(|((_, se), v)| se.map(|s| s / v.abs().max(f64::MIN_POSITIVE)))
+        .collect();
     Assessed {
         label: c.label.clone(),
         settings: c.settings.clone(),
-        predicted_se: names
+        predicted_se: u
+            .names
             .iter()
-            .enumerate()
-            .map(|(j, n)| (n.clone(), se(j)))
+            .cloned()
+            .zip(relative.iter().copied())
             .collect(),
-        names,
-        correlations,
-        conditioning,
+        score: score(request.criterion, &relative, &u.correlation),
+        names: u.names,
+        correlations: u.correlation,
+        conditioning: u.conditioning,
         residuals: jac.nrows(),
-        score,
     }
+}
+
+/// The criterion on the relative covariance ρᵢⱼ·seᵢ·seⱼ (`None` when a standard
+/// error is undefined).
+fn score(criterion: Criterion, se: &[Option<f64>], correlation: &[Vec<f64>]) -> Option<f64> {
+    let se: Vec<f64> = se.iter().copied().collect::<Option<_>>()?;
+    let k = se.len();
+    let cov = DMatrix::from_fn(k, k, |i, j| correlation[i][j] * se[i] * se[j]);
+    Some(match criterion {
+        Criterion::D => cov.determinant().max(0.0).powf(0.5 / k as f64),
+        Criterion::A => (cov.trace() / k as f64).max(0.0).sqrt(),
+    })
 }

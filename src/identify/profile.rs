@@ -239,12 +239,7 @@ impl<'a> Context<'a> {
 
     /// The first step of a walk: half a standard error, or 1 % without one.
     fn first_step(&self, name: &str, value: f64) -> f64 {
-        let se = self.request.result.uncertainty.as_ref().and_then(|u| {
-            u.standard_errors
-                .iter()
-                .find(|(n, _)| n == name)
-                .and_then(|(_, se)| *se)
-        });
+        let se = self.request.result.standard_error(name);
         let log = self.bound(name).lo > 0.0;
         let scale = if log { 1.0 } else { value.abs().max(1e-12) };
         match se {

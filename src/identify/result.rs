@@ -94,6 +94,16 @@ impl IdentifyResult {
         crate::io::atomic::write(path, format!("{text}\n").as_bytes())
     }
 
+    /// The standard error of fitted parameter `name` in its unit, where defined.
+    pub fn standard_error(&self, name: &str) -> Option<f64> {
+        self.uncertainty
+            .as_ref()?
+            .standard_errors
+            .iter()
+            .find(|(n, _)| n == name)?
+            .1
+    }
+
     /// Whether a warning with `code` was given.
     pub fn warns(&self, code: &str) -> bool {
         self.warnings.iter().any(|w| w.0.code() == code)

@@ -62,18 +62,31 @@ pub(crate) fn with_residuals(
     r0: &[f64],
     step: f64,
 ) -> Result<Assessed, ObjectiveError> {
-    let names: Vec<String> = space.names.iter().map(|s| s.to_string()).collect();
     let jac = jacobian(space, objective, values, step)?;
     let (m, n) = jac.shape();
-    let shape = Shape::of(&jac);
-    let mut warnings = shape.warnings(&names);
     let sigma2 = if m > n {
         r0.iter().map(|r| r * r).sum::<f64>() / (m - n) as f64
     } else {
         f64::NAN
     };
+    Ok(from_jacobian(space, values, &jac, sigma2))
+}
+
+/// The uncertainty at `values` from the Jacobian `jac` (columns as [`jacobian`]
+/// takes them) and the residual variance `sigma2` (NaN: unknown): what the data of
+/// a fit determine, or — with a stated σ² — what a planned test would
+/// ([`super::design`]).
+pub(crate) fn from_jacobian(
+    space: &ParamSpace,
+    values: &[f64],
+    jac: &DMatrix<f64>,
+    sigma2: f64,
+) -> Assessed {
+    let names: Vec<String> = space.names.iter().map(|s| s.to_string()).collect();
+    let shape = Shape::of(jac);
+    let mut warnings = shape.warnings(&names);
     let inv = (shape.conditioning >= SINGULAR_RATIO)
-        .then(|| (jac.transpose() * &jac).try_inverse())
+        .then(|| (jac.transpose() * jac).try_inverse())
         .flatten();
     let correlation = correlation(inv.as_ref(), &shape);
     warnings.extend(correlated(&correlation, &names));
@@ -87,7 +100,7 @@ pub(crate) fn with_residuals(
             )
         })
         .collect();
-    Ok(Assessed {
+    Assessed {
         uncertainty: Uncertainty {
             standard_errors,
             names,
@@ -96,7 +109,7 @@ pub(crate) fn with_residuals(
             conditioning: shape.conditioning,
         },
         warnings,
-    })
+    }
 }
 
 /// Central-difference Jacobian of the residuals: each column ∂r/∂ln p (log

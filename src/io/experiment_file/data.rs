@@ -132,7 +132,59 @@ pub struct Signal {
     pub values: Vec<f64>,
 }
 
+/// The channels of a `frequency_response_time` record, whichever input drove it.
+#[derive(Clone, Copy, Debug)]
+pub struct TimeRecord<'a> {
+    pub time_s: &'a [f64],
+    /// `motor_torque_nm`, or `motor_current_a` when `current`.
+    pub drive: &'a [f64],
+    pub current: bool,
+    pub motor_angle_rad: &'a [f64],
+    pub table_angle_rad: &'a [f64],
+}
+
 impl Data {
+    /// The channels of a `frequency_response_time` record (torque- or current-driven);
+    /// `None` for other kinds.
+    pub fn time_record(&self) -> Option<TimeRecord<'_>> {
+        let (time_s, drive, current, motor_angle_rad, table_angle_rad) = match self {
+            Data::FrequencyResponseTime {
+                time_s,
+                motor_torque_nm,
+                motor_angle_rad,
+                table_angle_rad,
+                ..
+            } => (
+                time_s,
+                motor_torque_nm,
+                false,
+                motor_angle_rad,
+                table_angle_rad,
+            ),
+            Data::FrequencyResponseTimeCurrent {
+                time_s,
+                motor_current_a,
+                motor_angle_rad,
+                table_angle_rad,
+                ..
+            } => (
+                time_s,
+                motor_current_a,
+                true,
+                motor_angle_rad,
+                table_angle_rad,
+            ),
+            _ => return None,
+        };
+        Some(TimeRecord {
+            time_s,
+            drive,
+            current,
+            motor_angle_rad,
+            table_angle_rad,
+        })
+    }
+
     /// The kind of experiment this data belongs to.
     pub fn kind(&self) -> Kind {
         match self {

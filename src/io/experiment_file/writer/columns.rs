@@ -153,33 +153,20 @@ fn positioning(data: &Data) -> Vec<Column<'_>> {
 /// A frequency-response record's columns, its input as `motor_torque_nm` or
 /// `motor_current_a`.
 fn record(data: &Data) -> Vec<Column<'_>> {
-    let (time_s, input, motor_angle_rad, table_angle_rad) = match data {
-        Data::FrequencyResponseTime {
-            time_s,
-            motor_torque_nm,
-            motor_angle_rad,
-            table_angle_rad,
-            ..
-        } => (
-            time_s,
-            plain("motor_torque_nm", motor_torque_nm),
-            motor_angle_rad,
-            table_angle_rad,
-        ),
-        Data::FrequencyResponseTimeCurrent {
-            time_s,
-            motor_current_a,
-            motor_angle_rad,
-            table_angle_rad,
-            ..
-        } => (
-            time_s,
-            plain("motor_current_a", motor_current_a),
-            motor_angle_rad,
-            table_angle_rad,
-        ),
-        _ => return Vec::new(),
+    let Some(r) = data.time_record() else {
+        return Vec::new();
     };
+    let drive = if r.current {
+        "motor_current_a"
+    } else {
+        "motor_torque_nm"
+    };
+    let (time_s, input, motor_angle_rad, table_angle_rad) = (
+        r.time_s,
+        plain(drive, r.drive),
+        r.motor_angle_rad,
+        r.table_angle_rad,
+    );
     vec![
         plain("time_s", time_s),
         input,
