@@ -15,6 +15,7 @@ mod profile;
 mod progress;
 #[cfg(test)]
 mod properties;
+mod resample;
 mod select;
 mod simulate;
 mod sweep;

@@ -14,7 +14,8 @@
 //! 5. [`assess`]: residuals, [`uncertainty`] and typed [`warning`]s at the best point;
 //! 6. [`result`]: the result file; [`comparison`]: the fitted model against the data;
 //! 7. on request, [`profile`]: the profile likelihood of fitted parameters, each point
-//!    an identification of the others.
+//!    an identification of the others; [`resample`]: the residual block bootstrap of
+//!    the fit, each replicate the whole search again.
 //!
 //! Parallelism: starts run in parallel (rayon); inside one cost evaluation the
 //! frequencies of a nonlinear frequency response, and the Jacobian's columns, run in
@@ -31,6 +32,7 @@ pub mod escalation;
 pub mod plan;
 pub mod problem;
 pub mod profile;
+pub mod resample;
 pub mod result;
 pub mod run;
 pub mod search;

@@ -7,6 +7,7 @@ use super::assess::Assessment;
 use super::config::Config;
 use super::plan::Plan;
 use super::profile::Profile;
+use super::resample::Resampling;
 use super::search::StartRecord;
 use super::space::ParamSpace;
 use super::start::StartEstimate;
@@ -86,6 +87,10 @@ pub struct IdentifyResult {
     /// profile behind it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub profiles: Option<BTreeMap<String, Profile>>,
+    /// With `--resample`: the residual block bootstrap of the fit, its replicates'
+    /// values and each fitted parameter's interval.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resampling: Option<Resampling>,
 }
 
 impl IdentifyResult {
@@ -178,5 +183,6 @@ pub fn assemble(
         nonlinear_check: assessment.nonlinear_check,
         warnings: warnings.into_iter().map(Coded).collect(),
         profiles: None,
+        resampling: None,
     }
 }
