@@ -10,7 +10,7 @@ mod cli;
 fn main() -> ExitCode {
     quiet_on_broken_pipe();
     cli::interrupt::install();
-    let matches = negative_numbers(cli::Cli::command()).get_matches();
+    let matches = negative_numbers(colour(cli::Cli::command())).get_matches();
     let cli = cli::Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     match cli::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -37,6 +37,16 @@ fn one_line(e: &anyhow::Error) -> String {
         line.push_str(&text);
     }
     line
+}
+
+/// No colour in help and errors when `NO_COLOR` is set to anything but the empty
+/// string (no-color.org). The tables and progress bars have none to begin with.
+fn colour(c: clap::Command) -> clap::Command {
+    if std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty()) {
+        c.color(clap::ColorChoice::Never)
+    } else {
+        c
+    }
 }
 
 /// Every option and subcommand, recursively, takes a negative number as its value:

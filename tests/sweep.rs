@@ -234,7 +234,10 @@ fn the_merge_of_n_shards_equals_the_unsharded_sweep() {
     shards.reverse();
     // A missing shard is named.
     let err = sweep::load_complete(&shards[..2]).unwrap_err().to_string();
-    assert!(err.contains("missing") && err.contains("0/3"), "{err}");
+    assert!(
+        err.contains("missing") && err.contains("missing shard 1/3"),
+        "{err}"
+    );
     let (merged_sweep, rows) = sweep::load_complete(&shards).unwrap();
     assert_eq!(merged_sweep, s);
     let out = dir.path().join("merged.csv");
@@ -321,7 +324,7 @@ fn a_resumed_or_merged_file_with_a_nan_or_a_changed_point_is_refused_naming_it()
         "{err}"
     );
     let err = sweep::load_complete(&shards[..1]).unwrap_err().to_string();
-    assert!(err.contains("shard-0.csv: missing shard 1/2"), "{err}");
+    assert!(err.contains("shard-0.csv: missing shard 2/2"), "{err}");
 }
 
 /// Runs the real binary in `dir`.
@@ -416,7 +419,7 @@ fn the_command_line_shards_merges_and_plots() {
     };
     ok(&[&common[..], &["--out", "all.csv"]].concat());
     for i in 0..2 {
-        let shard = format!("{i}/2");
+        let shard = format!("{}/2", i + 1);
         let file = format!("part{i}.csv");
         ok(&[&common[..], &["--shard", &shard, "--out", &file]].concat());
     }

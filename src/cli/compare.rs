@@ -51,6 +51,10 @@ pub struct Args {
     /// Print JSON {"DIR_A": summary, "DIR_B": summary} instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// No progress display or notes on stderr (the command is quick: it has no
+    /// progress bar; accepted like every command's `--quiet`, for scripts).
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {

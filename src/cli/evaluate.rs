@@ -64,6 +64,10 @@ pub struct Args {
     /// Print JSON instead of tables.
     #[arg(long)]
     pub json: bool,
+    /// No progress display or notes on stderr (the command is quick: it has no
+    /// progress bar; accepted like every command's `--quiet`, for scripts).
+    #[arg(long)]
+    pub quiet: bool,
     /// Where to write the plot (default: beside the manifest, FILE.svg).
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,

@@ -17,6 +17,7 @@ mod progress;
 mod properties;
 mod resample;
 mod select;
+mod shell;
 mod simulate;
 mod sweep;
 
@@ -50,7 +51,7 @@ Examples:
 
 /// Top-level arguments.
 #[derive(Debug, Parser)]
-#[command(name = "rtid", version, about = ABOUT, long_about = LONG_ABOUT)]
+#[command(name = "rtid", version = rtid::VERSION, about = ABOUT, long_about = LONG_ABOUT)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -92,6 +93,12 @@ pub enum Command {
     /// Experiment design: candidate tests ranked by the standard errors they would give.
     #[command(long_about = design::LONG_ABOUT)]
     Design(design::Args),
+    /// Shell completion script (bash, zsh, fish, elvish, powershell) on stdout.
+    #[command(long_about = shell::COMPLETIONS_ABOUT)]
+    Completions(shell::CompletionArgs),
+    /// The man page (roff), or with --out DIR one page per command.
+    #[command(long_about = shell::MAN_ABOUT)]
+    Man(shell::ManArgs),
 }
 
 /// Runs one parsed command line.
@@ -107,5 +114,43 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sweep(a) => sweep::run(a),
         Command::Select(a) => select::run(a),
         Command::Design(a) => design::run(a),
+        Command::Completions(a) => shell::completions(a),
+        Command::Man(a) => shell::man(a),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// The commands that run something, with their path (`rtid sweep merge`).
+    fn leaves(c: &clap::Command, path: String, out: &mut Vec<(String, clap::Command)>) {
+        let subs: Vec<&clap::Command> = c
+            .get_subcommands()
+            .filter(|s| s.get_name() != "help")
+            .collect();
+        for s in &subs {
+            leaves(s, format!("{path} {}", s.get_name()), out);
+        }
+        if subs.is_empty() {
+            out.push((path, c.clone()));
+        }
+    }
+
+    #[test]
+    fn every_command_takes_json_and_quiet() {
+        let mut all = Vec::new();
+        leaves(&super::Cli::command(), "rtid".into(), &mut all);
+        assert!(all.len() > 15, "{}", all.len());
+        for (path, c) in &all {
+            let has = |long: &str| c.get_arguments().any(|a| a.get_long() == Some(long));
+            // What completions print is the script itself, man the page.
+            if !path.ends_with("completions") {
+                assert!(has("quiet"), "{path} has no --quiet");
+            }
+            if !path.ends_with("completions") && !path.ends_with("man") {
+                assert!(has("json"), "{path} has no --json");
+            }
+        }
     }
 }

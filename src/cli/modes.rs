@@ -26,6 +26,10 @@ pub struct Args {
     /// Print JSON {\"clamped_hz\": [...], \"free_hz\": [...], ...} instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// No progress display or notes on stderr (the command is quick: it has no
+    /// progress bar; accepted like every command's `--quiet`, for scripts).
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {

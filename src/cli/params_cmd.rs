@@ -29,13 +29,18 @@ pub struct Args {
     /// Print the parameter set as JSON.
     #[arg(long)]
     pub json: bool,
+    /// No "wrote FILE" note on stderr.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.model.load()?;
     if let Some(path) = &a.out {
         params_file::write(path, &p)?;
-        eprintln!("wrote {}", path.display());
+        if !a.quiet {
+            eprintln!("wrote {}", path.display());
+        }
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&p)?);

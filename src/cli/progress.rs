@@ -1,5 +1,5 @@
-//! Progress bars for long runs: shown on a terminal, hidden when stdout is not one
-//! (scripts, pipes, CI) or with `--quiet`.
+//! Progress bars for long runs, with the time left: drawn on stderr when it is a
+//! terminal, hidden when it is not (scripts, pipes, CI) or with `--quiet`.
 
 use std::io::IsTerminal;
 
@@ -7,7 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 /// A bar of `total` steps labelled `what`.
 pub fn bar(total: u64, what: &str, quiet: bool) -> ProgressBar {
-    if quiet || !std::io::stdout().is_terminal() {
+    if quiet || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::new(total);

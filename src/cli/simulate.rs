@@ -74,6 +74,9 @@ pub struct Args {
     /// Print a JSON summary instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// No progress bar (shown on a terminal, with the simulated time and the time left).
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// A parsed `--input`.
@@ -197,6 +200,8 @@ struct CsvRecorder<W: Write> {
     count: u64,
     reference: Option<(Move, f64)>,
     error: Option<csv::Error>,
+    /// Simulated milliseconds (hidden unless stderr is a terminal).
+    bar: indicatif::ProgressBar,
 }
 
 impl<W: Write> Recorder for CsvRecorder<W> {
@@ -217,6 +222,7 @@ impl<W: Write> Recorder for CsvRecorder<W> {
         if let Err(e) = self.out.write_record(&row) {
             self.error = Some(e);
         }
+        self.bar.set_position((t * 1e3) as u64);
     }
 }
 
@@ -289,6 +295,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         closed,
         |rec| drive(&mut sim, &p, &a.input, recorded.take(), a.duration_s, rec),
         every,
+        super::progress::bar((a.duration_s * 1e3) as u64, "simulated ms", a.quiet),
     )
     .with_context(|| {
         format!(
@@ -397,6 +404,7 @@ fn write_csv(
         &mut CsvRecorder<&mut std::io::BufWriter<&std::fs::File>>,
     ) -> Result<(), rtid::sim::SimError>,
     every: u64,
+    bar: indicatif::ProgressBar,
 ) -> anyhow::Result<()> {
     let result: anyhow::Result<()> = atomic::write_with(path, |w| {
         let mut out = csv::Writer::from_writer(w);
@@ -412,8 +420,10 @@ fn write_csv(
             count: 0,
             reference: None,
             error: None,
+            bar,
         };
         simulate(&mut rec)?;
+        rec.bar.finish_and_clear();
         if let Some(e) = rec.error {
             return Err(e.into());
         }

@@ -50,7 +50,7 @@ are computed and the final file is the same as a straight run's. Beside it: \
 FILE-indices.csv (local/morris/sobol) and FILE-COLUMN.svg plots (tornado charts or \
 grid plots).
 
-Clusters: --shard I/N computes design points I, I+N, I+2N, … (0 ≤ I < N) into its own \
+Clusters: --shard I/N (1 ≤ I ≤ N, counted from 1) computes design points I−1, I−1+N, … into its own \
 --out; run N of them as a job array (Slurm: --shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT), \
 then `rtid sweep merge SHARD-FILES… --out FILE.csv` joins them and computes the indices. \
 docs/sweeps.md has a Slurm script.
@@ -102,6 +102,9 @@ pub struct MergeArgs {
     /// Print the indices as JSON.
     #[arg(long)]
     pub json: bool,
+    /// No "wrote FILE" lines.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// Arguments of a sweep run.
@@ -148,7 +151,7 @@ pub struct RunArgs {
     /// Replace an existing --out instead of refusing.
     #[arg(long)]
     pub overwrite: bool,
-    /// Compute only shard I of N (0 ≤ I < N) of the design, for a job array.
+    /// Compute only shard I of N (1 ≤ I ≤ N) of the design, for a job array.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<Shard>,
     /// Worker threads (default: one per core).
@@ -270,14 +273,21 @@ fn run_sweep(a: RunArgs) -> anyhow::Result<()> {
     }
     let (_, rows) = sweep::load_complete(std::slice::from_ref(&out))?;
     let (indices, files) = write_report(&sweep, &rows, &out)?;
-    print(&sweep, &out, Some(report), &indices, &files, a.json)
+    print(
+        &sweep,
+        &out,
+        Some(report),
+        &indices,
+        &files,
+        (a.json, a.quiet),
+    )
 }
 
 fn merge(m: MergeArgs) -> anyhow::Result<()> {
     let (sweep, rows) = sweep::load_complete(&m.shards)?;
     sweep::write_final(&sweep, &rows, &m.out)?;
     let (indices, files) = write_report(&sweep, &rows, &m.out)?;
-    print(&sweep, &m.out, None, &indices, &files, m.json)
+    print(&sweep, &m.out, None, &indices, &files, (m.json, m.quiet))
 }
 
 /// The indices file (not for a grid) and the plots beside `out`: tornado charts, or
@@ -325,7 +335,7 @@ fn print(
     report: Option<sweep::RunReport>,
     indices: &Indices,
     files: &[PathBuf],
-    json: bool,
+    (json, quiet): (bool, bool),
 ) -> anyhow::Result<()> {
     if json {
         let v = serde_json::json!({
@@ -369,7 +379,7 @@ fn print(
     for n in &indices.notes {
         println!("note: {n}");
     }
-    for f in files {
+    for f in files.iter().filter(|_| !quiet) {
         println!("wrote {}", f.display());
     }
     Ok(())

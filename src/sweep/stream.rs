@@ -22,7 +22,8 @@ use serde::{Deserialize, Serialize};
 /// First line of every sweep file (format version).
 pub const MAGIC: &str = "# rtid sweep 1";
 
-/// A slice of a design: the points whose index ≡ `index` (mod `count`).
+/// A slice of a design: the points whose index ≡ `index` (mod `count`). `index`
+/// counts from 0; the text form `I/N` from 1 (I = index + 1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Shard {
     pub index: usize,
@@ -38,27 +39,32 @@ impl Shard {
 
 impl std::str::FromStr for Shard {
     type Err = crate::names::BadForm;
-    /// `I/N` with 0 ≤ I < N (Slurm: `$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`).
+    /// `I/N` with 1 ≤ I ≤ N, counted from 1 like nextest, jest and Playwright
+    /// (Slurm: `--array=1-N`, `$SLURM_ARRAY_TASK_ID/N`).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let bad = || crate::names::BadForm {
             given: s.to_string(),
-            expected: "I/N with 0 ≤ I < N, e.g. 3/16",
+            expected: "I/N with 1 ≤ I ≤ N, e.g. 3/16",
         };
         let (i, n) = s.split_once('/').ok_or_else(bad)?;
-        let (index, count): (usize, usize) = (
+        let (number, count): (usize, usize) = (
             i.trim().parse().map_err(|_| bad())?,
             n.trim().parse().map_err(|_| bad())?,
         );
-        if count == 0 || index >= count {
+        if number == 0 || number > count {
             return Err(bad());
         }
-        Ok(Shard { index, count })
+        Ok(Shard {
+            index: number - 1,
+            count,
+        })
     }
 }
 
 impl std::fmt::Display for Shard {
+    /// `I/N`, counted from 1.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
+        write!(f, "{}/{}", self.index + 1, self.count)
     }
 }
 
@@ -380,7 +386,13 @@ pub fn merge(paths: &[PathBuf]) -> Result<(SweepFile, Vec<PathBuf>), StreamError
         .iter()
         .enumerate()
         .filter(|(_, p)| p.is_none())
-        .map(|(i, _)| format!("{i}/{}", seen.len()))
+        .map(|(index, _)| {
+            Shard {
+                index,
+                count: seen.len(),
+            }
+            .to_string()
+        })
         .collect();
     if !missing.is_empty() {
         let given: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
@@ -398,9 +410,11 @@ mod tests {
 
     #[test]
     fn shards_parse_and_partition() {
-        let s: Shard = "2/4".parse().unwrap();
+        let s: Shard = "3/4".parse().unwrap();
         assert!(s.contains(6) && !s.contains(7));
-        for bad in ["4/4", "1", "a/2", "0/0"] {
+        assert_eq!(s.to_string(), "3/4");
+        assert_eq!("4/4".parse::<Shard>().unwrap().index, 3);
+        for bad in ["0/4", "5/4", "1", "a/2", "0/0"] {
             assert!(bad.parse::<Shard>().is_err(), "{bad}");
         }
     }
