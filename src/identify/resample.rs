@@ -207,7 +207,7 @@ impl Problem<'_> {
     /// parts do not add up to it).
     fn segments(&self, n: usize) -> Vec<Range<usize>> {
         if self.parts.iter().map(|p| p.1).sum::<usize>() != n {
-            return vec![0..n];
+            return std::iter::once(0..n).collect();
         }
         let mut at = 0;
         self.parts
