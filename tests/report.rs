@@ -331,6 +331,13 @@ fn bad_input_is_one_clear_error_naming_the_file_or_option() {
         d,
     );
     assert_error(&out, &["--tolerance-arcsec"]);
+    let out = rtid(&["report", "pos", "--out", "x.html"], d);
+    assert_error(&out, &["pos", "not a regular file"]);
+    let sweep = std::fs::read_to_string(d.join("s.csv")).unwrap();
+    let head: Vec<&str> = sweep.lines().take(4).collect();
+    std::fs::write(d.join("part.csv"), head.join("\n") + "\n").unwrap();
+    let out = rtid(&["report", "part.csv", "--out", "x.html"], d);
+    assert_error(&out, &["part.csv", "sweep file"]);
     assert!(!d.join("x.html").exists(), "no page after an error");
 }
 

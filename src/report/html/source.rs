@@ -25,7 +25,9 @@ pub struct Options {
 
 /// The section of the file `path`, whatever its kind.
 pub fn load(path: &Path, options: &Options) -> Result<Section, HtmlError> {
-    let bytes = std::fs::read(path).map_err(|source| HtmlError::Read {
+    // A regular file of bounded size: a device or a pipe named by mistake would be
+    // read for ever.
+    let text = crate::io::read_input(path).map_err(|source| HtmlError::Read {
         path: path.to_path_buf(),
         source,
     })?;
@@ -33,8 +35,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Section, HtmlError> {
         path: path.to_path_buf(),
         reason,
     };
-    let text = std::str::from_utf8(&bytes).map_err(|_| unrecognised("not UTF-8 text".into()))?;
-    let text = crate::io::without_bom(text);
+    let text = crate::io::without_bom(&text);
     if text.starts_with(crate::sweep::stream::MAGIC) {
         return sweep::section(path);
     }
