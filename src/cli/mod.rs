@@ -15,6 +15,7 @@ mod profile;
 mod progress;
 #[cfg(test)]
 mod properties;
+mod report;
 mod resample;
 mod select;
 mod shell;
@@ -47,6 +48,7 @@ Examples:
   rtid evaluate runs/worm/positioning.json
   rtid compare runs/worm runs/roller
   rtid select fit-kw-kg.json fit-kw-kg-kb.json
+  rtid report fit.json runs/worm/positioning.json --tolerance-arcsec 20 --out report.html
   rtid sweep --preset worm-gear --method sobol --vary Kw=1e5..1e6:log --vary Jt=0.08..0.14 --outputs resonances --out s.csv";
 
 /// Top-level arguments.
@@ -99,6 +101,9 @@ pub enum Command {
     /// The man page (roff), or with --out DIR one page per command.
     #[command(long_about = shell::MAN_ABOUT)]
     Man(shell::ManArgs),
+    /// One self-contained HTML page of identifications, positioning tests and sweeps.
+    #[command(long_about = report::LONG_ABOUT)]
+    Report(report::Args),
 }
 
 /// Runs one parsed command line.
@@ -116,6 +121,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Design(a) => design::run(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
+        Command::Report(a) => report::run(a),
     }
 }
 

@@ -5,6 +5,7 @@ pub mod figure;
 pub mod fluctuation;
 pub mod frequency_response;
 pub mod frequency_response_time;
+pub mod html;
 pub mod identify;
 pub mod periodic;
 pub mod positioning;

@@ -1,0 +1,233 @@
+//! The section of an identification result (`rtid identify --out`): what was fitted
+//! to which data (with the data's SHA-256, so the record shows it was this data),
+//! the values with their uncertainty, the correlations, the residuals and the
+//! warnings.
+
+use std::path::{Path, PathBuf};
+
+use sha2::{Digest, Sha256};
+
+use super::markup::{escape, facts, figure, sci, table};
+use super::{correlation, HtmlError, Kind, Section};
+use crate::identify::IdentifyResult;
+use crate::report::figure::{Figure, FigureError, Series, Style};
+
+/// Most residuals drawn per experiment (the SVG stays small).
+const MAX_POINTS: usize = 2000;
+
+/// The section of `result`, read from `path`; `command` is the command line that
+/// wrote it, when the file records one.
+pub fn section(
+    path: &Path,
+    result: &IdentifyResult,
+    command: Option<&str>,
+) -> Result<Section, HtmlError> {
+    let drawn = |e: FigureError| HtmlError::Malformed {
+        path: path.to_path_buf(),
+        what: "identification result (`rtid identify --out`)",
+        message: e.to_string(),
+    };
+    let mut body = summary(result, command);
+    body.push_str("<h3>Experiments</h3>\n");
+    body.push_str(&experiments(path, result));
+    body.push_str("<h3>Parameters</h3>\n");
+    body.push_str(&parameters(result));
+    body.push_str(&correlations(result));
+    body.push_str(&residuals(result).map_err(drawn)?);
+    body.push_str(&profiles(result).map_err(drawn)?);
+    body.push_str(&warnings(result));
+    Ok(Section {
+        kind: Kind::Identification,
+        file: path.to_path_buf(),
+        title: format!("Identification: {}", result.mechanism),
+        body,
+    })
+}
+
+/// Mechanism, method, cost, effort and how the search ended.
+fn summary(r: &IdentifyResult, command: Option<&str>) -> String {
+    let mut pairs = vec![
+        ("mechanism", r.mechanism.clone()),
+        ("method", format!("{} ({} model)", r.method, r.fidelity)),
+        ("cost", format!("{:.4e}", r.cost)),
+        ("evaluations", r.evaluations.to_string()),
+        ("wall time", format!("{:.2} s", r.wall_time_s)),
+        ("termination", r.termination.0.to_string()),
+        ("report by", format!("rtid {}", env!("CARGO_PKG_VERSION"))),
+    ];
+    if r.interrupted {
+        pairs.push((
+            "interrupted",
+            "yes: the values are the best found before Ctrl-C".into(),
+        ));
+    }
+    if let Some(c) = command {
+        pairs.insert(0, ("command", c.to_string()));
+    }
+    facts(&pairs)
+}
+
+/// Each experiment file with its SHA-256, or "not found".
+fn experiments(path: &Path, r: &IdentifyResult) -> String {
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let rows: Vec<Vec<String>> = r
+        .experiments
+        .iter()
+        .map(|e| {
+            let hash = locate(folder, e).map_or("not found".into(), |p| {
+                sha256(&p).unwrap_or_else(|err| format!("not readable: {err}"))
+            });
+            vec![e.clone(), hash]
+        })
+        .collect();
+    table(&["file", "SHA-256"], &rows)
+}
+
+/// An experiment file as the result names it: beside the result first (where
+/// `rtid identify` was usually run from), else from the current folder.
+fn locate(folder: &Path, name: &str) -> Option<PathBuf> {
+    [folder.join(name), PathBuf::from(name)]
+        .into_iter()
+        .find(|p| p.is_file())
+}
+
+/// The file's SHA-256, hex.
+fn sha256(path: &Path) -> std::io::Result<String> {
+    let bytes = std::fs::read(path)?;
+    Ok(format!("{:x}", Sha256::digest(&bytes)))
+}
+
+/// One row per fitted parameter: start, value, standard error, bounds and the
+/// profile and bootstrap intervals when the fit has them.
+fn parameters(r: &IdentifyResult) -> String {
+    let profiles = r.profiles.as_ref();
+    let boot = r.resampling.as_ref().map(|s| &s.intervals);
+    let mut header = vec![
+        "parameter",
+        "start",
+        "identified",
+        "std. error",
+        "std. error %",
+        "lower bound",
+        "upper bound",
+    ];
+    if profiles.is_some() {
+        header.extend(["profile lower", "profile upper"]);
+    }
+    if boot.is_some() {
+        header.extend([
+            "bootstrap lower",
+            "bootstrap upper",
+            "bootstrap s.e.",
+            "bootstrap bias",
+        ]);
+    }
+    let open = |v: Option<f64>| v.map_or("open".into(), sci);
+    let rows: Vec<Vec<String>> = r
+        .parameters
+        .iter()
+        .map(|(name, &value)| {
+            let se = r.standard_error(name);
+            let bounds = r.bounds.get(name);
+            let mut row = vec![
+                name.clone(),
+                r.initial.get(name).map_or("–".into(), |&v| sci(v)),
+                sci(value),
+                se.map_or("–".into(), |s| format!("{s:.3e}")),
+                se.map_or("–".into(), |s| format!("{:.2}", 100.0 * s / value.abs())),
+                bounds.map_or("–".into(), |b| sci(b[0])),
+                bounds.map_or("–".into(), |b| sci(b[1])),
+            ];
+            if let Some(p) = profiles {
+                let p = p.get(name);
+                row.push(p.map_or("–".into(), |p| open(p.lower)));
+                row.push(p.map_or("–".into(), |p| open(p.upper)));
+            }
+            if let Some(b) = boot {
+                match b.get(name) {
+                    Some(i) => row.extend([
+                        sci(i.lower),
+                        sci(i.upper),
+                        format!("{:.3e}", i.standard_error),
+                        format!("{:.3e}", i.bias),
+                    ]),
+                    None => row.extend(["–".to_string(), "–".into(), "–".into(), "–".into()]),
+                }
+            }
+            row
+        })
+        .collect();
+    table(&header, &rows)
+}
+
+/// The correlation heat map, when the fit has an uncertainty estimate.
+fn correlations(r: &IdentifyResult) -> String {
+    let Some(u) = &r.uncertainty else {
+        return "<p>No uncertainty estimate: the fit has no standard errors or correlations.</p>\n"
+            .into();
+    };
+    format!(
+        "<h3>Correlations</h3>\n<p>Near ±1: the data cannot tell the two parameters apart.</p>\n{}",
+        correlation::heat_map(&u.names, &u.correlation)
+    )
+}
+
+/// One chart of the scaled residuals per experiment, against their index.
+fn residuals(r: &IdentifyResult) -> Result<String, FigureError> {
+    let mut html = String::from("<h3>Residuals</h3>\n");
+    for e in &r.residuals {
+        let points: Vec<(f64, f64)> = e
+            .residuals
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| (i as f64, v))
+            .collect();
+        html.push_str(&format!(
+            "<p><code>{}</code> ({}): RMS {:.4e}; one unit is {}.</p>\n",
+            escape(&e.source),
+            escape(&e.objective),
+            e.rms,
+            escape(&e.scale)
+        ));
+        if points.iter().all(|p| !p.1.is_finite()) {
+            html.push_str("<p>No finite residuals to draw.</p>\n");
+            continue;
+        }
+        let chart = Figure::new(
+            format!("residuals: {}", e.source),
+            "index",
+            "scaled residual",
+        )
+        .with(Series::new("residual", points, Style::Markers).thinned(MAX_POINTS));
+        html.push_str(&figure(&chart)?);
+    }
+    Ok(html)
+}
+
+/// The profile-likelihood charts, when the fit was profiled.
+fn profiles(r: &IdentifyResult) -> Result<String, FigureError> {
+    let Some(profiles) = &r.profiles else {
+        return Ok(String::new());
+    };
+    let mut html = String::from("<h3>Profiles</h3>\n");
+    for (name, p) in profiles {
+        if p.points.is_empty() {
+            continue;
+        }
+        html.push_str(&figure(&crate::report::identify::profile(name, p))?);
+    }
+    Ok(html)
+}
+
+/// The warnings in plain words.
+fn warnings(r: &IdentifyResult) -> String {
+    if r.warnings.is_empty() {
+        return "<h3>Warnings</h3>\n<p>None.</p>\n".into();
+    }
+    let mut html = String::from("<h3>Warnings</h3>\n<ul>\n");
+    for w in &r.warnings {
+        html.push_str(&format!("<li>{}</li>\n", escape(&w.0.to_string())));
+    }
+    html.push_str("</ul>\n");
+    html
+}
