@@ -18,6 +18,8 @@ table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.85em; }
 th, td { border: 1px solid #bbb; padding: 0.2em 0.5em; text-align: right; }
 th { background: #f0f0f0; }
 td:first-child, th:first-child, td.text { text-align: left; }
+td { white-space: nowrap; }
+td.text { white-space: normal; }
 dl.facts { display: grid; grid-template-columns: max-content auto; gap: 0.1em 1em; font-size: 0.9em; }
 dl.facts dt { font-weight: 600; }
 dl.facts dd { margin: 0; overflow-wrap: anywhere; }
@@ -33,6 +35,7 @@ code { overflow-wrap: anywhere; }
 @page { size: A4; margin: 14mm; }
 @media print {
   body { margin: 0; max-width: none; font-size: 10pt; }
+  table { font-size: 7.5pt; }
   nav { break-after: page; }
   section.report { break-before: page; }
   figure.chart, table, dl.facts { break-inside: avoid; }
@@ -53,7 +56,7 @@ pub fn page(title: &str, sections: &[Section]) -> String {
          <style>{CSS}</style>\n</head>\n<body>\n<header>\n<h1>{t}</h1>\n\
          <p class=\"meta\">Written by rtid {version}; {n} section{s}.</p>\n</header>\n",
         t = escape(title),
-        version = env!("CARGO_PKG_VERSION"),
+        version = escape(crate::VERSION),
         n = sections.len(),
         s = if sections.len() == 1 { "" } else { "s" },
     );
