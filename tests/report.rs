@@ -98,6 +98,26 @@ fn runs() -> &'static Runs {
             ],
             d,
         );
+        // The gain curve (79 residuals, linear: 0.05 s a fit) profiled and resampled.
+        rtid_ok(
+            &[
+                "identify",
+                exp,
+                "--preset",
+                "worm-gear",
+                "--objective",
+                "gain-curve",
+                "--model",
+                "linear",
+                "--profile",
+                "--resample",
+                "5",
+                "--out",
+                "intervals.json",
+                "--quiet",
+            ],
+            d,
+        );
         rtid_ok(
             &[
                 "experiment",
@@ -178,6 +198,33 @@ fn an_identification_page_shows_the_fit_as_the_result_file_holds_it() {
         "a residual chart per experiment"
     );
     assert!(page.contains("@page { size: A4"));
+}
+
+#[test]
+fn an_identification_page_shows_the_profile_and_bootstrap_intervals() {
+    let r = runs();
+    let page = r.page(&["intervals.json"], "intervals.html");
+    let text = std::fs::read_to_string(r.path("intervals.json")).unwrap();
+    let result: IdentifyResult = serde_json::from_str(&text).unwrap();
+    let profiles = result.profiles.as_ref().unwrap();
+    let resampling = result.resampling.as_ref().unwrap();
+    for name in result.parameters.keys() {
+        let p = &profiles[name];
+        for end in [p.lower, p.upper] {
+            assert!(page.contains(&sci(end.unwrap())), "{name}: profile end");
+        }
+        let i = resampling.intervals[name];
+        for end in [i.lower, i.upper] {
+            assert!(page.contains(&sci(end)), "{name}: bootstrap {end}");
+        }
+        for spread in [i.standard_error, i.bias] {
+            assert!(page.contains(&format!("{spread:.3e}")), "{name}: {spread}");
+        }
+        assert!(
+            page.contains(&format!("profile likelihood of {name}")),
+            "{name}: chart"
+        );
+    }
 }
 
 #[test]
