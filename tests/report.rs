@@ -118,6 +118,27 @@ fn runs() -> &'static Runs {
             ],
             d,
         );
+        // The same residuals with Kg held: a nested fit to compare.
+        rtid_ok(
+            &[
+                "identify",
+                exp,
+                "--preset",
+                "worm-gear",
+                "--objective",
+                "gain-curve",
+                "--model",
+                "linear",
+                "--fit",
+                "Kw",
+                "--set",
+                "Kg=800",
+                "--out",
+                "kw-only.json",
+                "--quiet",
+            ],
+            d,
+        );
         rtid_ok(
             &[
                 "experiment",
@@ -225,6 +246,25 @@ fn an_identification_page_shows_the_profile_and_bootstrap_intervals() {
             "{name}: chart"
         );
     }
+}
+
+#[test]
+fn identifications_of_the_same_data_are_compared_and_others_are_not() {
+    let r = runs();
+    let page = r.page(&["intervals.json", "kw-only.json"], "selection.html");
+    assert!(page.contains("Model selection"));
+    let out = rtid_ok(
+        &["select", "intervals.json", "kw-only.json", "--json"],
+        r.dir.path(),
+    );
+    let s: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for c in s["candidates"].as_array().unwrap() {
+        let aic = format!("{:.2}", c["aic"].as_f64().unwrap());
+        assert!(page.contains(&aic), "AIC {aic}");
+    }
+    assert!(page.contains("F-test: intervals.json adds Kg to kw-only.json"));
+    let page = r.page(&["fit.json", "intervals.json"], "other-data.html");
+    assert!(page.contains("are not compared") && page.contains("fits other residuals"));
 }
 
 #[test]

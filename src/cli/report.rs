@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 
+use rtid::identify::IdentifyResult;
 use rtid::report::html::{self, Options, Tolerances};
 
 pub const LONG_ABOUT: &str = "\
@@ -93,11 +94,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let options = a.options()?;
     let inputs: Vec<&Path> = a.files.iter().map(PathBuf::as_path).collect();
     super::inputs::refuse_overwrite("--out", &a.out, &inputs)?;
-    let sections = a
+    let loaded = a
         .files
         .iter()
         .map(|f| html::load(f, &options))
         .collect::<Result<Vec<_>, _>>()?;
+    let fits: Vec<(String, IdentifyResult)> = (a.files.iter().zip(&loaded))
+        .filter_map(|(f, l)| Some((f.display().to_string(), l.fit.clone()?)))
+        .collect();
+    let mut sections: Vec<html::Section> = loaded.into_iter().map(|l| l.section).collect();
+    sections.extend(html::selection::section(&fits));
     let title = a.title.as_deref().unwrap_or("rtid report");
     let page = html::page(title, &sections);
     rtid::io::atomic::write(&a.out, page.as_bytes())

@@ -95,22 +95,16 @@ fn print(s: &Selection) {
     }
     println!("{t}");
     for n in &s.nested {
-        let verdict = if n.full_stopped_short {
-            "but its cost is above the smaller fit's, which it contains: it stopped short of its optimum (more --max-iters or --starts), and the test says nothing"
-        } else if n.p_value < 0.05 {
-            "the data ask for it"
-        } else {
-            "not supported by the data"
-        };
         println!(
-            "F-test: {} adds {} to {}: F({}, {}) = {:.3}, p = {:.3e} — {verdict}",
+            "F-test: {} adds {} to {}: F({}, {}) = {:.3}, p = {:.3e} — {}",
             n.full,
             n.added.join(", "),
             n.restricted,
             n.df.0,
             n.df.1,
             n.f,
-            n.p_value
+            n.p_value,
+            n.verdict()
         );
     }
     let name = if s.criterion == "aicc" { "AICc" } else { "AIC" };

@@ -59,6 +59,19 @@ pub struct Nested {
     pub full_stopped_short: bool,
 }
 
+impl Nested {
+    /// What the test says, in words.
+    pub fn verdict(&self) -> &'static str {
+        if self.full_stopped_short {
+            "but its cost is above the smaller fit's, which it contains: it stopped short of its optimum (more --max-iters or --starts), and the test says nothing"
+        } else if self.p_value < 0.05 {
+            "the data ask for it"
+        } else {
+            "not supported by the data"
+        }
+    }
+}
+
 /// The comparison of several results.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Selection {

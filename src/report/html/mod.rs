@@ -12,6 +12,7 @@ pub mod identify;
 pub mod markup;
 pub mod page;
 pub mod positioning;
+pub mod selection;
 pub mod source;
 pub mod sweep;
 
@@ -28,6 +29,8 @@ pub enum Kind {
     Identification,
     Positioning,
     Sweep,
+    /// The comparison of the page's identifications (AIC, BIC, F-tests).
+    Selection,
 }
 
 impl Kind {
@@ -37,6 +40,7 @@ impl Kind {
             Kind::Identification => "identification",
             Kind::Positioning => "positioning",
             Kind::Sweep => "sweep",
+            Kind::Selection => "model selection",
         }
     }
 }
@@ -51,6 +55,12 @@ pub struct Section {
     pub title: String,
     /// The section's HTML, without its heading.
     pub body: String,
+}
+
+/// An identification's result with its section (for the page's model selection).
+pub struct Loaded {
+    pub section: Section,
+    pub fit: Option<crate::identify::IdentifyResult>,
 }
 
 /// Why a section cannot be written; each names its file.

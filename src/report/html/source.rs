@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use super::{identify, positioning, sweep, HtmlError, Section};
+use super::{identify, positioning, sweep, HtmlError, Loaded, Section};
 use crate::identify::IdentifyResult;
 
 /// Acceptance tolerances of the bidirectional accuracy A, one per kind of axis.
@@ -23,8 +23,9 @@ pub struct Options {
     pub tolerances: Tolerances,
 }
 
-/// The section of the file `path`, whatever its kind.
-pub fn load(path: &Path, options: &Options) -> Result<Section, HtmlError> {
+/// The section of the file `path`, whatever its kind (with the result, for an
+/// identification).
+pub fn load(path: &Path, options: &Options) -> Result<Loaded, HtmlError> {
     // A regular file of bounded size: a device or a pipe named by mistake would be
     // read for ever.
     let text = crate::io::read_input(path).map_err(|source| HtmlError::Read {
@@ -36,14 +37,15 @@ pub fn load(path: &Path, options: &Options) -> Result<Section, HtmlError> {
         reason,
     };
     let text = crate::io::without_bom(&text);
+    let alone = |section: Section| Loaded { section, fit: None };
     if text.starts_with(crate::sweep::stream::MAGIC) {
-        return sweep::section(path);
+        return sweep::section(path).map(alone);
     }
     let value: Value = serde_json::from_str(text)
         .map_err(|e| unrecognised(format!("not a sweep file, and not JSON: {e}")))?;
     match recognise(&value) {
         Some(Recognised::Identification) => identification(path, value),
-        Some(Recognised::Positioning) => positioning::section(path, &options.tolerances),
+        Some(Recognised::Positioning) => positioning::section(path, &options.tolerances).map(alone),
         Some(Recognised::OtherExperiment(kind)) => Err(unrecognised(format!(
             "an experiment manifest of kind `{kind}`; only positioning experiments are reported"
         ))),
@@ -76,7 +78,7 @@ fn recognise(v: &Value) -> Option<Recognised> {
 }
 
 /// The section of a result file's JSON.
-fn identification(path: &Path, value: Value) -> Result<Section, HtmlError> {
+fn identification(path: &Path, value: Value) -> Result<Loaded, HtmlError> {
     let command = value
         .get("command")
         .and_then(Value::as_str)
@@ -87,5 +89,9 @@ fn identification(path: &Path, value: Value) -> Result<Section, HtmlError> {
             what: "identification result (`rtid identify --out`)",
             message: e.to_string(),
         })?;
-    identify::section(path, &result, command.as_deref())
+    let section = identify::section(path, &result, command.as_deref())?;
+    Ok(Loaded {
+        section,
+        fit: Some(result),
+    })
 }
