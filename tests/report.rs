@@ -98,47 +98,16 @@ fn runs() -> &'static Runs {
             ],
             d,
         );
-        // The gain curve (79 residuals, linear: 0.05 s a fit) profiled and resampled.
-        rtid_ok(
-            &[
-                "identify",
-                exp,
-                "--preset",
-                "worm-gear",
-                "--objective",
-                "gain-curve",
-                "--model",
-                "linear",
-                "--profile",
-                "--resample",
-                "5",
-                "--out",
-                "intervals.json",
-                "--quiet",
-            ],
-            d,
-        );
-        // The same residuals with Kg held: a nested fit to compare.
-        rtid_ok(
-            &[
-                "identify",
-                exp,
-                "--preset",
-                "worm-gear",
-                "--objective",
-                "gain-curve",
-                "--model",
-                "linear",
-                "--fit",
-                "Kw",
-                "--set",
-                "Kg=800",
-                "--out",
-                "kw-only.json",
-                "--quiet",
-            ],
-            d,
-        );
+        // Fits of the gain curve (79 residuals, linear: 0.05 s a fit): profiled and
+        // resampled, and with Kg held (a nested fit to compare).
+        let gain_curve = |extra: &[&str]| {
+            let mut args = vec!["identify", exp, "--preset", "worm-gear", "--quiet"];
+            args.extend(["--objective", "gain-curve", "--model", "linear"]);
+            args.extend(extra);
+            rtid_ok(&args, d);
+        };
+        gain_curve(&["--profile", "--resample", "5", "--out", "intervals.json"]);
+        gain_curve(&["--fit", "Kw", "--set", "Kg=800", "--out", "kw-only.json"]);
         rtid_ok(
             &[
                 "experiment",

@@ -100,8 +100,6 @@ fn sha256(path: &Path) -> std::io::Result<String> {
 /// One row per fitted parameter: start, value, standard error, bounds and the
 /// profile and bootstrap intervals when the fit has them.
 fn parameters(r: &IdentifyResult) -> String {
-    let profiles = r.profiles.as_ref();
-    let boot = r.resampling.as_ref().map(|s| &s.intervals);
     let mut header = vec![
         "parameter",
         "start",
@@ -111,10 +109,10 @@ fn parameters(r: &IdentifyResult) -> String {
         "lower bound",
         "upper bound",
     ];
-    if profiles.is_some() {
+    if r.profiles.is_some() {
         header.extend(["profile lower", "profile upper"]);
     }
-    if boot.is_some() {
+    if r.resampling.is_some() {
         header.extend([
             "bootstrap lower",
             "bootstrap upper",
@@ -122,7 +120,6 @@ fn parameters(r: &IdentifyResult) -> String {
             "bootstrap bias",
         ]);
     }
-    let open = |v: Option<f64>| v.map_or("open".into(), sci);
     let rows: Vec<Vec<String>> = r
         .parameters
         .iter()
@@ -138,26 +135,37 @@ fn parameters(r: &IdentifyResult) -> String {
                 bounds.map_or("–".into(), |b| sci(b[0])),
                 bounds.map_or("–".into(), |b| sci(b[1])),
             ];
-            if let Some(p) = profiles {
-                let p = p.get(name);
-                row.push(p.map_or("–".into(), |p| open(p.lower)));
-                row.push(p.map_or("–".into(), |p| open(p.upper)));
-            }
-            if let Some(b) = boot {
-                match b.get(name) {
-                    Some(i) => row.extend([
-                        sci(i.lower),
-                        sci(i.upper),
-                        format!("{:.3e}", i.standard_error),
-                        format!("{:.3e}", i.bias),
-                    ]),
-                    None => row.extend(["–".to_string(), "–".into(), "–".into(), "–".into()]),
-                }
-            }
+            row.extend(interval_cells(r, name));
             row
         })
         .collect();
     table(&header, &rows)
+}
+
+/// A parameter's profile interval ("open" for an unbounded side) and bootstrap
+/// interval, spread and bias, for the columns the fit has.
+fn interval_cells(r: &IdentifyResult, name: &str) -> Vec<String> {
+    let dash = || "–".to_string();
+    let open = |v: Option<f64>| v.map_or("open".into(), sci);
+    let mut cells = Vec::new();
+    if let Some(profiles) = &r.profiles {
+        match profiles.get(name) {
+            Some(p) => cells.extend([open(p.lower), open(p.upper)]),
+            None => cells.extend([dash(), dash()]),
+        }
+    }
+    if let Some(s) = &r.resampling {
+        match s.intervals.get(name) {
+            Some(i) => cells.extend([
+                sci(i.lower),
+                sci(i.upper),
+                format!("{:.3e}", i.standard_error),
+                format!("{:.3e}", i.bias),
+            ]),
+            None => cells.extend([dash(), dash(), dash(), dash()]),
+        }
+    }
+    cells
 }
 
 /// The correlation heat map, when the fit has an uncertainty estimate.
