@@ -34,6 +34,10 @@ without one the page says \"no tolerance given\".
 ranges), the indices table (local sensitivities, Morris μ*/μ/σ or Sobol S1/ST with 95 % \
 intervals) and the tornado charts (grid plots for a grid), as `rtid sweep` computes them.
 
+With two or more identification results, a last section compares them as `rtid select` \
+does: AIC, AICc, BIC, Akaike weights and the F-tests of nested fits (or says why fits of \
+other data are not compared).
+
 A file of any other kind, unreadable or malformed stops the report with an error naming \
 it. --out is written atomically and may not be one of the inputs.
 
