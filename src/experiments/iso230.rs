@@ -90,6 +90,8 @@ pub struct ReportUnits {
     pub deviation: &'static str,
     /// The column-name suffix of a deviation (`arcsec`, `um`).
     pub deviation_key: &'static str,
+    /// The deviation unit in words, for headings (`arc-seconds`, `µm`).
+    pub deviation_name: &'static str,
 }
 
 impl ReportUnits {
@@ -100,6 +102,7 @@ impl ReportUnits {
         deviation_per_si: ARCSEC_PER_RAD,
         deviation: "″",
         deviation_key: "arcsec",
+        deviation_name: "arc-seconds",
     };
     pub const LINEAR: ReportUnits = ReportUnits {
         target_per_si: 1e3,
@@ -108,6 +111,7 @@ impl ReportUnits {
         deviation_per_si: 1e6,
         deviation: "µm",
         deviation_key: "um",
+        deviation_name: "µm",
     };
 
     /// The units of an axis.

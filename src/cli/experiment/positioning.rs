@@ -233,12 +233,11 @@ fn print_positioning(
         });
         println!("{}", serde_json::to_string_pretty(&value)?);
     } else {
-        let unit = if u == ReportUnits::ROTARY {
-            "arc-seconds"
-        } else {
-            "µm"
-        };
-        println!("{}: ISO 230-2 evaluation, {unit}", source.display());
+        println!(
+            "{}: ISO 230-2 evaluation, {}",
+            source.display(),
+            u.deviation_name
+        );
         println!("{}", table(report, u));
     }
     Ok(())

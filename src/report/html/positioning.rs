@@ -37,7 +37,7 @@ pub fn section(path: &Path, tolerances: &Tolerances) -> Result<Section, HtmlErro
     let mut body = verdict(a, tolerance, units);
     body.push_str(&format!(
         "<h3>Axis</h3>\n<p>ISO 230-2 figures of the axis, {}.</p>\n",
-        unit_name(units)
+        units.deviation_name
     ));
     body.push_str(&axis_table(&report.axis.scaled(units.deviation_per_si)));
     body.push_str("<h3>Targets</h3>\n");
@@ -49,14 +49,6 @@ pub fn section(path: &Path, tolerances: &Tolerances) -> Result<Section, HtmlErro
         title: format!("Positioning (ISO 230-2): {mechanism}"),
         body,
     })
-}
-
-fn unit_name(u: ReportUnits) -> &'static str {
-    if u == ReportUnits::ROTARY {
-        "arc-seconds (″)"
-    } else {
-        "micrometres (µm)"
-    }
 }
 
 /// The tolerance of the axis's kind, if given; the other kind's option is refused
