@@ -177,17 +177,93 @@ fn an_identification_page_shows_the_fit_as_the_result_file_holds_it() {
         Sha256::digest(std::fs::read(&r.experiment).unwrap())
     );
     assert!(page.contains(&sha), "the experiment's SHA-256");
+    let provenance = result
+        .provenance
+        .as_ref()
+        .expect("the command line records it");
+    let command = shlex::split(&provenance.command).unwrap();
+    assert_eq!(
+        command[..3],
+        ["rtid", "identify", r.experiment.to_str().unwrap()]
+    );
+    assert!(page.contains(&rtid::report::html::escape(&provenance.command)));
+    assert_eq!(provenance.inputs.len(), 2, "the manifest and its data");
+    for input in &provenance.inputs {
+        let bytes = std::fs::read(&input.path).unwrap();
+        assert_eq!(
+            input.sha256,
+            format!("{:x}", Sha256::digest(bytes)),
+            "{}",
+            input.path
+        );
+    }
+    assert!(page.contains("same") && !page.contains("CHANGED"));
+    assert!(
+        page.contains("Fit against data"),
+        "a chart of fit against data"
+    );
+    let gain = &result.comparisons[0];
+    assert!(gain
+        .curves
+        .iter()
+        .any(|c| c.label == "linear model, identified"));
+    assert!(page.contains(&format!("identification: {}", gain.source)));
     assert!(page.contains(&result.mechanism));
     assert!(page.contains(&rtid::report::html::escape(
         &result.termination.0.to_string()
     )));
     assert!(page.contains(&format!("rtid {}", env!("CARGO_PKG_VERSION"))));
+    assert!(page.contains("fitted by"), "the version that fitted it");
     assert!(page.contains("Correlations") && page.contains("class=\"heat\""));
     assert!(
         page.contains("residuals: "),
         "a residual chart per experiment"
     );
     assert!(page.contains("@page { size: A4"));
+}
+
+/// An input changed after the fit is flagged with its new hash; one gone is "not
+/// found".
+#[test]
+fn an_identification_page_flags_an_input_changed_since_the_fit() {
+    let r = runs();
+    let dir = r.path("changed");
+    std::fs::create_dir_all(&dir).unwrap();
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/worm-gear");
+    for name in ["frequency_response.json", "frequency_response.csv"] {
+        std::fs::copy(fixtures.join(name), dir.join(name)).unwrap();
+    }
+    let args = [
+        "--preset",
+        "worm-gear",
+        "--model",
+        "linear",
+        "--quiet",
+        "--out",
+    ];
+    let mut run = vec!["identify", "frequency_response.json"];
+    run.extend(args);
+    run.push("fit.json");
+    rtid_ok(&run, &dir);
+    let mut csv = std::fs::read_to_string(dir.join("frequency_response.csv")).unwrap();
+    csv.push('\n');
+    std::fs::write(dir.join("frequency_response.csv"), &csv).unwrap();
+    rtid_ok(&["report", "fit.json", "--out", "r.html", "--quiet"], &dir);
+    let page = std::fs::read_to_string(dir.join("r.html")).unwrap();
+    let now = format!("{:x}", Sha256::digest(csv.as_bytes()));
+    assert!(
+        page.contains(&format!("CHANGED since the fit: {now}")),
+        "the CSV"
+    );
+    assert_eq!(
+        page.matches("CHANGED").count(),
+        1,
+        "the manifest is the same"
+    );
+    std::fs::remove_file(dir.join("frequency_response.json")).unwrap();
+    rtid_ok(&["report", "fit.json", "--out", "r.html", "--quiet"], &dir);
+    let page = std::fs::read_to_string(dir.join("r.html")).unwrap();
+    assert!(page.contains("not found"));
 }
 
 #[test]
@@ -236,15 +312,19 @@ fn identifications_of_the_same_data_are_compared_and_others_are_not() {
     assert!(page.contains("are not compared") && page.contains("fits other residuals"));
 }
 
+/// A result that records no provenance (written by a library caller, or by an
+/// older rtid) gets today's hashes of its experiments, a missing one "not found".
 #[test]
 fn an_experiment_that_is_gone_is_not_found_rather_than_an_error() {
     let r = runs();
     let mut fit: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(r.path("fit.json")).unwrap()).unwrap();
     fit["experiments"] = serde_json::json!(["gone/frequency_response.json"]);
+    fit.as_object_mut().unwrap().remove("provenance").unwrap();
     std::fs::write(r.path("moved-fit.json"), fit.to_string()).unwrap();
     let page = r.page(&["moved-fit.json"], "moved.html");
     assert!(page.contains("gone/frequency_response.json") && page.contains("not found"));
+    assert!(page.contains("does not record its inputs"));
 }
 
 #[test]

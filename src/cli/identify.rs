@@ -11,13 +11,14 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use super::profile::{add_profiles, profile_table, write_profile_plots};
 use super::resample::{add_resampling, resample_table};
 use super::ModelArgs;
-use rtid::identify::comparison;
+use rtid::identify::comparison::{self, Comparison};
 use rtid::identify::{
     identify, Bound, Config, ExperimentSpec, FidelityChoice, Identified, IdentifyResult, Method,
     Monitor, SearchOptions, StartChoice, Warning,
 };
 use rtid::io::experiment_file::{self, Kind};
 use rtid::io::params_file;
+use rtid::io::provenance::Provenance;
 use rtid::model::Params;
 use rtid::objectives::{Detail, ObjectiveKind};
 
@@ -74,7 +75,9 @@ Output: a table of parameter, start, identified ± standard error; warnings when
 cannot separate parameters (|correlation| > 0.95 or a singular JᵀJ), when a parameter ends \
 on a bound, or when the fit misses the measured resonances; --out result.json with \
 everything (parameters, initial, bounds, cost, residuals per experiment, evaluations, \
-wall_time_s, termination, uncertainty); an SVG per experiment of the fit against the data; \
+wall_time_s, termination, uncertainty, the fit against the data, and the command line, rtid \
+version and inputs' SHA-256 for `rtid report`); an SVG per chart of the fit against the \
+data (FILE-1.svg, …; a servo trace has two: effort and following error); \
 --save-params FILE for `--params FILE` everywhere. --profile adds each fitted \
 parameter's profile likelihood: its 95 % likelihood-ratio interval (open where the data do \
 not bound it, naming the parameters that move with it), beside ±1.96 standard errors, and \
@@ -318,15 +321,21 @@ impl Args {
         })
     }
 
-    /// No output (--out, --save-params, --checkpoint) over an input: a manifest, its
-    /// data file or the parameter file.
-    fn refuse_overwrites(&self, experiments: &[ExperimentSpec]) -> anyhow::Result<()> {
+    /// The input files: each manifest, its data file, the parameter file.
+    fn inputs<'a>(&'a self, experiments: &'a [ExperimentSpec]) -> Vec<&'a Path> {
         let mut inputs: Vec<&Path> = Vec::new();
         for (path, spec) in self.experiments.iter().zip(experiments) {
             inputs.push(path);
             inputs.extend(spec.experiment.data_path.as_deref());
         }
         inputs.extend(self.model.params.as_deref());
+        inputs
+    }
+
+    /// No output (--out, --save-params, --checkpoint) over an input: a manifest, its
+    /// data file or the parameter file.
+    fn refuse_overwrites(&self, experiments: &[ExperimentSpec]) -> anyhow::Result<()> {
+        let inputs = self.inputs(experiments);
         let outputs = [
             ("--out", &self.out),
             ("--save-params", &self.save_params),
@@ -428,11 +437,13 @@ fn usable(all: &[ObjectiveKind], spec: &ExperimentSpec) -> anyhow::Result<Vec<Ob
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let config = a.config()?;
+    let provenance = Provenance::of_this_run(&a.inputs(&config.experiments))
+        .context("hashing the input files")?;
     let monitor = Arc::new(Monitor::default());
     stop_on_ctrl_c(&monitor);
-    let spinner = spinner(&monitor, a.quiet);
+    let bar = live_bar(&monitor, a.quiet);
     let outcome = identify(&config, &monitor);
-    if let Some((bar, done, handle)) = spinner {
+    if let Some((bar, done, handle)) = bar {
         done.store(true, std::sync::atomic::Ordering::Relaxed);
         let _ = handle.join();
         bar.finish_and_clear();
@@ -451,11 +462,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let fit = (objective.as_ref(), settings);
         add_resampling(n as usize, &mut result, &params, fit, &monitor, a.quiet)?;
     }
+    result.provenance = Some(provenance);
+    if a.out.is_some() || a.json {
+        let start = start_params(&config.base, &result)?;
+        result.comparisons = comparison::compare_all(&config.experiments, &start, &params)?
+            .into_iter()
+            .map(|c| c.thinned(MAX_RECORDED_POINTS))
+            .collect();
+    }
     if let Some(path) = &a.out {
         result
             .write(path)
             .with_context(|| format!("writing {}", path.display()))?;
-        write_plots(path, &config.experiments, &config.base, &params)?;
+        write_plots(path, &result.comparisons)?;
         write_profile_plots(path, &result)?;
     }
     if let Some(path) = &a.save_params {
@@ -497,29 +516,38 @@ fn save_params(path: &Path, result: &IdentifyResult, mut p: Params) -> anyhow::R
     params_file::write(path, &p).with_context(|| format!("writing {}", path.display()))
 }
 
-type Spinner = (
+type LiveBar = (
     indicatif::ProgressBar,
     Arc<std::sync::atomic::AtomicBool>,
     std::thread::JoinHandle<()>,
 );
 
-/// A live line: evaluations and the best cost so far.
-fn spinner(monitor: &Arc<Monitor>, quiet: bool) -> Option<Spinner> {
+/// Steps of the bar: the fraction of the iteration budget, in thousandths.
+const BAR_STEPS: u64 = 1000;
+
+/// A live bar: the searches' iterations done of their budget (starts × --max-iters),
+/// with the time left that implies — an upper bound, since a start that converges
+/// early gives back the rest of its budget — and the evaluations and best cost so far.
+fn live_bar(monitor: &Arc<Monitor>, quiet: bool) -> Option<LiveBar> {
     if quiet || !std::io::stderr().is_terminal() {
         return None;
     }
-    let bar = indicatif::ProgressBar::new_spinner();
+    let bar = indicatif::ProgressBar::new(BAR_STEPS);
     bar.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} {elapsed} identifying: {msg}")
-            .expect("a valid template"),
+        indicatif::ProgressStyle::with_template(
+            "{elapsed:>4} identifying [{bar:16}] {percent:>3}% of budget, ≤{eta} left, {msg}",
+        )
+        .expect("a valid template")
+        .progress_chars("=> "),
     );
     let done = Arc::new(std::sync::atomic::AtomicBool::new(false));
     let (b, d, m) = (bar.clone(), Arc::clone(&done), Arc::clone(monitor));
     let handle = std::thread::spawn(move || {
         while !d.load(std::sync::atomic::Ordering::Relaxed) {
-            let best = m.best().map_or("—".into(), |b| format!("{:.4e}", b.cost));
-            b.set_message(format!("{} evaluations, best cost {best}", m.evaluations()));
-            b.tick();
+            let best = m.best().map_or("—".into(), |b| format!("{:.3e}", b.cost));
+            b.set_message(format!("{} evals, best {best}", m.evaluations()));
+            let fraction = m.progress().fraction().unwrap_or(0.0);
+            b.set_position((fraction * BAR_STEPS as f64) as u64);
             std::thread::sleep(Duration::from_millis(150));
         }
     });
@@ -656,19 +684,25 @@ fn hint(w: &Warning) -> String {
     }
 }
 
-/// One SVG per experiment beside the result: the data and the identified model.
-fn write_plots(
-    out: &Path,
-    experiments: &[ExperimentSpec],
-    start: &Params,
-    fitted: &Params,
-) -> anyhow::Result<()> {
+/// Most points per curve of a comparison kept in the result file.
+const MAX_RECORDED_POINTS: usize = 2000;
+
+/// The parameters the search started from: the base set with the recorded start
+/// values (a direct estimate may have replaced the base's).
+fn start_params(base: &Params, result: &IdentifyResult) -> anyhow::Result<Params> {
+    let mut p = base.clone();
+    for (name, &v) in &result.initial {
+        p.set(name, v)?;
+    }
+    Ok(p)
+}
+
+/// One SVG per comparison beside the result: FILE-1.svg, FILE-2.svg, … in order.
+fn write_plots(out: &Path, comparisons: &[Comparison]) -> anyhow::Result<()> {
     let stem = out.with_extension("");
-    for (k, e) in experiments.iter().enumerate() {
-        if let Some(c) = comparison::compare(&e.source, &e.experiment, start, fitted)? {
-            let path = PathBuf::from(format!("{}-{}.svg", stem.display(), k + 1));
-            rtid::report::identify::comparison(&c).write(&path)?;
-        }
+    for (k, c) in comparisons.iter().enumerate() {
+        let path = PathBuf::from(format!("{}-{}.svg", stem.display(), k + 1));
+        rtid::report::identify::comparison(c).write(&path)?;
     }
     Ok(())
 }

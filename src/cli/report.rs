@@ -14,13 +14,17 @@ self-contained (inline CSS and SVG charts, nothing fetched from the network), so
 be mailed, archived or printed to A4 from a browser (each section starts a new page).
 
 Each FILE is recognised by its content:
-  identification result (`rtid identify --out fit.json`)   mechanism, method, cost, \
-evaluations, wall time and how the search ended; each experiment file with its SHA-256 \
-(\"not found\" when it is neither beside the result nor in the current folder); every \
+  identification result (`rtid identify --out fit.json`)   the command line and rtid \
+version that ran the fit, mechanism, method, cost, evaluations, wall time and how the \
+search ended; each input file with the SHA-256 recorded when it was fitted and whether \
+the file now is the same, CHANGED, or \"not found\" (neither beside the result nor in \
+the current folder); every \
 fitted parameter's start, identified value, standard error (absolute and %), bounds, and \
 the profile (--profile) and bootstrap (--resample) intervals when the fit has them; the \
 correlation matrix as a heat map (red positive, blue negative; near ±1 the data cannot \
-tell two parameters apart); each experiment's scaled residuals against their index (a \
+tell two parameters apart); each experiment's data against the model at the start and \
+identified values (gain over frequency, torque over time, a servo trace's effort and \
+following error replayed); its scaled residuals against their index (a \
 pattern instead of noise: the model misses something); the profiles' charts; the \
 warnings in words.
   positioning experiment (a manifest with \"kind\": \"positioning\")   the ISO 230-2 \

@@ -3,15 +3,20 @@
 //! experiment's own axes. Computed here (it runs the model); drawn by
 //! `report::identify`.
 
+use serde::{Deserialize, Serialize};
+
+use super::config::ExperimentSpec;
 use crate::experiments::fluctuation::{self, FluctuationTest};
+use crate::experiments::servo_trace::{self, ServoTrace, TraceError};
 use crate::experiments::torque_curve::{simulate_torque, TorqueTest};
 use crate::io::experiment_file::{Data, Experiment};
 use crate::model::linear_response::{Channel, LinearResponse};
+use crate::model::params::Axis;
 use crate::model::Params;
 use crate::sim::SimError;
 
 /// What a curve shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Role {
     Measured,
@@ -22,7 +27,7 @@ pub enum Role {
 }
 
 /// One curve of a comparison.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Curve {
     pub label: String,
     pub role: Role,
@@ -30,13 +35,27 @@ pub struct Curve {
 }
 
 /// The data of one experiment and the model, in the experiment's axes.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Comparison {
     /// The experiment file.
     pub source: String,
-    pub x_label: &'static str,
-    pub y_label: &'static str,
+    pub x_label: String,
+    pub y_label: String,
     pub curves: Vec<Curve>,
+}
+
+impl Comparison {
+    /// The same curves with at most `max` points each (every k-th kept).
+    pub fn thinned(mut self, max: usize) -> Comparison {
+        for c in &mut self.curves {
+            let every = c.points.len().div_ceil(max.max(1)).max(1);
+            c.points = std::mem::take(&mut c.points)
+                .into_iter()
+                .step_by(every)
+                .collect();
+        }
+        self
+    }
 }
 
 /// Why a comparison could not be computed.
@@ -53,6 +72,11 @@ pub enum ComparisonError {
         source_file: String,
         error: fluctuation::FluctuationError,
     },
+    #[error("{source_file}: {error}")]
+    Trace {
+        source_file: String,
+        error: TraceError,
+    },
 }
 
 /// Points of the model's curve over the measured frequency range.
@@ -60,19 +84,33 @@ const CURVE_POINTS: usize = 600;
 /// Points per curve kept for the deviation of an unbalance test.
 const MAX_DEVIATION_POINTS: usize = 3000;
 
-/// The comparison for one experiment (`None` for kinds without one).
+/// The comparisons of every experiment, in order (kinds without one add none).
+pub fn compare_all(
+    experiments: &[ExperimentSpec],
+    start: &Params,
+    fitted: &Params,
+) -> Result<Vec<Comparison>, ComparisonError> {
+    let mut all = Vec::new();
+    for e in experiments {
+        all.extend(compare(&e.source, &e.experiment, start, fitted)?);
+    }
+    Ok(all)
+}
+
+/// The comparisons of one experiment (none for kinds without one; a servo trace has
+/// two: its effort and its following error).
 pub fn compare(
     source: &str,
     exp: &Experiment,
     start: &Params,
     fitted: &Params,
-) -> Result<Option<Comparison>, ComparisonError> {
+) -> Result<Vec<Comparison>, ComparisonError> {
     Ok(match &exp.data {
         Data::FrequencyResponse {
             frequency_hz,
             gain_db,
             ..
-        } => Some(gain(source, frequency_hz, gain_db, start, fitted)),
+        } => vec![gain(source, frequency_hz, gain_db, start, fitted)],
         Data::TorqueCurve {
             time_s,
             motor_torque_nm,
@@ -84,18 +122,25 @@ pub fn compare(
                     source_file: source.into(),
                     error,
                 })?;
-            Some(Comparison {
+            vec![Comparison {
                 source: source.into(),
-                x_label: "time, s",
-                y_label: "motor torque, N·m",
+                x_label: "time, s".into(),
+                y_label: "motor torque, N·m".into(),
                 curves: vec![
                     curve("measured", Role::Measured, time_s, motor_torque_nm),
                     curve("identified model", Role::Fitted, time_s, &model),
                 ],
-            })
+            }]
         }
-        Data::Unbalance { .. } => Some(unbalance(source, exp, fitted)?),
-        _ => None,
+        Data::Unbalance { .. } => vec![unbalance(source, exp, fitted)?],
+        Data::ServoTrace(file) => trace(
+            source,
+            file.axis,
+            &ServoTrace::from_file(file),
+            start,
+            fitted,
+        )?,
+        _ => Vec::new(),
     })
 }
 
@@ -129,8 +174,8 @@ fn gain(
     measured.points.retain(|(_, g)| g.is_finite());
     Comparison {
         source: source.into(),
-        x_label: "frequency, Hz",
-        y_label: "gain θt/(θm·Rg·Rw), dB",
+        x_label: "frequency, Hz".into(),
+        y_label: "gain θt/(θm·Rg·Rw), dB".into(),
         curves: vec![
             measured,
             Curve {
@@ -185,8 +230,139 @@ fn unbalance(
     }
     Ok(Comparison {
         source: source.into(),
-        x_label: "table angle, deg",
-        y_label: "θt − θm·Rg·Rw, arc-sec",
+        x_label: "table angle, deg".into(),
+        y_label: "θt − θm·Rg·Rw, arc-sec".into(),
         curves,
     })
+}
+
+/// A servo trace replayed at the start and identified values: the drive's effort
+/// over time, and the following error (reference − loop encoder) in arc-seconds or
+/// µm, recorded and replayed.
+fn trace(
+    source: &str,
+    axis: Axis,
+    trace: &ServoTrace,
+    start: &Params,
+    fitted: &Params,
+) -> Result<Vec<Comparison>, ComparisonError> {
+    let replay = |p: &Params| {
+        servo_trace::replay(p, trace).map_err(|error| ComparisonError::Trace {
+            source_file: source.into(),
+            error,
+        })
+    };
+    let (at_start, at_fit) = (replay(start)?, replay(fitted)?);
+    let (effort, position_unit, per_si) = match axis {
+        Axis::Rotary => (
+            "motor torque, N·m",
+            "arc-sec",
+            180.0 / std::f64::consts::PI * 3600.0,
+        ),
+        Axis::Linear => ("force, N", "µm", 1e6),
+    };
+    let t = &trace.time_s;
+    let following = |position: &[f64]| -> Vec<f64> {
+        trace
+            .reference
+            .iter()
+            .zip(position)
+            .map(|(r, q)| (r - q) * per_si)
+            .collect()
+    };
+    let three = |measured: &[f64], start: &[f64], fit: &[f64]| {
+        vec![
+            curve("measured", Role::Measured, t, measured),
+            curve("replayed, start", Role::Start, t, start),
+            curve("replayed, identified", Role::Fitted, t, fit),
+        ]
+    };
+    Ok(vec![
+        Comparison {
+            source: source.into(),
+            x_label: "time, s".into(),
+            y_label: effort.into(),
+            curves: three(&trace.force, &at_start.force, &at_fit.force),
+        },
+        Comparison {
+            source: source.into(),
+            x_label: "time, s".into(),
+            y_label: format!("following error, {position_unit}"),
+            curves: three(
+                &following(&trace.position),
+                &following(&at_start.position),
+                &following(&at_fit.position),
+            ),
+        },
+    ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiments::servo_trace::{virtual_trace, MoveTo, TrapezoidalMoves};
+    use crate::model::presets;
+
+    /// A virtual trace of the worm preset replayed at the preset: the identified
+    /// curves are the recorded ones, the following error in arc-seconds; a start
+    /// elsewhere differs.
+    #[test]
+    fn a_servo_trace_compares_its_effort_and_following_error() {
+        let p = presets::load("worm-gear").unwrap();
+        let moves = TrapezoidalMoves {
+            moves: vec![MoveTo {
+                target: 0.05,
+                speed: 0.1,
+            }],
+            acceleration: 1.0,
+            dwell_s: 0.05,
+        };
+        let recorded = virtual_trace(&p, &moves, None).unwrap();
+        let mut start = p.clone();
+        start
+            .set("Kw", 2.0 * p.get("Kw").unwrap().unwrap())
+            .unwrap();
+        let c = trace("t.json", Axis::Rotary, &recorded, &start, &p).unwrap();
+        assert_eq!(c.len(), 2);
+        assert_eq!(c[0].y_label, "motor torque, N·m");
+        assert_eq!(c[1].y_label, "following error, arc-sec");
+        for comparison in &c {
+            let [measured, at_start, fitted] = &comparison.curves[..] else {
+                panic!("three curves: {comparison:?}")
+            };
+            assert_eq!(measured.points, fitted.points, "{}", comparison.y_label);
+            assert_ne!(measured.points, at_start.points, "{}", comparison.y_label);
+        }
+        let (k, largest) = recorded
+            .reference
+            .iter()
+            .zip(&recorded.position)
+            .map(|(r, q)| (r - q).abs())
+            .enumerate()
+            .fold((0, 0.0), |a, (k, e)| if e > a.1 { (k, e) } else { a });
+        let arcsec = c[1].curves[0].points[k].1.abs();
+        assert!(
+            (arcsec / (largest * 3600.0_f64.to_degrees()) - 1.0).abs() < 1e-9,
+            "{arcsec}"
+        );
+        assert!(largest > 0.0);
+    }
+
+    #[test]
+    fn thinning_keeps_at_most_the_asked_points_each() {
+        let points: Vec<(f64, f64)> = (0..1001).map(|i| (i as f64, 0.0)).collect();
+        let c = Comparison {
+            source: "s".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            curves: vec![Curve {
+                label: "m".into(),
+                role: Role::Measured,
+                points,
+            }],
+        }
+        .thinned(100);
+        assert_eq!(c.curves[0].points.len(), 91);
+        assert_eq!(c.curves[0].points[1].0, 11.0);
+    }
 }

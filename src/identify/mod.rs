@@ -32,6 +32,7 @@ pub mod escalation;
 pub mod plan;
 pub mod problem;
 pub mod profile;
+pub mod progress;
 pub mod resample;
 pub mod result;
 pub mod run;

@@ -11,12 +11,13 @@
 //! search; the first such error is kept for the report.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use argmin::core::{CostFunction, Error, Jacobian, Operator};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
+use super::progress::Progress;
 use super::search::Settings;
 use super::space::ParamSpace;
 use crate::objectives::{sum_of_squares, Objective, ObjectiveError};
@@ -39,9 +40,20 @@ pub struct Monitor {
     best: Mutex<Option<Best>>,
     failure: Mutex<Option<String>>,
     stop: AtomicBool,
+    progress: Arc<Progress>,
 }
 
 impl Monitor {
+    /// The searches' iterations done of their budget.
+    pub fn progress(&self) -> &Progress {
+        &self.progress
+    }
+
+    /// A handle on the progress for a solver's observer.
+    pub(crate) fn progress_handle(&self) -> Arc<Progress> {
+        Arc::clone(&self.progress)
+    }
+
     pub fn evaluations(&self) -> usize {
         self.evaluations.load(Ordering::Relaxed)
     }

@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::assess::Assessment;
+use super::comparison::Comparison;
 use super::config::Config;
 use super::plan::Plan;
 use super::profile::Profile;
@@ -14,6 +15,7 @@ use super::start::StartEstimate;
 use super::termination::Termination;
 use super::uncertainty::Uncertainty;
 use super::warning::{Coded, Warning};
+use crate::io::provenance::Provenance;
 use crate::objectives::Detail;
 
 /// One experiment's share of the fit.
@@ -91,6 +93,14 @@ pub struct IdentifyResult {
     /// values and each fitted parameter's interval.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resampling: Option<Resampling>,
+    /// Each experiment's data against the model at the start and identified values,
+    /// in the experiment's axes (thinned for the file), for plots and reports.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub comparisons: Vec<Comparison>,
+    /// The command line, the rtid version and the inputs' SHA-256 (written by the
+    /// command line; a library caller may leave it out).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
 }
 
 impl IdentifyResult {
@@ -184,5 +194,7 @@ pub fn assemble(
         warnings: warnings.into_iter().map(Coded).collect(),
         profiles: None,
         resampling: None,
+        comparisons: Vec::new(),
+        provenance: None,
     }
 }

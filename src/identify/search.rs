@@ -95,6 +95,10 @@ pub fn search(
             monitor.offer(c, v);
         }
     }
+    let to_run = (0..settings.starts)
+        .filter(|i| !done.iter().any(|d| d.index == *i && d.finished()))
+        .count();
+    monitor.progress().plan(to_run as u64 * settings.max_iters);
     let mut records: Vec<StartRecord> = space
         .starts(settings.starts, settings.seed)
         .into_par_iter()
@@ -134,6 +138,10 @@ fn one_start(
         seed: settings.seed.wrapping_add(index as u64),
     };
     let out = solvers::run(settings.method, problem, space.to_solver(&from), limits);
+    // The budget this start did not use: done, as far as the progress is concerned.
+    monitor
+        .progress()
+        .advance(settings.max_iters.saturating_sub(out.iterations));
     let result =
         (!out.x.is_empty()).then(|| space.physical(&nalgebra::DVector::from_vec(out.x.clone())));
     StartRecord {

@@ -11,6 +11,7 @@
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use argmin::core::observers::ObserverMode;
 use argmin::core::{CostFunction, Executor, State, TerminationReason, TerminationStatus};
 use argmin::solver::gaussnewton::GaussNewtonLS;
 use argmin::solver::linesearch::{condition::ArmijoCondition, BacktrackingLineSearch};
@@ -20,6 +21,7 @@ use nalgebra::DVector;
 use rand::{rngs::StdRng, SeedableRng};
 
 use super::problem::{Problem, SingularJacobian};
+use super::progress::CountIterations;
 use super::termination::Termination;
 use crate::objectives::ObjectiveError;
 
@@ -68,6 +70,7 @@ pub struct Outcome {
 /// Runs `method` from solver coordinates `x0`.
 pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limits) -> Outcome {
     let monitor = problem.monitor;
+    let count = || CountIterations(monitor.progress_handle());
     let n = x0.len();
     let result = match method {
         Method::Lsq => {
@@ -77,6 +80,7 @@ pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limit
                 .expect("positive");
             Executor::new(problem, solver)
                 .configure(|s| s.param(x0.clone()).max_iters(limits.max_iters))
+                .add_observer(count(), ObserverMode::Always)
                 .run()
                 .map(|r| {
                     // Gauss–Newton's cost is ‖r‖; report Σr² like the other solvers.
@@ -102,6 +106,7 @@ pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limit
             };
             Executor::new(problem, solver)
                 .configure(|s| s.max_iters(limits.max_iters))
+                .add_observer(count(), ObserverMode::Always)
                 .run()
                 .map(|r| summarize(r.state()))
         }
@@ -115,6 +120,7 @@ pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limit
                 .with_rng_generator(StdRng::seed_from_u64(limits.seed));
             Executor::new(problem, solver)
                 .configure(|s| s.max_iters(limits.max_iters))
+                .add_observer(count(), ObserverMode::Always)
                 .run()
                 .map(|r| {
                     let s = r.state();

@@ -3,6 +3,7 @@
 pub mod atomic;
 pub mod experiment_file;
 pub mod params_file;
+pub mod provenance;
 pub mod torque_file;
 
 /// JSON text without a leading UTF-8 byte-order mark (editors on Windows write one;

@@ -9,8 +9,8 @@ use crate::identify::profile::{Profile, THRESHOLD};
 pub fn comparison(c: &Comparison) -> Figure {
     let mut figure = Figure::new(
         format!("identification: {}", c.source),
-        c.x_label,
-        c.y_label,
+        &c.x_label,
+        &c.y_label,
     );
     let sampled = c.x_label.starts_with("frequency");
     for curve in &c.curves {

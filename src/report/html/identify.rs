@@ -5,34 +5,29 @@
 
 use std::path::{Path, PathBuf};
 
-use sha2::{Digest, Sha256};
-
 use super::markup::{escape, facts, figure, sci, table};
 use super::{correlation, HtmlError, Kind, Section};
 use crate::identify::IdentifyResult;
+use crate::io::provenance::sha256;
 use crate::report::figure::{Figure, FigureError, Series, Style};
 
 /// Most residuals drawn per experiment (the SVG stays small).
 const MAX_POINTS: usize = 2000;
 
-/// The section of `result`, read from `path`; `command` is the command line that
-/// wrote it, when the file records one.
-pub fn section(
-    path: &Path,
-    result: &IdentifyResult,
-    command: Option<&str>,
-) -> Result<Section, HtmlError> {
+/// The section of `result`, read from `path`.
+pub fn section(path: &Path, result: &IdentifyResult) -> Result<Section, HtmlError> {
     let drawn = |e: FigureError| HtmlError::Malformed {
         path: path.to_path_buf(),
         what: "identification result (`rtid identify --out`)",
         message: e.to_string(),
     };
-    let mut body = summary(result, command);
-    body.push_str("<h3>Experiments</h3>\n");
-    body.push_str(&experiments(path, result));
+    let mut body = summary(result);
+    body.push_str("<h3>Input files</h3>\n");
+    body.push_str(&inputs(path, result));
     body.push_str("<h3>Parameters</h3>\n");
     body.push_str(&parameters(result));
     body.push_str(&correlations(result));
+    body.push_str(&fit_against_data(result).map_err(drawn)?);
     body.push_str(&residuals(result).map_err(drawn)?);
     body.push_str(&profiles(result).map_err(drawn)?);
     body.push_str(&warnings(result));
@@ -44,9 +39,14 @@ pub fn section(
     })
 }
 
-/// Mechanism, method, cost, effort and how the search ended.
-fn summary(r: &IdentifyResult, command: Option<&str>) -> String {
-    let mut pairs = vec![
+/// Command, version, mechanism, method, cost, effort and how the search ended.
+fn summary(r: &IdentifyResult) -> String {
+    let mut pairs = Vec::new();
+    if let Some(p) = &r.provenance {
+        pairs.push(("command", p.command.clone()));
+        pairs.push(("fitted by", format!("rtid {}", p.version)));
+    }
+    pairs.extend([
         ("mechanism", r.mechanism.clone()),
         ("method", format!("{} ({} model)", r.method, r.fidelity)),
         ("cost", format!("{:.4e}", r.cost)),
@@ -54,47 +54,57 @@ fn summary(r: &IdentifyResult, command: Option<&str>) -> String {
         ("wall time", format!("{:.2} s", r.wall_time_s)),
         ("termination", r.termination.0.to_string()),
         ("report by", format!("rtid {}", crate::VERSION)),
-    ];
+    ]);
     if r.interrupted {
         pairs.push((
             "interrupted",
             "yes: the values are the best found before Ctrl-C".into(),
         ));
     }
-    if let Some(c) = command {
-        pairs.insert(0, ("command", c.to_string()));
-    }
     facts(&pairs)
 }
 
-/// Each experiment file with its SHA-256, or "not found".
-fn experiments(path: &Path, r: &IdentifyResult) -> String {
+/// Each input file with the SHA-256 recorded when it was fitted and whether the
+/// file found now still has it; a result without a record gets today's hashes of
+/// its experiment files.
+fn inputs(path: &Path, r: &IdentifyResult) -> String {
     let folder = path.parent().unwrap_or(Path::new(""));
-    let rows: Vec<Vec<String>> = r
-        .experiments
+    let now = |name: &str| -> Option<String> {
+        let file = locate(folder, name)?;
+        Some(sha256(&file).unwrap_or_else(|err| format!("not readable: {err}")))
+    };
+    let Some(p) = &r.provenance else {
+        let rows: Vec<Vec<String>> = r
+            .experiments
+            .iter()
+            .map(|e| vec![e.clone(), now(e).unwrap_or_else(|| "not found".into())])
+            .collect();
+        return format!(
+            "<p>The result does not record its inputs' hashes: these are the files found now.</p>\n{}",
+            table(&["file", "SHA-256 now"], &rows)
+        );
+    };
+    let rows: Vec<Vec<String>> = p
+        .inputs
         .iter()
-        .map(|e| {
-            let hash = locate(folder, e).map_or("not found".into(), |p| {
-                sha256(&p).unwrap_or_else(|err| format!("not readable: {err}"))
-            });
-            vec![e.clone(), hash]
+        .map(|i| {
+            let check = match now(&i.path) {
+                None => "not found".to_string(),
+                Some(h) if h == i.sha256 => "same".to_string(),
+                Some(h) => format!("CHANGED since the fit: {h}"),
+            };
+            vec![i.path.clone(), i.sha256.clone(), check]
         })
         .collect();
-    table(&["file", "SHA-256"], &rows)
+    table(&["file", "SHA-256 when fitted", "the file now"], &rows)
 }
 
-/// An experiment file as the result names it: beside the result first (where
+/// An input file as the result names it: beside the result first (where
 /// `rtid identify` was usually run from), else from the current folder.
 fn locate(folder: &Path, name: &str) -> Option<PathBuf> {
     [folder.join(name), PathBuf::from(name)]
         .into_iter()
         .find(|p| p.is_file())
-}
-
-/// The file's SHA-256, hex.
-fn sha256(path: &Path) -> std::io::Result<String> {
-    let bytes = std::fs::read(path)?;
-    Ok(format!("{:x}", Sha256::digest(&bytes)))
 }
 
 /// One row per fitted parameter: start, value, standard error, bounds and the
@@ -178,6 +188,19 @@ fn correlations(r: &IdentifyResult) -> String {
         "<h3>Correlations</h3>\n<p>Near ±1: the data cannot tell the two parameters apart.</p>\n{}",
         correlation::heat_map(&u.names, &u.correlation)
     )
+}
+
+/// Each experiment's data against the model at the start and identified values.
+fn fit_against_data(r: &IdentifyResult) -> Result<String, FigureError> {
+    if r.comparisons.is_empty() {
+        return Ok(String::new());
+    }
+    let mut html = String::from("<h3>Fit against data</h3>\n");
+    for c in &r.comparisons {
+        html.push_str(&format!("<p><code>{}</code></p>\n", escape(&c.source)));
+        html.push_str(&figure(&crate::report::identify::comparison(c))?);
+    }
+    Ok(html)
 }
 
 /// One chart of the scaled residuals per experiment, against their index.

@@ -19,7 +19,7 @@ th, td { border: 1px solid #bbb; padding: 0.2em 0.5em; text-align: right; }
 th { background: #f0f0f0; }
 td:first-child, th:first-child, td.text { text-align: left; }
 td { white-space: nowrap; }
-td.text { white-space: normal; }
+td.text { white-space: normal; overflow-wrap: anywhere; }
 dl.facts { display: grid; grid-template-columns: max-content auto; gap: 0.1em 1em; font-size: 0.9em; }
 dl.facts dt { font-weight: 600; }
 dl.facts dd { margin: 0; overflow-wrap: anywhere; }

@@ -79,17 +79,13 @@ fn recognise(v: &Value) -> Option<Recognised> {
 
 /// The section of a result file's JSON.
 fn identification(path: &Path, value: Value) -> Result<Loaded, HtmlError> {
-    let command = value
-        .get("command")
-        .and_then(Value::as_str)
-        .map(str::to_string);
     let result: IdentifyResult =
         serde_json::from_value(value).map_err(|e| HtmlError::Malformed {
             path: path.to_path_buf(),
             what: "identification result (`rtid identify --out`)",
             message: e.to_string(),
         })?;
-    let section = identify::section(path, &result, command.as_deref())?;
+    let section = identify::section(path, &result)?;
     Ok(Loaded {
         section,
         fit: Some(result),
