@@ -464,11 +464,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     result.provenance = Some(provenance);
     if a.out.is_some() || a.json {
-        let start = start_params(&config.base, &result)?;
-        result.comparisons = comparison::compare_all(&config.experiments, &start, &params)?
-            .into_iter()
-            .map(|c| c.thinned(MAX_RECORDED_POINTS))
-            .collect();
+        result.comparisons = comparisons(&config, &result, &params, a.quiet);
     }
     if let Some(path) = &a.out {
         result
@@ -686,6 +682,36 @@ fn hint(w: &Warning) -> String {
 
 /// Most points per curve of a comparison kept in the result file.
 const MAX_RECORDED_POINTS: usize = 2000;
+
+/// Each experiment's data against the model at the start and the result, thinned
+/// for the file. A model that cannot be run there (a replay diverging at the start
+/// values) costs the charts, said in a note, never the result.
+fn comparisons(
+    config: &Config,
+    result: &IdentifyResult,
+    fitted: &Params,
+    quiet: bool,
+) -> Vec<Comparison> {
+    let all = start_params(&config.base, result).and_then(|start| {
+        Ok(comparison::compare_all(
+            &config.experiments,
+            &start,
+            fitted,
+        )?)
+    });
+    match all {
+        Ok(all) => all
+            .into_iter()
+            .map(|c| c.thinned(MAX_RECORDED_POINTS))
+            .collect(),
+        Err(e) => {
+            if !quiet {
+                eprintln!("note: no charts of the fit against the data: {e:#}");
+            }
+            Vec::new()
+        }
+    }
+}
 
 /// The parameters the search started from: the base set with the recorded start
 /// values (a direct estimate may have replaced the base's).

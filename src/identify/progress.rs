@@ -24,6 +24,14 @@ impl Progress {
         (budget > 0).then(|| (done as f64 / budget as f64).min(1.0))
     }
 
+    /// Iterations done and planned so far.
+    pub fn iterations(&self) -> (u64, u64) {
+        (
+            self.done.load(Ordering::Relaxed),
+            self.budget.load(Ordering::Relaxed),
+        )
+    }
+
     /// Adds `iterations` to the budget (a start about to run).
     pub(crate) fn plan(&self, iterations: u64) {
         self.budget.fetch_add(iterations, Ordering::Relaxed);

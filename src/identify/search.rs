@@ -153,3 +153,57 @@ fn one_start(
         termination: out.termination,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identify::Bound;
+    use crate::model::{presets, Params};
+    use crate::objectives::ObjectiveError;
+
+    /// Residuals of Kw and Kg from 3e5 and 900, relative.
+    struct Bowl;
+
+    impl Objective for Bowl {
+        fn name(&self) -> &'static str {
+            "bowl"
+        }
+        fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+            Ok(vec![p.kw / 3e5 - 1.0, p.kg.unwrap_or(0.0) / 900.0 - 1.0, 0.0])
+        }
+        fn len(&self) -> usize {
+            3
+        }
+        fn scale(&self) -> String {
+            String::new()
+        }
+    }
+
+    /// Every method's iterations, counted by the observer, plus the budget the
+    /// converged starts give back, add up to the budget exactly: the bar ends full,
+    /// never past it.
+    #[test]
+    fn the_iterations_done_end_equal_to_the_budget() {
+        let base = presets::load("worm-gear").unwrap();
+        let names = ["Kw".to_string(), "Kg".to_string()];
+        let bounds = [
+            ("Kw".to_string(), Bound { lo: 1e5, hi: 1e6 }),
+            ("Kg".to_string(), Bound { lo: 1e2, hi: 1e4 }),
+        ];
+        let space = ParamSpace::new(base, &names, &bounds).unwrap();
+        for method in [Method::Lsq, Method::NelderMead, Method::Pso] {
+            let monitor = Monitor::default();
+            let settings = Settings {
+                method,
+                starts: 3,
+                max_iters: 30,
+                ..Settings::default()
+            };
+            let records = search(&space, &Bowl, &settings, &monitor, &[], &|_| {});
+            let (done, budget) = monitor.progress().iterations();
+            assert_eq!(budget, 90, "{method:?}");
+            assert_eq!(done, budget, "{method:?}: {records:?}");
+            assert_eq!(monitor.progress().fraction(), Some(1.0));
+        }
+    }
+}
