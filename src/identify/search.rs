@@ -169,7 +169,11 @@ mod tests {
             "bowl"
         }
         fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
-            Ok(vec![p.kw / 3e5 - 1.0, p.kg.unwrap_or(0.0) / 900.0 - 1.0, 0.0])
+            Ok(vec![
+                p.kw / 3e5 - 1.0,
+                p.kg.unwrap_or(0.0) / 900.0 - 1.0,
+                0.0,
+            ])
         }
         fn len(&self) -> usize {
             3
