@@ -45,16 +45,23 @@ pub struct Comparison {
 }
 
 impl Comparison {
-    /// The same curves with at most `max` points each (every k-th kept).
+    /// The same curves with at most `max` points each.
     pub fn thinned(mut self, max: usize) -> Comparison {
         for c in &mut self.curves {
-            let every = c.points.len().div_ceil(max.max(1)).max(1);
-            c.points = std::mem::take(&mut c.points)
-                .into_iter()
-                .step_by(every)
-                .collect();
+            c.thin(max);
         }
         self
+    }
+}
+
+impl Curve {
+    /// Keeps at most `max` points (every k-th).
+    fn thin(&mut self, max: usize) {
+        let every = self.points.len().div_ceil(max.max(1)).max(1);
+        self.points = std::mem::take(&mut self.points)
+            .into_iter()
+            .step_by(every)
+            .collect();
     }
 }
 
@@ -217,14 +224,13 @@ fn unbalance(
         ("identified model", &model, Role::Fitted),
     ] {
         for p in &e.passes {
-            let every = p.angle_deg.len().div_ceil(MAX_DEVIATION_POINTS).max(1);
             let mut c = curve(
                 &format!("{who}, {}", p.direction),
                 role,
                 &p.angle_deg,
                 &p.deviation_arcsec,
             );
-            c.points = c.points.into_iter().step_by(every).collect();
+            c.thin(MAX_DEVIATION_POINTS);
             curves.push(c);
         }
     }
