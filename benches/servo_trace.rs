@@ -12,7 +12,7 @@
 use std::path::PathBuf;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use rtid::experiments::inverse_dynamics::IdimSettings;
+use rtid::estimation::inverse_dynamics::IdimSettings;
 use rtid::experiments::servo_trace::{replay, ServoTrace};
 use rtid::identify::{identify, Config, ExperimentSpec, Monitor};
 use rtid::io::experiment_file::{self, Data};

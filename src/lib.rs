@@ -9,6 +9,7 @@
 pub const VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), " (", env!("RTID_COMMIT"), ")");
 
 pub mod controller;
+pub mod estimation;
 pub mod experiments;
 pub mod identify;
 pub mod input;
@@ -16,7 +17,6 @@ pub mod io;
 pub mod model;
 pub mod names;
 pub mod objectives;
-pub mod peaks;
 pub mod recorder;
 pub mod report;
 pub mod sim;

@@ -9,7 +9,7 @@ mod cli;
 
 fn main() -> ExitCode {
     quiet_on_broken_pipe();
-    cli::interrupt::install();
+    cli::common::interrupt::install();
     let matches = negative_numbers(colour(cli::Cli::command())).get_matches();
     let cli = cli::Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     match cli::run(cli) {

@@ -5,7 +5,7 @@
 use rtid::experiments::fluctuation::{
     evaluate, evaluate_experiment, manifest, run, to_data, FluctuationTest, Record, STEP_WINDOW,
 };
-use rtid::experiments::iso230::ARCSEC_PER_RAD;
+use rtid::experiments::positioning::iso230::ARCSEC_PER_RAD;
 use rtid::io::experiment_file::{self, Kind};
 use rtid::model::presets;
 

@@ -1,8 +1,8 @@
 //! The virtual frequency-response test (docs/experiments.md (frequency response)).
 
+use rtid::estimation::peaks::maxima as peaks;
 use rtid::experiments::frequency_response::{linear, sweep, FrequencyTest};
 use rtid::model::{presets, Params};
-use rtid::peaks::maxima as peaks;
 
 /// The preset made linear: no backlash, no Coulomb friction, no fluctuation.
 fn linear_limit(name: &str) -> Params {

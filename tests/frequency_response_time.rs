@@ -1,16 +1,16 @@
 //! The frequency response estimated from raw time series (docs/experiments.md (frequency response), recorded as a
 //! `frequency_response_time` file) against the exact linear response.
 
+use rtid::estimation::peaks::maxima as peaks;
 use rtid::experiments::frequency_response::linear;
-use rtid::experiments::frequency_response_estimate::{
+use rtid::experiments::frequency_response::time_evaluation::{
     evaluate_experiment, EstimateOptions, Evaluation,
 };
-use rtid::experiments::frequency_response_record::{
+use rtid::experiments::frequency_response::time_record::{
     manifest, run, to_data, Excitation, RecordTest,
 };
 use rtid::io::experiment_file::{self, Experiment};
 use rtid::model::{presets, Params};
-use rtid::peaks::maxima as peaks;
 
 /// The preset made linear: no backlash, no Coulomb friction, no fluctuation.
 fn linear_limit(name: &str) -> Params {
@@ -125,14 +125,15 @@ fn measurement_noise_lowers_the_coherence() {
     };
     let (clean, kept_clean) = band(0.0);
     let (noisy, kept_noisy) = band(2.0);
-    let mean = |bins: &[rtid::experiments::frequency_response_estimate::Bin], lo: f64, hi: f64| {
-        let v: Vec<f64> = bins
-            .iter()
-            .filter(|b| (lo..hi).contains(&b.frequency_hz))
-            .map(|b| b.coherence)
-            .collect();
-        v.iter().sum::<f64>() / v.len() as f64
-    };
+    let mean =
+        |bins: &[rtid::experiments::frequency_response::time_evaluation::Bin], lo: f64, hi: f64| {
+            let v: Vec<f64> = bins
+                .iter()
+                .filter(|b| (lo..hi).contains(&b.frequency_hz))
+                .map(|b| b.coherence)
+                .collect();
+            v.iter().sum::<f64>() / v.len() as f64
+        };
     let (c_low, n_low) = (mean(&clean, 20.0, 150.0), mean(&noisy, 20.0, 150.0));
     let (c_high, n_high) = (mean(&clean, 300.0, 400.0), mean(&noisy, 300.0, 400.0));
     eprintln!(

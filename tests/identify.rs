@@ -4,13 +4,13 @@
 
 mod support;
 
+use rtid::estimation::peaks::of_linear_response as linear_peaks;
 use rtid::identify::{
     identify, Bound, Config, ExperimentSpec, FidelityChoice, Identified, Method, Monitor, Warning,
 };
 use rtid::io::experiment_file::{Data, Experiment, Kind, Manifest};
 use rtid::model::{presets, Params};
 use rtid::objectives::ObjectiveKind;
-use rtid::peaks::of_linear_response as linear_peaks;
 use support::{off, values, Fixture};
 
 fn config(experiments: Vec<ExperimentSpec>, base: Params, fit: &[&str]) -> Config {
@@ -327,8 +327,11 @@ fn methods_agree_on_an_easy_problem() {
 
 /// The torque-curve objective of the worm fixture and the uncertainty at the truth
 /// for `names` (standard machinery: the Jacobian step of a simulated objective).
-fn torque_curve_uncertainty(names: &[&str], step: f64) -> rtid::identify::uncertainty::Assessed {
-    use rtid::identify::{setup, uncertainty::at_optimum, ParamSpace};
+fn torque_curve_uncertainty(
+    names: &[&str],
+    step: f64,
+) -> rtid::identify::intervals::uncertainty::Assessed {
+    use rtid::identify::{intervals::uncertainty::at_optimum, setup, ParamSpace};
     use rtid::objectives::{Fidelity, Stage};
     let Fixture { spec, truth } = support::worm_torque_curve();
     let joint = setup::build(&[spec], Stage::Search, Fidelity::Linear).unwrap();

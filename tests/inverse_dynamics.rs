@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use rtid::experiments::inverse_dynamics::{identify, IdimFit, IdimSettings};
+use rtid::estimation::inverse_dynamics::{identify, IdimFit, IdimSettings};
 use rtid::io::experiment_file::{self, sample_period, Axis, Data};
 
 const PUBLISHED: [f64; 4] = [95.1089, 203.5034, 20.3935, -3.1648];

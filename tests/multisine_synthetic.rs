@@ -17,9 +17,11 @@
 
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use rtid::experiments::multisine::{generate, Level, LineSet, Multisine, MultisineSpec, PhaseRule};
-use rtid::experiments::periodic_estimate::{h1, FrfEstimate};
-use rtid::experiments::periodic_record::{PeriodicOptions, PeriodicRecord};
+use rtid::estimation::periodic::estimate::{h1, FrfEstimate};
+use rtid::estimation::periodic::multisine::{
+    generate, Level, LineSet, Multisine, MultisineSpec, PhaseRule,
+};
+use rtid::estimation::periodic::record::{PeriodicOptions, PeriodicRecord};
 use rustfft::{num_complex::Complex, FftPlanner};
 use std::f64::consts::TAU;
 

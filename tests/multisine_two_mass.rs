@@ -15,14 +15,14 @@
 //! lines per half-power width) are the disturbed ones — the coherence dips to 0.970 at
 //! 53–54 Hz, where the motor stands almost still and its friction acts — so the
 //! extrema are used to find and count the modes, and a rational fit over the band
-//! around them ([`rtid::experiments::local_mode_fit`]) to locate them: 76.15 Hz and
+//! around them ([`rtid::estimation::local_mode_fit`]) to locate them: 76.15 Hz and
 //! 53.86 Hz (± 0.09 Hz), 53.78 Hz (± 0.13 Hz), the reference's values.
 
-use rtid::experiments::extrema::{extrema, Extrema, ExtremaOptions};
-use rtid::experiments::local_mode_fit::{fit, ModeFit, ModeFitOptions};
-use rtid::experiments::periodic_estimate::{h1, reference_ratio, FrfEstimate};
-use rtid::experiments::periodic_record::{PeriodicOptions, PeriodicRecord};
-use rtid::experiments::two_mass_ratios;
+use rtid::estimation::extrema::{extrema, Extrema, ExtremaOptions};
+use rtid::estimation::local_mode_fit::{fit, ModeFit, ModeFitOptions};
+use rtid::estimation::periodic::estimate::{h1, reference_ratio, FrfEstimate};
+use rtid::estimation::periodic::record::{PeriodicOptions, PeriodicRecord};
+use rtid::estimation::two_mass_ratios;
 
 const FS: f64 = 2500.0;
 

@@ -1,6 +1,6 @@
 //! The virtual ISO 230-2 positioning test on both presets (docs/experiments.md (positioning)).
 
-use rtid::experiments::iso230::{evaluate, ARCSEC_PER_RAD};
+use rtid::experiments::positioning::iso230::{evaluate, ARCSEC_PER_RAD};
 use rtid::experiments::positioning::{run, PositioningTest};
 use rtid::model::presets;
 

@@ -6,7 +6,8 @@ mod support;
 
 use std::collections::BTreeMap;
 
-use rtid::identify::profile::{self, Profile, Request, Variance};
+use rtid::identify::intervals::profile::{self, Request};
+use rtid::identify::result::profile::{Profile, Variance};
 use rtid::identify::{identify, Config, FidelityChoice, Identified, Monitor, Warning};
 use rtid::model::{presets, Params};
 use support::{off, Fixture};

@@ -2,11 +2,12 @@
 //! rough cost, whose standard error misses the truth, its interval holds it and
 //! replaces the warning that the standard errors are lower bounds; objectives of a
 //! few residuals are refused. (Its agreement with σ²(JᵀJ)⁻¹ on a smooth cost with
-//! white errors is tested in src/identify/resample.rs.)
+//! white errors is tested in src/identify/intervals/resample.rs.)
 
 mod support;
 
-use rtid::identify::resample::{self, Request, Resampling};
+use rtid::identify::intervals::resample::{self, Request};
+use rtid::identify::result::resampling::Resampling;
 use rtid::identify::{identify, Config, FidelityChoice, Identified, Monitor};
 use support::{off, Fixture};
 

@@ -10,10 +10,11 @@
 use std::path::PathBuf;
 
 use rtid::controller::{Controller, Gains};
-use rtid::experiments::inverse_dynamics::{of_torque_curve, IdimSettings};
+use rtid::estimation::inverse_dynamics::IdimSettings;
 use rtid::experiments::servo_trace::{
     replay, simulation_error, virtual_trace, MoveTo, ServoTrace, TrapezoidalMoves,
 };
+use rtid::experiments::torque_curve::idim_fit;
 use rtid::experiments::torque_curve::{self, TorqueTest};
 use rtid::io::experiment_file::{self, Data};
 use rtid::model::{presets, Params};
@@ -202,7 +203,7 @@ fn the_friction_law_of_a_virtual_emps_trace_is_the_model_s() {
 fn the_friction_law_of_the_worm_torque_curve_is_the_friction_at_the_motor() {
     let p = presets::load("worm-gear").unwrap();
     let curve = torque_curve::run(&p, &TorqueTest::default(), |_, _| {}).unwrap();
-    let fit = of_torque_curve(&curve, &IdimSettings::default()).unwrap();
+    let fit = idim_fit(&curve, &IdimSettings::default()).unwrap();
     let at_motor = p.fm + p.fw * p.rg.unwrap() + p.ft * p.ratio();
     let windows = torque_curve::evaluate(&curve, &TorqueTest::default())
         .unwrap()

@@ -4,11 +4,11 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 
-use super::experiment::{
+use crate::cli::common::model_args::ModelArgs;
+use crate::cli::experiment::{
     fluctuation, frequency_response, frequency_response_time, positioning, servo_trace,
     torque_curve,
 };
-use super::model_args::ModelArgs;
 use rtid::io::experiment_file::{self, Kind};
 
 pub const LONG_ABOUT: &str = "\
@@ -87,7 +87,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut inputs: Vec<&std::path::Path> = vec![&a.file];
     inputs.extend(exp.data_path.as_deref());
     inputs.extend(a.model.params.as_deref());
-    super::inputs::refuse_overwrite("--plot", &plot, &inputs)?;
+    crate::cli::common::inputs::refuse_overwrite("--plot", &plot, &inputs)?;
     report(&a, &exp, &plot).map_err(|e| {
         // Every error names the file evaluated.
         let file = a.file.display().to_string();

@@ -1,30 +1,21 @@
 //! The command line: clap parses raw arguments here, each command's module validates
 //! them into a run configuration and runs it.
 
+pub mod common;
 mod compare;
-mod design;
 mod evaluate;
 mod experiment;
 mod identify;
-mod inputs;
-pub mod interrupt;
-mod model_args;
-mod modes;
-mod params_cmd;
-mod profile;
-mod progress;
+mod model;
 #[cfg(test)]
 mod properties;
 mod report;
-mod resample;
-mod select;
 mod shell;
-mod simulate;
 mod sweep;
 
 use clap::{Parser, Subcommand};
 
-pub use model_args::ModelArgs;
+pub use common::model_args::ModelArgs;
 
 const ABOUT: &str = "Simulate CNC rotary tables (worm-gear and roller-gear-cam drives) and \
 identify their stiffness, damping and friction from measurements.";
@@ -63,14 +54,14 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Natural frequencies of the linearised drive, motor held and motor free.
-    #[command(long_about = modes::LONG_ABOUT)]
-    Modes(modes::Args),
+    #[command(long_about = model::modes::LONG_ABOUT)]
+    Modes(model::modes::Args),
     /// Time simulation under an open-loop torque or a closed-loop move; writes a CSV.
-    #[command(long_about = simulate::LONG_ABOUT)]
-    Simulate(simulate::Args),
+    #[command(long_about = model::simulate::LONG_ABOUT)]
+    Simulate(model::simulate::Args),
     /// List, check or save a parameter set (names, values, units, notes).
-    #[command(long_about = params_cmd::LONG_ABOUT)]
-    Params(params_cmd::Args),
+    #[command(long_about = model::params::LONG_ABOUT)]
+    Params(model::params::Args),
     /// Run one of the paper's tests on the model; writes an experiment file and a plot.
     #[command(long_about = experiment::LONG_ABOUT)]
     Experiment {
@@ -90,11 +81,11 @@ pub enum Command {
     #[command(long_about = sweep::LONG_ABOUT)]
     Sweep(sweep::Args),
     /// Model selection: AIC, AICc, BIC and F-tests between identifications of the same data.
-    #[command(long_about = select::LONG_ABOUT)]
-    Select(select::Args),
+    #[command(long_about = identify::select::LONG_ABOUT)]
+    Select(identify::select::Args),
     /// Experiment design: candidate tests ranked by the standard errors they would give.
-    #[command(long_about = design::LONG_ABOUT)]
-    Design(design::Args),
+    #[command(long_about = identify::design::LONG_ABOUT)]
+    Design(identify::design::Args),
     /// Shell completion script (bash, zsh, fish, elvish, powershell) on stdout.
     #[command(long_about = shell::COMPLETIONS_ABOUT)]
     Completions(shell::CompletionArgs),
@@ -109,16 +100,16 @@ pub enum Command {
 /// Runs one parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Modes(a) => modes::run(a),
-        Command::Simulate(a) => simulate::run(a),
-        Command::Params(a) => params_cmd::run(a),
+        Command::Modes(a) => model::modes::run(a),
+        Command::Simulate(a) => model::simulate::run(a),
+        Command::Params(a) => model::params::run(a),
         Command::Experiment { test } => experiment::run(test),
         Command::Identify(a) => identify::run(a),
         Command::Evaluate(a) => evaluate::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Sweep(a) => sweep::run(a),
-        Command::Select(a) => select::run(a),
-        Command::Design(a) => design::run(a),
+        Command::Select(a) => identify::select::run(a),
+        Command::Design(a) => identify::design::run(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
         Command::Report(a) => report::run(a),

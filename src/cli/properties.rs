@@ -6,10 +6,10 @@
 use clap::{CommandFactory, FromArgMatches};
 use proptest::prelude::*;
 
-use super::identify::parse_bound;
-use super::model_args::parse_assignment;
-use super::simulate::InputSpec;
 use super::Cli;
+use crate::cli::common::model_args::parse_assignment;
+use crate::cli::identify::parse_bound;
+use crate::cli::model::simulate::InputSpec;
 
 /// Every (subcommand path, long option taking a value) of the command line.
 fn options() -> Vec<(Vec<String>, String)> {

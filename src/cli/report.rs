@@ -101,7 +101,7 @@ impl Args {
 pub fn run(a: Args) -> anyhow::Result<()> {
     let options = a.options()?;
     let inputs: Vec<&Path> = a.files.iter().map(PathBuf::as_path).collect();
-    super::inputs::refuse_overwrite("--out", &a.out, &inputs)?;
+    crate::cli::common::inputs::refuse_overwrite("--out", &a.out, &inputs)?;
     let loaded = a
         .files
         .iter()

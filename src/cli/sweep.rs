@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
-use super::{progress, ModelArgs};
+use crate::cli::{common::progress, ModelArgs};
 use rtid::report::sweep as figures;
 use rtid::sweep::{self, analysis::Indices, Method, Output, RunOptions, Shard, Sweep, TestLength};
 

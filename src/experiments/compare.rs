@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::iso230;
+use super::positioning::iso230;
 use super::{fluctuation, positioning, torque_curve};
 use crate::io::experiment_file::{self, Data, Experiment, ExperimentFileError};
 
@@ -178,7 +178,7 @@ fn add(s: &mut Summary, exp: &Experiment) -> Result<(), BoxedError> {
                 .copied()
                 .zip(gain_db.iter().copied())
                 .collect();
-            let peaks = crate::peaks::maxima(&curve, RESONANCES);
+            let peaks = crate::estimation::peaks::maxima(&curve, RESONANCES);
             s.resonances_hz = Some(peaks.iter().map(|p| p.frequency_hz).collect());
         }
         Data::Resonance { peaks_hz, .. } if s.resonances_hz.is_none() => {
@@ -228,7 +228,7 @@ fn add(s: &mut Summary, exp: &Experiment) -> Result<(), BoxedError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiments::iso230::ARCSEC_PER_RAD;
+    use crate::experiments::positioning::iso230::ARCSEC_PER_RAD;
 
     #[test]
     fn the_threshold_is_two_counts_of_a_tenthousandth_degree() {

@@ -1,27 +1,25 @@
-//! The paper's five tests (docs/experiments.md): virtual experiments and the evaluation of their
-//! measured data; servo traces of any axis (replay, simulation error, virtual traces) and
-//! the friction law fitted to any recorded motion.
+//! The tests (docs/experiments.md), one folder each: its description, its virtual
+//! experiment (run on the model), its record as experiment-file data, and the
+//! evaluation of a measured or virtual record. The estimators they share — spectra,
+//! frequency-response estimation, peak and mode fitting, inverse dynamics — are in
+//! [`crate::estimation`], which calls nothing of this layer.
+//!
+//! - [`frequency_response`]: the paper's frequency-response test (§4.1), its raw time
+//!   records (stepped sine, noise, chirp, periodic multisine) and their evaluation;
+//! - [`torque_curve`]: the friction-torque test (§4.2);
+//! - [`positioning`]: the positioning test (§4.3) and its ISO 230-2 evaluation;
+//! - [`fluctuation`]: the rotational-fluctuation test (§4.4) and the unbalance-mass
+//!   test (§4.5) — one procedure, the second with a mass on the table, sharing run,
+//!   record and evaluation;
+//! - [`servo_trace`]: recorded closed-loop runs of any axis, their replay and virtual
+//!   traces;
+//! - [`compare`]: the paper's Table 3 over folders of experiment files;
+//!   [`measurement_noise`]: the noise virtual experiments add.
 
 pub mod compare;
-pub mod extrema;
 pub mod fluctuation;
 pub mod frequency_response;
-pub mod frequency_response_estimate;
-pub mod frequency_response_record;
-pub mod inverse_dynamics;
-pub mod iso230;
-pub mod line_scatter;
-pub mod local_mode_fit;
 pub mod measurement_noise;
-pub mod multisine;
-pub mod nonlinear_distortion;
-pub mod periodic_estimate;
-pub mod periodic_evaluation;
-pub mod periodic_record;
 pub mod positioning;
 pub mod servo_trace;
-pub mod spectrum;
-pub mod stepped_sine;
 pub mod torque_curve;
-pub mod two_mass_ratios;
-pub mod welch;

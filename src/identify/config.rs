@@ -4,9 +4,8 @@
 
 use std::path::PathBuf;
 
-use super::solvers::Method;
-use super::space::Bound;
-use super::start::StartChoice;
+use crate::identify::search::settings::Method;
+use crate::identify::space::Bound;
 use crate::io::experiment_file::Experiment;
 use crate::model::Params;
 use crate::objectives::ObjectiveKind;
@@ -48,7 +47,7 @@ pub enum FidelityChoice {
     Nonlinear,
 }
 
-/// How to search; `None` fields follow from the objectives ([`super::plan`]).
+/// How to search; `None` fields follow from the objectives ([`crate::identify::plan`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SearchOptions {
     /// The solver (default: Gauss–Newton; Nelder–Mead when an objective is rough).
@@ -119,4 +118,14 @@ impl Config {
         }
         self
     }
+}
+
+/// Where to start.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum StartChoice {
+    /// At the direct estimate where an experiment offers one, else the given values.
+    #[default]
+    Estimate,
+    /// At the given parameter set's values.
+    Given,
 }

@@ -22,13 +22,13 @@ use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::config::ExperimentSpec;
-use super::setup;
-use super::space::ParamSpace;
-use super::uncertainty::{self, jacobian};
 use crate::experiments::fluctuation::{self, FluctuationTest};
 use crate::experiments::frequency_response::{self as fr, FrequencyTest};
 use crate::experiments::torque_curve::{self, TorqueTest};
+use crate::identify::config::ExperimentSpec;
+use crate::identify::intervals::uncertainty::{self, jacobian};
+use crate::identify::setup;
+use crate::identify::space::ParamSpace;
 use crate::io::experiment_file::Experiment;
 use crate::model::Params;
 use crate::objectives::{Fidelity, Stage};
@@ -86,7 +86,7 @@ pub enum DesignError {
     #[error("{label}: {message}")]
     Objective { label: String, message: String },
     #[error("{0}")]
-    Space(#[from] super::space::SpaceError),
+    Space(#[from] crate::identify::space::SpaceError),
 }
 
 /// What every candidate shares.
@@ -131,7 +131,7 @@ fn assess(request: &Request, space: &ParamSpace, c: &Candidate) -> Result<Assess
         .rough;
     let joint =
         setup::build(specs, Stage::Search, Fidelity::Nonlinear).map_err(|e| objective_error(&e))?;
-    let step = super::plan::uncertainty_step(rough, Fidelity::Nonlinear);
+    let step = crate::identify::plan::uncertainty_step(rough, Fidelity::Nonlinear);
     let jac = jacobian(space, &joint, &space.start, step).map_err(|e| objective_error(&e))?;
     Ok(predict(request, c, space, &jac))
 }

@@ -4,10 +4,10 @@
 //! starts and finite-difference step, the step of the uncertainty's Jacobian, and
 //! whether the result is checked on the nonlinear test. Pure: no simulation runs.
 
-use super::config::{Config, FidelityChoice};
-use super::search::{Settings, SIMPLEX_STEP, SIMPLEX_STEP_NEAR};
-use super::setup::{self, Declared};
-use super::solvers::Method;
+use crate::identify::config::{Config, FidelityChoice};
+use crate::identify::search::settings::Method;
+use crate::identify::search::settings::{Settings, SIMPLEX_STEP, SIMPLEX_STEP_NEAR};
+use crate::identify::setup::{self, Declared};
 use crate::objectives::{Fidelity, SetupError, Stage};
 
 /// One stage.
@@ -19,7 +19,7 @@ pub struct StagePlan {
     /// The search's settings (for corrections: those of their linear sub-searches).
     pub settings: Settings,
     /// Run only when the linear search's result fails the nonlinear check
-    /// (`--model auto`: [`super::escalation`]).
+    /// (`--model auto`: [`crate::identify::pipeline::escalation`]).
     pub escalation: bool,
 }
 
@@ -144,7 +144,7 @@ impl Plan {
     }
 
     /// The plan of a search that starts at a direct estimate
-    /// ([`super::start`]): the first stage's Nelder–Mead simplex starts small.
+    /// ([`crate::identify::start`]): the first stage's Nelder–Mead simplex starts small.
     pub fn from_estimate(mut self) -> Plan {
         self.stages[0].settings.simplex_step = SIMPLEX_STEP_NEAR;
         self

@@ -5,18 +5,19 @@
 use std::borrow::Cow;
 use std::time::Instant;
 
-use super::assess::assess;
-use super::checkpoint::{Checkpointer, Fingerprint};
-use super::config::Config;
-use super::plan::Plan;
-use super::problem::Monitor;
-use super::result::{assemble, IdentifyResult, Run};
-use super::search::Settings;
-use super::space::ParamSpace;
-use super::stages;
-use super::start::start;
-use super::warning::Warning;
-use super::IdentifyError;
+use crate::identify::config::Config;
+use crate::identify::error::IdentifyError;
+use crate::identify::pipeline::assemble::{assemble, Run};
+use crate::identify::pipeline::assess::assess;
+use crate::identify::pipeline::checkpoint::{Checkpointer, Fingerprint};
+use crate::identify::pipeline::stages;
+use crate::identify::plan::Plan;
+use crate::identify::result::warning::Warning;
+use crate::identify::result::IdentifyResult;
+use crate::identify::search::problem::Monitor;
+use crate::identify::search::settings::Settings;
+use crate::identify::space::ParamSpace;
+use crate::identify::start::start;
 use crate::model::Params;
 use crate::objectives::{Objective, ObjectiveError};
 

@@ -19,7 +19,7 @@
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, FisherSnedecor};
 
-use super::result::IdentifyResult;
+use crate::identify::result::IdentifyResult;
 
 /// One result's figures.
 #[derive(Clone, Debug, PartialEq, Serialize)]

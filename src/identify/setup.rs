@@ -2,7 +2,7 @@
 //! feeds at a stage (its own, or its kind's defaults from the registry), with which
 //! weights, and which parameters a user who names none wants fitted.
 
-use super::config::ExperimentSpec;
+use crate::identify::config::ExperimentSpec;
 use crate::model::Params;
 use crate::objectives::{Fidelity, Joint, ObjectiveKind, SetupError, Smoothness, Source, Stage};
 

@@ -10,7 +10,7 @@
 use nalgebra::DVector;
 use rand::{rngs::StdRng, seq::SliceRandom, Rng, SeedableRng};
 
-use super::warning::Side;
+use crate::identify::result::warning::Side;
 use crate::model::registry::Constraint;
 use crate::model::{ParamError, Params};
 

@@ -2,39 +2,18 @@
 //! a direct estimate made before any simulation (a servo trace's inverse-dynamics
 //! least squares) — that estimate for the fitted parameters it gives. The default
 //! bounds then lie around the estimate, and a Nelder–Mead simplex starts small
-//! ([`super::plan::Plan::from_estimate`]): the estimate is close, where the given
+//! ([`crate::identify::plan::Plan::from_estimate`]): the estimate is close, where the given
 //! values may be guesses.
 
+use crate::identify::config::StartChoice;
+use crate::identify::result::starts::StartEstimate;
 use std::collections::BTreeMap;
 
-use super::config::Config;
-use super::setup::selection;
-use super::warning::Warning;
+use crate::identify::config::Config;
+use crate::identify::result::warning::Warning;
+use crate::identify::setup::selection;
 use crate::model::Params;
 use crate::objectives::{Estimated, SetupError, Source, Stage};
-
-/// Where to start.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum StartChoice {
-    /// At the direct estimate where an experiment offers one, else the given values.
-    #[default]
-    Estimate,
-    /// At the given parameter set's values.
-    Given,
-}
-
-/// One experiment's direct estimate, as used: the fitted parameters it set.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct StartEstimate {
-    /// The experiment file.
-    pub source: String,
-    /// The objective that made it.
-    pub objective: String,
-    /// How, in words (method, filters).
-    pub method: String,
-    /// Name → estimated value (SI): the fitted parameters it starts.
-    pub values: BTreeMap<String, f64>,
-}
 
 /// Where the search starts.
 pub struct Start {

@@ -1,7 +1,9 @@
-//! Files in and out: parameter files, experiment files, atomic writes.
+//! Files in and out: parameter files, experiment files, atomic writes, provenance;
+//! [`formats`]: the formats labs export.
 
 pub mod atomic;
 pub mod experiment_file;
+pub mod formats;
 pub mod params_file;
 pub mod provenance;
 pub mod torque_file;

@@ -3,9 +3,9 @@
 //! measured at, and the conditions of the test the model must reproduce.
 
 use super::registry::{SetupError, Source};
+use crate::estimation::peaks::{self, Peak};
 use crate::experiments::frequency_response::FrequencyTest;
 use crate::io::experiment_file::{Data, Experiment, Kind};
-use crate::peaks::{self, Peak};
 
 /// A local maximum of a measured gain curve counts as a resonance when it stands
 /// this far above the lowest point between it and any higher point (or the curve's

@@ -1,5 +1,5 @@
 //! Where the model's resonances are, for the objectives that compare peaks: those of
-//! its exact linear response ([`crate::peaks::of_linear_response`]), or of the
+//! its exact linear response ([`crate::estimation::peaks::of_linear_response`]), or of the
 //! nonlinear virtual test (a short scan of time simulations around the linear
 //! prediction + two parabolic refinements, or like for like on a measured grid).
 //!
@@ -8,9 +8,9 @@
 
 use rayon::prelude::*;
 
+use crate::estimation::peaks::{of_linear_response, vertex, Peak};
 use crate::experiments::frequency_response::{simulate_point, FrequencyTest};
 use crate::model::Params;
-use crate::peaks::{of_linear_response, vertex, Peak};
 use crate::sim::SimError;
 
 /// Relative offsets of the first nonlinear scan around the linear prediction: backlash

@@ -11,10 +11,10 @@
 use super::model_peaks::ModelPeaks;
 use super::registry::{Definition, SetupError, Source, Stage};
 use super::{measured, Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
+use crate::estimation::peaks::Peak;
 use crate::experiments::frequency_response::FrequencyTest;
 use crate::io::experiment_file::Kind;
 use crate::model::Params;
-use crate::peaks::Peak;
 
 /// Weight, relative to the resonance frequencies, of the peak heights that a gain curve
 /// feeds by default: resonance frequencies alone admit two (Kw, Kg) pairs for the worm

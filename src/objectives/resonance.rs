@@ -156,7 +156,7 @@ mod tests {
     #[test]
     fn the_linear_resonances_of_the_model_itself_match_exactly() {
         let p = presets::load("worm-gear").unwrap();
-        let peaks = crate::peaks::of_linear_response(&p, 10.0, 600.0, 2).unwrap();
+        let peaks = crate::estimation::peaks::of_linear_response(&p, 10.0, 600.0, 2).unwrap();
         let hz: Vec<f64> = peaks.iter().map(|pk| pk.frequency_hz).collect();
         let obj = ResonanceMatch::new(hz, Fidelity::Linear, FrequencyTest::default());
         let r = obj.residuals(&p).unwrap();

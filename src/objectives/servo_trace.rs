@@ -15,7 +15,7 @@
 
 use super::registry::{Definition, Estimated, SetupError, Source};
 use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
-use crate::experiments::inverse_dynamics::IdimSettings;
+use crate::estimation::inverse_dynamics::IdimSettings;
 use crate::experiments::servo_trace::{replay, ServoTrace, TraceError};
 use crate::io::experiment_file::{Data, Kind};
 use crate::model::{Params, Topology};

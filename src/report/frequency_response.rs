@@ -2,7 +2,7 @@
 //! linear model's curve where the file carries one, the resonances marked.
 
 use super::figure::{Figure, Series, Style};
-use crate::peaks::Peak;
+use crate::estimation::peaks::Peak;
 
 /// The gain curve (`frequency_hz`, `gain_db`), the linear model's gain at the same
 /// frequencies when given, and the resonances.

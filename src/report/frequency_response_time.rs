@@ -2,7 +2,7 @@
 //! sine or H1) with its resonances, and the coherence of an H1 estimate.
 
 use super::figure::{Figure, Series, Style};
-use crate::experiments::frequency_response_estimate::{kept_runs, Bin, Evaluation};
+use crate::experiments::frequency_response::time_evaluation::{kept_runs, Bin, Evaluation};
 
 /// The gain with the resonances marked, and for H1 the coherence figure too.
 pub fn figures(e: &Evaluation, mechanism: &str) -> (Figure, Option<Figure>) {

@@ -1,8 +1,9 @@
 //! Figures of an identification: each experiment's data against the model.
 
 use super::figure::{Figure, Series, Style};
-use crate::identify::comparison::{Comparison, Role};
-use crate::identify::profile::{Profile, THRESHOLD};
+use crate::identify::intervals::profile::THRESHOLD;
+use crate::identify::result::comparison::{Comparison, Role};
+use crate::identify::result::profile::Profile;
 
 /// The measured data as markers (frequency responses) or lines, the model at the
 /// start dashed and at the identified values as a line.

@@ -2,7 +2,7 @@
 //! resonances and antiresonances, and their coherence over the excited lines.
 
 use super::figure::{Figure, Series, Style};
-use crate::experiments::periodic_evaluation::{Channel, PeriodicEvaluation};
+use crate::experiments::frequency_response::periodic_evaluation::{Channel, PeriodicEvaluation};
 
 /// The gains (each channel in its own unit, dB) with the modes marked, and the
 /// coherence.
@@ -35,12 +35,16 @@ pub fn figures(p: &PeriodicEvaluation, mechanism: &str) -> (Figure, Option<Figur
             Style::Line,
         ));
     }
-    let marks = |pick: fn(&Channel) -> &[crate::experiments::periodic_evaluation::Mode]| {
-        [&p.table, &p.motor]
-            .into_iter()
-            .flat_map(|c| pick(c).iter().map(|m| (m.extremum_hz, m.gain_db)))
-            .collect::<Vec<_>>()
-    };
+    let marks =
+        |pick: fn(
+            &Channel,
+        )
+            -> &[crate::experiments::frequency_response::periodic_evaluation::Mode]| {
+            [&p.table, &p.motor]
+                .into_iter()
+                .flat_map(|c| pick(c).iter().map(|m| (m.extremum_hz, m.gain_db)))
+                .collect::<Vec<_>>()
+        };
     gain = gain
         .with(Series::new(
             "resonances",

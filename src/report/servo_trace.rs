@@ -2,7 +2,7 @@
 //! measured and, when the model replayed it, replayed.
 
 use super::figure::{Figure, Series, Style};
-use crate::experiments::iso230::ARCSEC_PER_RAD;
+use crate::experiments::positioning::iso230::ARCSEC_PER_RAD;
 use crate::experiments::servo_trace::{Replay, ServoTrace};
 use crate::io::experiment_file::Axis;
 

@@ -18,7 +18,7 @@
 //!
 //! **Resonances.** The peaks of the exact linear gain (table over motor amplitude ×
 //! Rg·Rw, docs/model.md) from half the lowest to twice the highest motor-held natural
-//! frequency, found by [`crate::peaks::of_linear_response`] — the same function the
+//! frequency, found by [`crate::estimation::peaks::of_linear_response`] — the same function the
 //! identification's resonance objective uses, so both report the same resonance for
 //! the same parameters. The number of columns is
 //! the number of motor-held modes of the base topology (worm 3, roller 2); column i is
@@ -29,14 +29,14 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
+use crate::estimation::peaks::{self, Peak};
 use crate::experiments::fluctuation::{self, FluctuationError, FluctuationTest};
-use crate::experiments::iso230::{self, Iso230Error};
+use crate::experiments::positioning::iso230::{self, Iso230Error};
 use crate::experiments::positioning::{self, PositioningTest};
 use crate::experiments::torque_curve::{self, TorqueEvalError, TorqueTest};
 use crate::model::modes;
 use crate::model::{ParamError, Params, Topology};
 use crate::names::UnknownName;
-use crate::peaks::{self, Peak};
 use crate::sim::SimError;
 
 /// One requested output.

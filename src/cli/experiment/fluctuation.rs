@@ -5,10 +5,10 @@ use std::path::{Path, PathBuf};
 use anyhow::bail;
 
 use super::{check, Common};
-use crate::cli::progress;
+use crate::cli::common::progress;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+use rtid::estimation::spectrum::Peak;
 use rtid::experiments::fluctuation::{self, Evaluation, FluctuationTest};
-use rtid::experiments::spectrum::Peak;
 use rtid::io::experiment_file::{Experiment, Kind};
 use rtid::model::{LoopMode, Params};
 use rtid::report;
@@ -122,7 +122,7 @@ pub fn run_test(
     let bar = progress::bar(test.duration().ceil() as u64, name, common.quiet);
     let mut record = fluctuation::run(p, test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
-    let sigma = run.noise_arcsec / rtid::experiments::iso230::ARCSEC_PER_RAD;
+    let sigma = run.noise_arcsec / rtid::experiments::positioning::iso230::ARCSEC_PER_RAD;
     rtid::experiments::measurement_noise::perturb_absolute(
         &mut record.table_angle,
         sigma,

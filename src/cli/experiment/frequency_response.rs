@@ -6,7 +6,7 @@ use anyhow::{bail, Context};
 
 use super::check;
 use super::Common;
-use crate::cli::progress;
+use crate::cli::common::progress;
 use rtid::experiments::frequency_response::{self as fr, FrequencyTest, Point};
 use rtid::experiments::measurement_noise;
 use rtid::io::experiment_file::{Data, Experiment};

@@ -7,12 +7,12 @@ use anyhow::bail;
 
 use super::check::{self, positive};
 use super::Common;
-use crate::cli::progress;
-use rtid::experiments::frequency_response_estimate::{
+use crate::cli::common::progress;
+use rtid::estimation::periodic::multisine::LineSet;
+use rtid::experiments::frequency_response::time_evaluation::{
     self as estimate, EstimateOptions, Evaluation,
 };
-use rtid::experiments::frequency_response_record::{self as record, Excitation, RecordTest};
-use rtid::experiments::multisine::LineSet;
+use rtid::experiments::frequency_response::time_record::{self as record, Excitation, RecordTest};
 use rtid::io::experiment_file::{self, Experiment};
 use rtid::names::Num;
 use std::fmt::Write as _;

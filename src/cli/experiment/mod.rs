@@ -86,7 +86,7 @@ impl Common {
         if let Some(params) = &self.model.params {
             for ext in ["json", "csv", "svg"] {
                 let output = self.out.join(format!("{stem}.{ext}"));
-                crate::cli::inputs::refuse_overwrite("--out", &output, &[params])?;
+                crate::cli::common::inputs::refuse_overwrite("--out", &output, &[params])?;
             }
         }
         manifest.data = Some(format!("{stem}.csv"));

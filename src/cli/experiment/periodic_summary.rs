@@ -3,8 +3,10 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use rtid::experiments::nonlinear_distortion::DistortionBand;
-use rtid::experiments::periodic_evaluation::{Channel, Input, Mode, PeriodicEvaluation};
+use rtid::estimation::periodic::nonlinear_distortion::DistortionBand;
+use rtid::experiments::frequency_response::periodic_evaluation::{
+    Channel, Input, Mode, PeriodicEvaluation,
+};
 
 /// The summary: framing, each channel's modes, the two-mass ratios, the distortion.
 pub fn summary(p: &PeriodicEvaluation, source: &Path) -> String {
@@ -122,7 +124,10 @@ fn distortion(c: &Channel, s: &mut String) {
     }
 }
 
-fn class(b: &DistortionBand, c: &rtid::experiments::nonlinear_distortion::LineClass) -> String {
+fn class(
+    b: &DistortionBand,
+    c: &rtid::estimation::periodic::nonlinear_distortion::LineClass,
+) -> String {
     match (c.level_db, b.signal_db) {
         (Some(level), Some(signal)) if c.lines > 0 => format!(
             "{:+6.1} dB{}",

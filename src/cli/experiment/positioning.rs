@@ -7,9 +7,9 @@ use anyhow::bail;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use super::{check, Common};
-use crate::cli::progress;
-use rtid::experiments::iso230::ReportUnits;
-use rtid::experiments::{iso230, positioning};
+use crate::cli::common::progress;
+use rtid::experiments::positioning::iso230::ReportUnits;
+use rtid::experiments::positioning::{self, iso230};
 use rtid::io::experiment_file::Experiment;
 use rtid::model::{Axis, LoopMode, Params};
 

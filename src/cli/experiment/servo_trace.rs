@@ -8,7 +8,7 @@ use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use serde::Serialize;
 
-use rtid::experiments::inverse_dynamics::{IdimFit, IdimSettings};
+use rtid::estimation::inverse_dynamics::{IdimFit, IdimSettings};
 use rtid::experiments::servo_trace::{
     replay, simulation_error, virtual_trace, Misfit, MoveTo, ServoTrace, TrapezoidalMoves,
 };
@@ -17,7 +17,7 @@ use rtid::model::Params;
 use rtid::report::servo_trace as figures;
 
 use super::{check, Common};
-use crate::cli::progress;
+use crate::cli::common::progress;
 
 pub const LONG_ABOUT: &str = "\
 A servo trace of the model (docs/experiment-files.md, servo_trace): the axis's own sampled \

@@ -7,7 +7,7 @@ use rtid::experiments::torque_curve::TorqueReport;
 use rtid::report::torque_curve as figures;
 
 use super::{check, Common};
-use crate::cli::progress;
+use crate::cli::common::progress;
 use rtid::experiments::torque_curve::{self, TorqueTest};
 use rtid::io::experiment_file::{Axis, Experiment};
 use rtid::model::{LoopMode, Params};

@@ -7,7 +7,7 @@ use serde::Serialize;
 use super::record::from_data;
 use super::steps::{find_steps, pass_samples, PassSamples, Step};
 use super::{FluctuationError, Record, PEAKS, REVERSAL_THRESHOLD, STEP_WINDOW};
-use crate::experiments::spectrum::{self, Peak, Spectrum};
+use crate::estimation::spectrum::{self, Peak, Spectrum};
 use crate::io::experiment_file::{Direction, Experiment};
 use crate::model::presets;
 

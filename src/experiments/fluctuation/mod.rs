@@ -18,7 +18,7 @@
 //!    whole travel if less than one turn), resampled uniformly in angle by linear
 //!    interpolation at a power of two of points no fewer than the samples;
 //! 3. peak-to-peak of the deviation there; its spectrum after removing the mean and a
-//!    linear trend ([`super::spectrum`]); the step: the largest change of the
+//!    linear trend ([`crate::estimation::spectrum`]); the step: the largest change of the
 //!    deviation across [`STEP_WINDOW`] of table angle.
 
 mod evaluate;

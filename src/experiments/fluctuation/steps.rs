@@ -6,7 +6,7 @@ use serde::Serialize;
 use super::{
     Record, REVERSAL_THRESHOLD, STEP_LEVEL_SPAN, STEP_LOCATE_HALF_WIDTH, STEP_MIN_FRACTION,
 };
-use crate::experiments::iso230::ARCSEC_PER_RAD;
+use crate::experiments::positioning::iso230::ARCSEC_PER_RAD;
 use crate::io::experiment_file::Direction;
 
 /// A step of the deviation.

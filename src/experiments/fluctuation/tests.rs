@@ -1,7 +1,7 @@
 //! Tests of the evaluation: synthetic records with known steps, orders and gaps.
 
 use super::*;
-use crate::experiments::iso230::ARCSEC_PER_RAD;
+use crate::experiments::positioning::iso230::ARCSEC_PER_RAD;
 use crate::io::experiment_file::Direction;
 
 /// A synthetic record: `revs` turns up then down at constant speed; the table

@@ -27,16 +27,19 @@
 //! each mesh is out of contact (inside its gap) is reported. Where it is not zero the
 //! table rattles in the gap and the "gain" is not a property of the drive.
 
+pub mod periodic_evaluation;
 mod record;
 mod run;
 mod sines;
+pub mod time_evaluation;
+pub mod time_record;
 
 pub use record::{linear_points, manifest, to_data};
 pub(crate) use run::initial_state;
 pub use run::simulate_point;
 
+use crate::estimation::peaks::Peak;
 use crate::model::Params;
-use crate::peaks::Peak;
 use crate::sim::SimError;
 
 /// Frequencies advanced together by one worker (two AVX2 registers per state).
@@ -125,7 +128,7 @@ pub fn sweep(
 pub fn refinement(points: &[Point], test: &FrequencyTest) -> Vec<f64> {
     let gains: Vec<(f64, f64)> = points.iter().map(|p| (p.frequency_hz, p.gain_db)).collect();
     let mut extra: Vec<f64> = Vec::new();
-    for i in crate::peaks::local_maxima(&gains) {
+    for i in crate::estimation::peaks::local_maxima(&gains) {
         let centre = gains[i].0;
         let n = (test.refine_half_width_hz / test.refine_step_hz).floor() as i64;
         for k in -n..=n {
@@ -163,7 +166,7 @@ pub fn evaluate(frequency_hz: &[f64], gain_db: &[f64]) -> Evaluation {
         .zip(gain_db.iter().copied())
         .collect();
     Evaluation {
-        peaks: crate::peaks::maxima(&curve, RESONANCES),
+        peaks: crate::estimation::peaks::maxima(&curve, RESONANCES),
         points: curve.len(),
     }
 }

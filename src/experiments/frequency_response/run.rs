@@ -236,7 +236,7 @@ impl Run {
         // The smallest table amplitude a measurement resolves (0.0001° encoder), and a
         // floor for the ideal-encoder case, so that a table at rest gives a finite gain.
         let floor = p.controller.table_encoder_resolution.max(1e-12);
-        let [(am, pm), (at, pt)] = crate::experiments::stepped_sine::components(
+        let [(am, pm), (at, pt)] = crate::estimation::stepped_sine::components(
             &rec.t,
             [&rec.motor, &rec.table],
             self.omega,
@@ -370,7 +370,7 @@ mod tests {
             .iter()
             .map(|&t| 3.0 + 20.0 * t - 5.0 * t * t + 0.7 * (omega * t + 0.4).sin())
             .collect();
-        let [(a, phi)] = crate::experiments::stepped_sine::components(&t, [&x], omega);
+        let [(a, phi)] = crate::estimation::stepped_sine::components(&t, [&x], omega);
         assert!(
             (a - 0.7).abs() < 1e-9 && (phi - 0.4).abs() < 1e-9,
             "{a} {phi}"

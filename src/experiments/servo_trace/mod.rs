@@ -32,7 +32,7 @@ mod virtual_trace;
 pub use replay::{replay, simulation_error, Misfit, Replay};
 pub use virtual_trace::{virtual_trace, MoveTo, TrapezoidalMoves};
 
-use super::inverse_dynamics::{self, IdimError, IdimFit, IdimSettings};
+use crate::estimation::inverse_dynamics::{self, IdimError, IdimFit, IdimSettings};
 use crate::io::experiment_file::{self as file, check_uniform, sample_period, NonUniform};
 use crate::sim::SimError;
 

@@ -4,7 +4,7 @@
 //! acceptance record and printed to A4 years later exactly as it was written.
 //!
 //! Each section module turns an already computed result into HTML; the computations
-//! stay in their own modules (ISO 230-2 in `experiments::iso230`, indices in
+//! stay in their own modules (ISO 230-2 in `experiments::positioning::iso230`, indices in
 //! `sweep::analysis`), so the page and the command line never disagree.
 
 pub mod correlation;

@@ -6,8 +6,8 @@ use std::path::Path;
 
 use super::markup::{escape, fixed, svg_block, table};
 use super::{HtmlError, Kind, Section, Tolerances};
-use crate::experiments::iso230::{self, AxisStats, Iso230Report, ReportUnits};
 use crate::experiments::positioning;
+use crate::experiments::positioning::iso230::{self, AxisStats, Iso230Report, ReportUnits};
 use crate::io::experiment_file::{self, Kind as ExperimentKind};
 
 const WHAT: &str = "positioning experiment";

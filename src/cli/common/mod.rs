@@ -1,0 +1,8 @@
+//! What every command shares: the mechanism's arguments ([`model_args`]), reading
+//! input files ([`inputs`]), progress bars ([`progress`]) and the Ctrl-C handler
+//! ([`interrupt`]).
+
+pub mod inputs;
+pub mod interrupt;
+pub mod model_args;
+pub mod progress;

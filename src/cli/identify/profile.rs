@@ -1,0 +1,98 @@
+//! `rtid identify --profile`: the profiles computed after the fit, their table and
+//! their plots.
+
+use std::path::{Path, PathBuf};
+
+use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+use rtid::identify::intervals::profile;
+use rtid::identify::result::warning::Coded;
+use rtid::identify::{IdentifyResult, Monitor};
+use rtid::model::Params;
+
+use crate::cli::common::progress;
+
+/// The profiles of `names` (comma-separated; empty: every fitted parameter), added
+/// to `result` with their warnings. A progress bar counts the fitted points.
+pub fn add_profiles(
+    names: &str,
+    result: &mut IdentifyResult,
+    params: &Params,
+    fit: (&dyn rtid::objectives::Objective, rtid::identify::Settings),
+    monitor: &Monitor,
+    quiet: bool,
+) -> anyhow::Result<()> {
+    let names: Vec<String> = if names.trim().is_empty() {
+        result.parameters.keys().cloned().collect()
+    } else {
+        names.split(',').map(|n| n.trim().to_string()).collect()
+    };
+    let bar = progress::bar((names.len() * 2 * 6) as u64, "profiling (fits)", quiet);
+    let request = profile::Request {
+        result,
+        params,
+        objective: fit.0,
+        settings: fit.1,
+        names,
+        stop: &|| monitor.stopped(),
+        on_point: &|| {
+            bar.inc(1);
+            if bar.length().is_some_and(|n| bar.position() >= n) {
+                bar.inc_length(2);
+            }
+        },
+    };
+    let (profiles, warnings) = profile::profiles(&request)?;
+    bar.finish_and_clear();
+    result.warnings.extend(warnings.into_iter().map(Coded));
+    result.profiles = Some(profiles);
+    Ok(())
+}
+
+/// One plot per profile beside `out`: the likelihood-ratio statistic against the
+/// held value, with the 95 % threshold.
+pub fn write_profile_plots(out: &Path, result: &IdentifyResult) -> anyhow::Result<()> {
+    let stem = out.with_extension("");
+    for (name, p) in result.profiles.iter().flatten() {
+        let path = PathBuf::from(format!("{}-profile-{name}.svg", stem.display()));
+        rtid::report::identify::profile(name, p).write(&path)?;
+    }
+    Ok(())
+}
+
+/// Each profiled parameter's likelihood-ratio interval beside the one the standard
+/// error implies (±1.96 se): where they differ, the cost is not the quadratic bowl
+/// the standard error assumes.
+pub fn profile_table(r: &IdentifyResult) -> Option<Table> {
+    let profiles = r.profiles.as_ref().filter(|p| !p.is_empty())?;
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header([
+        "parameter",
+        "identified",
+        "95 % profile interval",
+        "relative",
+        "±1.96 standard errors",
+        "profile points",
+    ]);
+    for (name, p) in profiles {
+        let v = r.parameters[name];
+        let end = |e: Option<f64>| e.map_or("open".to_string(), |x| format!("{x:.4e}"));
+        let rel = |e: Option<f64>| {
+            e.map_or("—".to_string(), |x| {
+                format!("{:+.2} %", 100.0 * (x - v) / v.abs())
+            })
+        };
+        let se = r.standard_error(name);
+        t.add_row([
+            name.clone(),
+            format!("{v:.5e}"),
+            format!("{} … {}", end(p.lower), end(p.upper)),
+            format!("{} / {}", rel(p.lower), rel(p.upper)),
+            se.map_or("—".into(), |s| {
+                format!("{:.4e} … {:.4e}", v - 1.96 * s, v + 1.96 * s)
+            }),
+            p.points.len().to_string(),
+        ]);
+    }
+    Some(t)
+}

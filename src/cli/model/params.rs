@@ -1,0 +1,63 @@
+//! `rtid params`: list, check and save parameter sets.
+
+use std::path::PathBuf;
+
+use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+
+use crate::cli::ModelArgs;
+use rtid::io::params_file;
+use rtid::model::params::PARAMS;
+
+pub const LONG_ABOUT: &str = "\
+Lists every parameter of a mechanism with its value, SI unit and meaning, and the notes on \
+where uncertain values come from. With --out, writes the set (after --set overrides) as a \
+parameter file that every command accepts with --params.
+
+Examples:
+  rtid params --preset worm-gear
+  rtid params --preset worm-gear --set theta_bw=5e-5 --out my-table.json
+  rtid params --params my-table.json --json";
+
+/// Arguments of `rtid params`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Write the parameter set to this file (atomically).
+    #[arg(long, value_name = "FILE.json")]
+    pub out: Option<PathBuf>,
+    /// Print the parameter set as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// No "wrote FILE" note on stderr.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let p = a.model.load()?;
+    if let Some(path) = &a.out {
+        params_file::write(path, &p)?;
+        if !a.quiet {
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&p)?);
+        return Ok(());
+    }
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header(["name", "value", "unit", "meaning", "note"]);
+    for s in PARAMS {
+        let Some(v) = s.get(&p) else { continue };
+        let note = p.notes.get(s.name).map(String::as_str).unwrap_or("");
+        t.add_row([s.name, &format!("{v:.6e}"), s.unit, s.meaning, note]);
+    }
+    println!(
+        "{} ({} topology, {} loop)",
+        p.name, p.topology, p.controller.loop_mode
+    );
+    println!("{t}");
+    Ok(())
+}

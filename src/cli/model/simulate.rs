@@ -1,0 +1,484 @@
+//! `rtid simulate`: one time simulation, written as a CSV of every state.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+use std::time::Instant;
+
+use anyhow::{bail, Context};
+use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+
+use crate::cli::experiment::check;
+use crate::cli::ModelArgs;
+use rtid::input::{Move, NoTorque, Samples, Sine, Step};
+use rtid::io::{atomic, torque_file};
+use rtid::model::{idx::*, LoopMode, NSTATE};
+use rtid::recorder::Recorder;
+use rtid::sim::{Simulation, STATE_NAMES};
+
+pub const LONG_ABOUT: &str = "\
+Integrates the nonlinear model (backlash, stick-slip friction, gear fluctuation, servo) \
+from rest and writes every state to a CSV: time_s, motor_torque_nm, motor/shaft/table \
+angles (rad) and velocities (rad/s), the worm's axial displacement (m) and velocity (m/s), \
+and for closed-loop moves the commanded table angle (reference_rad).
+
+Inputs (--input):
+  sine:freq_hz=F,amp_nm=A[,offset_nm=O]   open-loop motor torque O + A·sin(2πFt)
+  step:torque_nm=T[,at_s=S]                open-loop torque step at time S
+  file:PATH.csv                            open-loop torque from columns time_s, motor_torque_nm
+  move:target_deg=D[,speed_deg_per_min=V][,loop=semi_closed|full_closed]
+                                           closed-loop move of the table to D degrees:
+                                           a step command, or a ramp at V °/min
+  none                                     free response (with --load-nm, a table torque)
+
+The integration step defaults to the largest of 10, 5, 2.5, 2 µs (then decades below) that \
+resolves the stiffest mode of the linearised model (|λ|·dt ≤ 0.1; docs/model.md).
+
+Examples:
+  rtid simulate --preset worm-gear --input sine:freq_hz=100,amp_nm=5 --duration-s 0.5 --out run.csv
+  rtid simulate --preset worm-gear --input move:target_deg=30 --duration-s 1 --out move.csv";
+
+/// Arguments of `rtid simulate`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// What drives the table (see above): sine:…, step:…, file:…, move:…, none.
+    #[arg(long, value_name = "SPEC")]
+    pub input: InputSpec,
+    /// Simulated time, s.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub duration_s: f64,
+    /// Output CSV (written atomically).
+    #[arg(long, value_name = "FILE.csv")]
+    pub out: PathBuf,
+    /// Integration step, s (default: from the stiffest mode).
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub dt_s: Option<f64>,
+    /// Period of the output samples, s (rounded to whole steps).
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 1e-4,
+        allow_negative_numbers = true
+    )]
+    pub sample_s: f64,
+    /// Constant external torque on the table (e.g. a brake), N·m.
+    #[arg(
+        long,
+        value_name = "NM",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub load_nm: f64,
+    /// Print a JSON summary instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress bar (shown on a terminal, with the simulated time and the time left).
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// A parsed `--input`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum InputSpec {
+    Sine {
+        freq_hz: f64,
+        amp_nm: f64,
+        offset_nm: f64,
+    },
+    Step {
+        torque_nm: f64,
+        at_s: f64,
+    },
+    File(PathBuf),
+    Move {
+        target_deg: f64,
+        speed_deg_per_min: Option<f64>,
+        loop_mode: Option<LoopMode>,
+    },
+    None,
+}
+
+impl FromStr for InputSpec {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (kind, rest) = s.split_once(':').unwrap_or((s, ""));
+        if kind == "file" {
+            return if rest.is_empty() {
+                Err("file: needs a path, e.g. file:torque.csv".into())
+            } else {
+                Ok(InputSpec::File(rest.into()))
+            };
+        }
+        let mut fields = Fields::parse(kind, rest)?;
+        let spec = match kind {
+            "sine" => InputSpec::Sine {
+                freq_hz: fields.number("freq_hz")?,
+                amp_nm: fields.number("amp_nm")?,
+                offset_nm: fields.optional("offset_nm")?.unwrap_or(0.0),
+            },
+            "step" => InputSpec::Step {
+                torque_nm: fields.number("torque_nm")?,
+                at_s: fields.optional("at_s")?.unwrap_or(0.0),
+            },
+            "move" => InputSpec::Move {
+                target_deg: fields.number("target_deg")?,
+                speed_deg_per_min: fields.optional("speed_deg_per_min")?,
+                loop_mode: fields
+                    .take("loop")
+                    .map(|v| v.parse())
+                    .transpose()
+                    .map_err(|e: rtid::names::UnknownName| e.to_string())?,
+            },
+            "none" => InputSpec::None,
+            other => {
+                return Err(format!(
+                    "unknown input `{other}`: expected sine:, step:, file:, move: or none"
+                ))
+            }
+        };
+        fields.finish()?;
+        Ok(spec)
+    }
+}
+
+/// `key=value,…` fields of an input specification.
+struct Fields {
+    kind: String,
+    pairs: Vec<(String, String)>,
+}
+
+impl Fields {
+    fn parse(kind: &str, rest: &str) -> Result<Self, String> {
+        let mut pairs = Vec::new();
+        for part in rest.split(',').filter(|p| !p.trim().is_empty()) {
+            let (k, v) = part
+                .split_once('=')
+                .ok_or_else(|| format!("{kind}: `{part}` is not KEY=VALUE"))?;
+            pairs.push((k.trim().to_string(), v.trim().to_string()));
+        }
+        Ok(Fields {
+            kind: kind.into(),
+            pairs,
+        })
+    }
+
+    fn take(&mut self, key: &str) -> Option<String> {
+        let i = self.pairs.iter().position(|(k, _)| k == key)?;
+        Some(self.pairs.remove(i).1)
+    }
+
+    fn optional(&mut self, key: &str) -> Result<Option<f64>, String> {
+        let Some(v) = self.take(key) else {
+            return Ok(None);
+        };
+        match v.parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(Some(x)),
+            _ => Err(format!("{}: {key}=`{v}` is not a finite number", self.kind)),
+        }
+    }
+
+    fn number(&mut self, key: &str) -> Result<f64, String> {
+        self.optional(key)?
+            .ok_or_else(|| format!("{}: missing {key}=VALUE", self.kind))
+    }
+
+    fn finish(self) -> Result<(), String> {
+        match self.pairs.first() {
+            None => Ok(()),
+            Some((k, _)) => Err(format!("{}: unknown field `{k}`", self.kind)),
+        }
+    }
+}
+
+/// Streams every `every`-th sample into a CSV.
+struct CsvRecorder<W: Write> {
+    out: csv::Writer<W>,
+    every: u64,
+    count: u64,
+    reference: Option<(Move, f64)>,
+    error: Option<csv::Error>,
+    /// Simulated milliseconds (hidden unless stderr is a terminal).
+    bar: indicatif::ProgressBar,
+}
+
+impl<W: Write> Recorder for CsvRecorder<W> {
+    fn record(&mut self, t: f64, y: &[f64; NSTATE], motor_torque: f64) {
+        let keep = self.count % self.every == 0;
+        self.count += 1;
+        if !keep || self.error.is_some() {
+            return;
+        }
+        let mut row: Vec<String> = Vec::with_capacity(NSTATE + 3);
+        row.push(format!("{t:.9}"));
+        row.push(format!("{motor_torque:.9e}"));
+        row.extend(y.iter().map(|v| format!("{v:.12e}")));
+        if let Some((m, _)) = &self.reference {
+            use rtid::input::Trajectory;
+            row.push(format!("{:.12e}", m.angle(t)));
+        }
+        if let Err(e) = self.out.write_record(&row) {
+            self.error = Some(e);
+        }
+        self.bar.set_position((t * 1e3) as u64);
+    }
+}
+
+/// Integration steps of one run (10⁴ s simulated at the worm preset's 1e-5 s step).
+const MAX_STEPS: f64 = 1e9;
+
+/// Rows of the output CSV (≈ 3 GB).
+const MAX_ROWS: f64 = 2e7;
+
+impl Args {
+    /// The numeric options, checked before anything runs.
+    fn check(&self) -> anyhow::Result<()> {
+        if !(self.duration_s > 0.0 && self.duration_s.is_finite()) {
+            bail!(
+                "--duration-s {}: must be a positive number of seconds",
+                self.duration_s
+            );
+        }
+        if !(self.sample_s > 0.0 && self.sample_s.is_finite()) {
+            bail!(
+                "--sample-s {}: must be a positive number of seconds",
+                self.sample_s
+            );
+        }
+        if let Some(dt) = self.dt_s {
+            check::positive(dt, "--dt-s")?;
+        }
+        if !self.load_nm.is_finite() {
+            bail!("--load-nm {}: must be a finite torque in N·m", self.load_nm);
+        }
+        Ok(())
+    }
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let p = a.model.load()?;
+    a.check()?;
+    let mut inputs: Vec<&std::path::Path> = a.model.params.iter().map(|p| p.as_path()).collect();
+    if let InputSpec::File(path) = &a.input {
+        inputs.push(path);
+    }
+    crate::cli::common::inputs::refuse_overwrite("--out", &a.out, &inputs)?;
+    let mut sim = match a.dt_s {
+        Some(dt) => Simulation::new(&p, dt).context("--dt-s")?,
+        None => Simulation::with_default_step(&p)?,
+    };
+    sim.set_load(a.load_nm);
+    let steps = a.duration_s / sim.dt();
+    check::work(
+        steps,
+        MAX_STEPS,
+        "integration steps",
+        "--duration-s over --dt-s (or the default step)",
+    )?;
+    let every = ((a.sample_s / sim.dt()).round() as u64).max(1);
+    check::work(
+        steps / every as f64,
+        MAX_ROWS,
+        "rows of CSV",
+        "--duration-s over --sample-s",
+    )?;
+    let started = Instant::now();
+    let closed = matches!(a.input, InputSpec::Move { .. });
+    let mut recorded = match &a.input {
+        InputSpec::File(path) => Some(torque_file::read(path)?),
+        _ => None,
+    };
+    write_csv(
+        &a.out,
+        closed,
+        |rec| drive(&mut sim, &p, &a.input, recorded.take(), a.duration_s, rec),
+        every,
+        crate::cli::common::progress::bar((a.duration_s * 1e3) as u64, "simulated ms", a.quiet),
+    )
+    .with_context(|| {
+        format!(
+            "the run of --input with --load-nm {}",
+            rtid::names::Num(a.load_nm)
+        )
+    })?;
+    let wall = started.elapsed().as_secs_f64();
+    print_summary(&a, &sim, p.ratio(), wall)
+}
+
+/// Runs `duration` s of `input` (`recorded`: the torque file's samples) on `sim`.
+fn drive<W: Write>(
+    sim: &mut Simulation,
+    p: &rtid::model::Params,
+    input: &InputSpec,
+    recorded: Option<(Vec<f64>, Vec<f64>)>,
+    duration: f64,
+    rec: &mut CsvRecorder<W>,
+) -> Result<(), rtid::sim::SimError> {
+    match input {
+        InputSpec::Sine {
+            freq_hz,
+            amp_nm,
+            offset_nm,
+        } => sim.run_open_loop(&mut Sine::new(*freq_hz, *amp_nm, *offset_nm), duration, rec),
+        InputSpec::Step { torque_nm, at_s } => {
+            let mut input = Step {
+                torque_nm: *torque_nm,
+                at_s: *at_s,
+            };
+            sim.run_open_loop(&mut input, duration, rec)
+        }
+        InputSpec::File(_) => {
+            let (t, q) = recorded.expect("read before the run");
+            sim.run_open_loop(&mut Samples::new(t, q), duration, rec)
+        }
+        InputSpec::None => sim.run_open_loop(&mut NoTorque, duration, rec),
+        InputSpec::Move {
+            target_deg,
+            speed_deg_per_min,
+            loop_mode,
+        } => {
+            let mut q = p.clone();
+            if let Some(m) = loop_mode {
+                q.controller.loop_mode = *m;
+            }
+            let mut controller = sim.controller(&q)?;
+            let m = Move {
+                from: 0.0,
+                to: target_deg.to_radians(),
+                speed: speed_deg_per_min.map(|v| v.to_radians() / 60.0),
+            };
+            rec.reference = Some((m, 0.0));
+            sim.run_closed_loop(&mut controller, &m, duration, rec)
+        }
+    }
+}
+
+/// The run's summary: steps, wall time, final angles; a table or JSON.
+fn print_summary(a: &Args, sim: &Simulation, ratio: f64, wall: f64) -> anyhow::Result<()> {
+    let steps = (sim.time() / sim.dt()).round();
+    let y = sim.state();
+    if a.json {
+        let summary = serde_json::json!({
+            "output": a.out,
+            "steps": steps,
+            "dt_s": sim.dt(),
+            "simulated_s": sim.time(),
+            "wall_time_s": wall,
+            "steps_per_s": steps / wall,
+            "final": STATE_NAMES.iter().zip(y).map(|(n, v)| (n.to_string(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
+        });
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+        return Ok(());
+    }
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header(["", "value"]);
+    t.add_row(["output", &a.out.display().to_string()]);
+    t.add_row([
+        "steps × dt",
+        &format!("{steps} × {:.3e} s = {:.4} s", sim.dt(), sim.time()),
+    ]);
+    t.add_row([
+        "wall time",
+        &format!("{wall:.3} s ({:.1} M steps/s)", steps / wall / 1e6),
+    ]);
+    t.add_row([
+        "final table angle",
+        &format!("{:.6}°", y[THETA_T].to_degrees()),
+    ]);
+    t.add_row([
+        "final motor angle × ratio",
+        &format!("{:.6}°", (y[THETA_M] * ratio).to_degrees()),
+    ]);
+    println!("{t}");
+    Ok(())
+}
+
+/// Runs `simulate` with a CSV recorder streaming into `path` (atomically replaced).
+fn write_csv(
+    path: &Path,
+    closed: bool,
+    simulate: impl FnOnce(
+        &mut CsvRecorder<&mut std::io::BufWriter<&std::fs::File>>,
+    ) -> Result<(), rtid::sim::SimError>,
+    every: u64,
+    bar: indicatif::ProgressBar,
+) -> anyhow::Result<()> {
+    let result: anyhow::Result<()> = atomic::write_with(path, |w| {
+        let mut out = csv::Writer::from_writer(w);
+        let mut header = vec!["time_s", "motor_torque_nm"];
+        header.extend(STATE_NAMES);
+        if closed {
+            header.push("reference_rad");
+        }
+        out.write_record(&header)?;
+        let mut rec = CsvRecorder {
+            out,
+            every,
+            count: 0,
+            reference: None,
+            error: None,
+            bar,
+        };
+        simulate(&mut rec)?;
+        rec.bar.finish_and_clear();
+        if let Some(e) = rec.error {
+            return Err(e.into());
+        }
+        rec.out.flush()?;
+        Ok(())
+    });
+    result.with_context(|| format!("writing {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn input_specs_parse() {
+        assert_eq!(
+            "sine:freq_hz=100,amp_nm=5".parse::<InputSpec>().unwrap(),
+            InputSpec::Sine {
+                freq_hz: 100.0,
+                amp_nm: 5.0,
+                offset_nm: 0.0
+            }
+        );
+        assert_eq!(
+            "move:target_deg=30,loop=full_closed"
+                .parse::<InputSpec>()
+                .unwrap(),
+            InputSpec::Move {
+                target_deg: 30.0,
+                speed_deg_per_min: None,
+                loop_mode: Some(LoopMode::FullClosed)
+            }
+        );
+        assert_eq!(
+            "file:a/b.csv".parse::<InputSpec>().unwrap(),
+            InputSpec::File("a/b.csv".into())
+        );
+        assert_eq!("none".parse::<InputSpec>().unwrap(), InputSpec::None);
+    }
+
+    #[test]
+    fn bad_input_specs_say_what_is_wrong() {
+        for (spec, expect) in [
+            ("sine:freq_hz=100", "missing amp_nm"),
+            (
+                "sine:freq_hz=abc,amp_nm=5",
+                "freq_hz=`abc` is not a finite number",
+            ),
+            ("sine:freq_hz=1,amp_nm=5,phase=3", "unknown field `phase`"),
+            ("chirp:f=1", "unknown input `chirp`"),
+            ("move:target_deg=30,loop=open", "unknown loop `open`"),
+            ("step:torque_nm", "`torque_nm` is not KEY=VALUE"),
+        ] {
+            let err = spec.parse::<InputSpec>().unwrap_err();
+            assert!(err.contains(expect), "{spec}: {err}");
+        }
+    }
+}

@@ -1,0 +1,24 @@
+//! Estimators that work on any record, whichever test made it: the layer the tests of
+//! [`crate::experiments`] call, which calls nothing above the model and the files.
+//!
+//! - frequency responses from raw records: [`welch`] (H1 with Welch averaging and the
+//!   coherence), [`stepped_sine`] (demodulation dwell by dwell), [`periodic`] (a
+//!   periodic multisine: its design, the record cut into periods, the estimate with
+//!   per-line noise and the nonlinear distortion);
+//! - what a gain curve shows: [`peaks`] (the one peak finder), [`extrema`]
+//!   (resonances and antiresonances above the noise), [`local_mode_fit`] (frequency
+//!   and damping by a local rational fit), [`two_mass_ratios`] (what a two-mass
+//!   drive's resonance and antiresonance determine);
+//! - signals over angle: [`spectrum`];
+//! - [`inverse_dynamics`]: the friction law and inertia of a rigid axis by least
+//!   squares (IDIM-LS) from any recorded motion and effort.
+
+pub mod extrema;
+pub mod inverse_dynamics;
+pub mod local_mode_fit;
+pub mod peaks;
+pub mod periodic;
+pub mod spectrum;
+pub mod stepped_sine;
+pub mod two_mass_ratios;
+pub mod welch;

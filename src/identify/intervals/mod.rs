@@ -1,0 +1,7 @@
+//! How well the data determine the fitted parameters: standard errors and correlations
+//! from the Jacobian ([`uncertainty`]), profile-likelihood intervals ([`profile`]) and
+//! the residual block bootstrap ([`resample`]).
+
+pub mod profile;
+pub mod resample;
+pub mod uncertainty;

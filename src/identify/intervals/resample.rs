@@ -1,0 +1,577 @@
+//! Resampling intervals (docs/identification.md): the residual block bootstrap of
+//! the whole estimator. Where the cost is rough — a closed-loop simulation with
+//! quantised encoders, whose cost has local minima the search stops in — σ²(JᵀJ)⁻¹
+//! measures the residuals' scatter only, and a profile walks one local minimum to
+//! the next. The bootstrap replicates what made the estimate instead: each
+//! replicate's data are the fitted model's response plus the fit's residuals
+//! resampled in blocks (the blocks keep their correlation), and the replicate is
+//! fitted as the data were — the same search from the same start. The spread of the
+//! replicates' values around the fit stands for the spread of the fit around the
+//! truth, the search's stops included; their mean offset estimates its bias.
+//!
+//! In the objectives' scaled residuals r(p) = (model(p) − data) / scale, a
+//! replicate's data `model(p̂) − scale·r*` give r(p) − r(p̂) + r*: each replicate is
+//! the fitted objective plus a fixed offset, whatever the objective computes.
+//! Replicates run in parallel; replicate b's blocks come from a generator seeded by
+//! (seed, b), so the result does not depend on the order they finish in.
+
+use crate::identify::result::resampling::{Interval, Resampling};
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+use rand::{rngs::StdRng, Rng, SeedableRng};
+use rayon::prelude::*;
+
+use crate::identify::error::IdentifyError;
+use crate::identify::pipeline::correction::Corrected;
+use crate::identify::result::warning::Warning;
+use crate::identify::result::IdentifyResult;
+use crate::identify::search::problem::Monitor;
+use crate::identify::search::search;
+use crate::identify::search::settings::Settings;
+use crate::identify::space::{Bound, ParamSpace};
+use crate::model::Params;
+use crate::objectives::{Objective, ObjectiveError};
+
+/// The confidence level of the intervals.
+pub const LEVEL: f64 = 0.95;
+/// The two-sided normal quantile at [`LEVEL`].
+const Z: f64 = 1.959_963_984_540_054;
+/// Fewer finished replicates than this give no interval.
+pub const MIN_REPLICATES: usize = 5;
+
+/// What is resampled and how each replicate is fitted.
+pub struct Request<'a> {
+    /// The fit's result and identified parameter set.
+    pub result: &'a IdentifyResult,
+    pub params: &'a Params,
+    /// The objective the result minimises and the search's settings
+    /// ([`crate::identify::run::Identified`]).
+    pub objective: &'a dyn Objective,
+    pub settings: Settings,
+    pub replicates: usize,
+    /// Asked before each replicate whether to stop (Ctrl-C).
+    pub stop: &'a (dyn Fn() -> bool + Sync),
+    /// Called after each replicate (progress).
+    pub on_replicate: &'a (dyn Fn() + Sync),
+}
+
+/// Why a bootstrap cannot be computed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ResampleError {
+    #[error("--resample: the fit was stopped before it converged; resample a finished fit")]
+    Interrupted,
+    #[error("--resample {0}: at least {MIN_REPLICATES} replicates are needed for an interval")]
+    TooFew(usize),
+    #[error("--resample: {label} has {residuals} residual(s) in {blocks} block(s) of {length}; a bootstrap needs at least {MIN_BLOCKS} blocks of each experiment's residuals to stand for their errors (use --profile, or the standard errors, for it)")]
+    TooFewResiduals {
+        label: String,
+        residuals: usize,
+        blocks: usize,
+        length: usize,
+    },
+    #[error("--resample: the objective cannot be evaluated at the result: {0}")]
+    Objective(#[from] ObjectiveError),
+}
+
+/// Fewer blocks than this in one experiment's residuals (an objective's, where an
+/// experiment feeds several) cannot stand for their errors: the unbalance test's
+/// four step angles, a frequency response's two resonances.
+pub const MIN_BLOCKS: usize = 10;
+
+/// The bootstrap of `request.result`.
+pub fn resample(request: &Request) -> Result<Resampling, ResampleError> {
+    if request.result.interrupted {
+        return Err(ResampleError::Interrupted);
+    }
+    let result = request.result;
+    let names: Vec<String> = result.parameters.keys().cloned().collect();
+    let problem = Problem {
+        fit: names.iter().map(|n| result.parameters[n]).collect(),
+        initial: names.iter().map(|n| result.initial[n]).collect(),
+        bounds: names
+            .iter()
+            .map(|n| {
+                let [lo, hi] = result.bounds[n];
+                (n.clone(), Bound { lo, hi })
+            })
+            .collect(),
+        names,
+        params: request.params,
+        objective: request.objective,
+        settings: request.settings,
+        parts: parts(result),
+    };
+    problem.run(request.replicates, request.stop, request.on_replicate)
+}
+
+/// Adds `resampling` to `result`. Where it gives intervals, they replace the
+/// warning that the standard errors of a rough cost are lower bounds.
+pub fn attach(result: &mut IdentifyResult, resampling: Resampling) {
+    if !resampling.intervals.is_empty() {
+        result.warnings.retain(|w| w.0 != Warning::RoughCost);
+    }
+    result.resampling = Some(resampling);
+}
+
+/// Each experiment's (and objective's) residual count, named as the result names it.
+fn parts(result: &IdentifyResult) -> Vec<(String, usize)> {
+    result
+        .residuals
+        .iter()
+        .map(|r| (format!("{} [{}]", r.source, r.objective), r.residuals.len()))
+        .collect()
+}
+
+/// What one bootstrap needs of a fit.
+struct Problem<'a> {
+    /// The fitted parameters, their fitted and start values, and bounds.
+    names: Vec<String>,
+    fit: Vec<f64>,
+    initial: Vec<f64>,
+    bounds: Vec<(String, Bound)>,
+    /// The identified parameter set.
+    params: &'a Params,
+    objective: &'a dyn Objective,
+    settings: Settings,
+    /// Each part of the residual vector, in order: its name and length.
+    parts: Vec<(String, usize)>,
+}
+
+impl Problem<'_> {
+    /// `replicates` replicates, in parallel.
+    fn run(
+        &self,
+        replicates: usize,
+        stop: &(dyn Fn() -> bool + Sync),
+        on_replicate: &(dyn Fn() + Sync),
+    ) -> Result<Resampling, ResampleError> {
+        if replicates < MIN_REPLICATES {
+            return Err(ResampleError::TooFew(replicates));
+        }
+        let r0 = self.objective.residuals(self.params)?;
+        let segments = self.segments(r0.len());
+        let errors = modified(&centre(&r0, &segments), self.names.len());
+        let blocks = self.blocks(&errors, &segments)?;
+        let outcomes: Vec<Option<Result<Vec<f64>, String>>> = (0..replicates)
+            .into_par_iter()
+            .map(|b| {
+                if stop() {
+                    return None;
+                }
+                let draw = draw(&errors, &segments, &blocks, seed(self.settings.seed, b));
+                let offset: Vec<f64> = draw.iter().zip(&r0).map(|(d, r)| d - r).collect();
+                let fitted = self
+                    .refit(offset)
+                    .map_err(|e| format!("replicate {b}: {e}"));
+                on_replicate();
+                Some(fitted)
+            })
+            .collect();
+        Ok(self.summarise(replicates, blocks, outcomes))
+    }
+
+    /// The parts' ranges in the residual vector of length `n` (one range when the
+    /// parts do not add up to it).
+    fn segments(&self, n: usize) -> Vec<Range<usize>> {
+        if self.parts.iter().map(|p| p.1).sum::<usize>() != n {
+            return std::iter::once(0..n).collect();
+        }
+        let mut at = 0;
+        self.parts
+            .iter()
+            .map(|&(_, l)| {
+                at += l;
+                at - l..at
+            })
+            .collect()
+    }
+
+    /// Each segment's block length; an error naming a part with too few blocks.
+    fn blocks(&self, r: &[f64], segments: &[Range<usize>]) -> Result<Vec<usize>, ResampleError> {
+        segments
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let length = block_length(&r[s.clone()]);
+                let blocks = s.len() / length;
+                if blocks < MIN_BLOCKS {
+                    let label = self.parts.get(i).map_or("the fit".into(), |p| p.0.clone());
+                    return Err(ResampleError::TooFewResiduals {
+                        label,
+                        residuals: s.len(),
+                        blocks,
+                        length,
+                    });
+                }
+                Ok(length)
+            })
+            .collect()
+    }
+
+    /// The fit repeated on the objective shifted by `offset`: the same search from
+    /// the same start. The fitted values, in `names`' order.
+    fn refit(&self, offset: Vec<f64>) -> Result<Vec<f64>, IdentifyError> {
+        let mut base = self.params.clone();
+        for (name, &v) in self.names.iter().zip(&self.initial) {
+            base.set(name, v).map_err(ObjectiveError::from)?;
+        }
+        let space = ParamSpace::new(base, &self.names, &self.bounds)?;
+        let objective = Corrected {
+            linear: self.objective,
+            offset,
+        };
+        let settings = Settings {
+            max_evaluations: None,
+            ..self.settings
+        };
+        let monitor = Monitor::default();
+        search(&space, &objective, &settings, &monitor, &[], &|_| {});
+        monitor
+            .best()
+            .map(|b| b.values)
+            .ok_or_else(|| IdentifyError::NothingEvaluated(monitor.failure().unwrap_or_default()))
+    }
+
+    /// The replicates' values and the intervals they give.
+    fn summarise(
+        &self,
+        asked: usize,
+        block_lengths: Vec<usize>,
+        outcomes: Vec<Option<Result<Vec<f64>, String>>>,
+    ) -> Resampling {
+        let mut notes = Vec::new();
+        let stopped = outcomes.iter().filter(|o| o.is_none()).count();
+        if stopped > 0 {
+            notes.push(format!("{stopped} replicate(s) not run: stopped (Ctrl-C)"));
+        }
+        let fits: Vec<Vec<f64>> = outcomes
+            .into_iter()
+            .flatten()
+            .filter_map(|o| o.map_err(|e| notes.push(e)).ok())
+            .collect();
+        let values: BTreeMap<String, Vec<f64>> = self
+            .names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (n.clone(), fits.iter().map(|f| f[i]).collect()))
+            .collect();
+        let intervals = if fits.len() >= MIN_REPLICATES {
+            (self.names.iter().zip(&self.fit))
+                .map(|(n, &fit)| (n.clone(), interval(fit, &values[n])))
+                .collect()
+        } else {
+            notes.push(format!(
+                "{} replicate(s) fitted, fewer than {MIN_REPLICATES}: no interval",
+                fits.len()
+            ));
+            BTreeMap::new()
+        };
+        Resampling {
+            method: "residual block bootstrap".into(),
+            level: LEVEL,
+            asked,
+            fitted: fits.len(),
+            block_lengths,
+            intervals,
+            values,
+            notes,
+        }
+    }
+}
+
+/// The residuals less each segment's mean (a bootstrap draws errors of mean zero).
+fn centre(r: &[f64], segments: &[Range<usize>]) -> Vec<f64> {
+    let mut out = r.to_vec();
+    for s in segments {
+        let mean = r[s.clone()].iter().sum::<f64>() / s.len() as f64;
+        out[s.clone()].iter_mut().for_each(|x| *x -= mean);
+    }
+    out
+}
+
+/// Residuals scaled by √(m / (m − k)) for m residuals and k fitted parameters: a
+/// fit's residuals are smaller than its errors by that factor on average (the
+/// modified residuals of Davison & Hinkley, 1997).
+fn modified(r: &[f64], k: usize) -> Vec<f64> {
+    let m = r.len() as f64;
+    let factor = if m > k as f64 {
+        (m / (m - k as f64)).sqrt()
+    } else {
+        1.0
+    };
+    r.iter().map(|x| x * factor).collect()
+}
+
+/// The block length of residuals `r`: the first lag where their autocorrelation
+/// falls below e⁻² (twice the correlation time of an exponential decay), so that
+/// blocks carry the correlation and neighbouring blocks are nearly independent;
+/// 1 for white residuals, at most a quarter of the record.
+pub fn block_length(r: &[f64]) -> usize {
+    let n = r.len();
+    let c0: f64 = r.iter().map(|x| x * x).sum();
+    if n < 8 || c0 <= 0.0 {
+        return 1;
+    }
+    let limit = (n / 4).max(1);
+    (1..=limit)
+        .find(|&k| {
+            let ck: f64 = r[..n - k].iter().zip(&r[k..]).map(|(a, b)| a * b).sum();
+            ck / c0 < (-2.0f64).exp()
+        })
+        .unwrap_or(limit)
+}
+
+/// The seed of replicate `b`.
+fn seed(seed: u64, b: usize) -> u64 {
+    seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ (b as u64).wrapping_add(0x7265_7361_6d70)
+}
+
+/// A circular block bootstrap draw of each segment of `r`.
+fn draw(r: &[f64], segments: &[Range<usize>], blocks: &[usize], seed: u64) -> Vec<f64> {
+    let mut rng = StdRng::seed_from_u64(seed);
+    let mut out = Vec::with_capacity(r.len());
+    for (s, &block) in segments.iter().zip(blocks) {
+        let part = &r[s.clone()];
+        let n = part.len();
+        while out.len() < s.end {
+            let from = rng.random_range(0..n);
+            let take = block.min(s.end - out.len());
+            out.extend((0..take).map(|i| part[(from + i) % n]));
+        }
+    }
+    out
+}
+
+/// The bias-corrected normal interval of a fit `fit` from its replicates `v`.
+fn interval(fit: f64, v: &[f64]) -> Interval {
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let bias = mean - fit;
+    Interval {
+        lower: fit - bias - Z * sd,
+        upper: fit - bias + Z * sd,
+        standard_error: sd,
+        bias,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets;
+    use crate::objectives::sum_of_squares;
+    use rand_distr::{Distribution, Normal};
+
+    /// y = (Kw / 1e5)·exp(−t·Kg / 850) on t ∈ [0, 3) s, measured with white Gaussian
+    /// errors of one unit: a smooth cost where σ²(JᵀJ)⁻¹ is right.
+    struct Decay {
+        t: Vec<f64>,
+        y: Vec<f64>,
+    }
+
+    impl Decay {
+        fn model(p: &Params, t: f64) -> f64 {
+            let (a, b) = (p.get("Kw").unwrap().unwrap(), p.get("Kg").unwrap().unwrap());
+            a / 1e5 * (-t * b / 850.0).exp() * 100.0
+        }
+    }
+
+    impl Objective for Decay {
+        fn name(&self) -> &'static str {
+            "decay"
+        }
+        fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+            Ok((self.t.iter().zip(&self.y))
+                .map(|(&t, y)| Decay::model(p, t) - y)
+                .collect())
+        }
+        fn len(&self) -> usize {
+            self.t.len()
+        }
+        fn scale(&self) -> String {
+            "one unit".into()
+        }
+    }
+
+    /// Standard errors σ²(JᵀJ)⁻¹ of a two-parameter fit, by central differences.
+    fn standard_errors(o: &Decay, p: &Params, names: &[String]) -> [f64; 2] {
+        let m = o.len();
+        let r = o.residuals(p).unwrap();
+        let sigma2 = sum_of_squares(&r) / (m - 2) as f64;
+        let columns: Vec<Vec<f64>> = names
+            .iter()
+            .map(|n| {
+                let v = p.get(n).unwrap().unwrap();
+                let h = v * 1e-6;
+                let (mut up, mut down) = (p.clone(), p.clone());
+                up.set(n, v + h).unwrap();
+                down.set(n, v - h).unwrap();
+                let (ru, rd) = (o.residuals(&up).unwrap(), o.residuals(&down).unwrap());
+                ru.iter()
+                    .zip(&rd)
+                    .map(|(a, b)| (a - b) / (2.0 * h))
+                    .collect()
+            })
+            .collect();
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let jtj = nalgebra::Matrix2::new(
+            dot(&columns[0], &columns[0]),
+            dot(&columns[0], &columns[1]),
+            dot(&columns[1], &columns[0]),
+            dot(&columns[1], &columns[1]),
+        );
+        let cov = jtj.try_inverse().unwrap() * sigma2;
+        [cov[(0, 0)].sqrt(), cov[(1, 1)].sqrt()]
+    }
+
+    /// One data set of [`Decay`] with errors from `seed`, fitted from 1.2× the truth
+    /// and bootstrapped with 40 replicates: per parameter (Kg, Kw), the bootstrap
+    /// standard error over σ²(JᵀJ)⁻¹'s, and whether the interval holds the truth.
+    fn decay_case(seed: u64) -> Vec<(f64, bool)> {
+        let truth = presets::load("worm-gear").unwrap();
+        let t: Vec<f64> = (0..200).map(|i| i as f64 * 0.015).collect();
+        let noise = Normal::new(0.0, 1.0).unwrap();
+        let mut rng = StdRng::seed_from_u64(seed);
+        let y = t
+            .iter()
+            .map(|&t| Decay::model(&truth, t) + noise.sample(&mut rng))
+            .collect();
+        let decay = Decay { t, y };
+        let names = vec!["Kg".to_string(), "Kw".to_string()];
+        let truths: Vec<f64> = names
+            .iter()
+            .map(|n| truth.get(n).unwrap().unwrap())
+            .collect();
+        let initial: Vec<f64> = truths.iter().map(|v| v * 1.2).collect();
+        let bounds: Vec<(String, Bound)> = (names.iter().zip(&truths))
+            .map(|(n, v)| {
+                (
+                    n.clone(),
+                    Bound {
+                        lo: v / 10.0,
+                        hi: v * 10.0,
+                    },
+                )
+            })
+            .collect();
+        let mut start = truth.clone();
+        for (n, v) in names.iter().zip(&initial) {
+            start.set(n, *v).unwrap();
+        }
+        let space = ParamSpace::new(start, &names, &bounds).unwrap();
+        let settings = Settings {
+            starts: 1,
+            seed,
+            ..Settings::default()
+        };
+        let monitor = Monitor::default();
+        search(&space, &decay, &settings, &monitor, &[], &|_| {});
+        let fit = monitor.best().unwrap().values;
+        let params = space.params(&fit).unwrap();
+        let problem = Problem {
+            names: names.clone(),
+            fit,
+            initial,
+            bounds,
+            params: &params,
+            objective: &decay,
+            settings,
+            parts: vec![("decay".into(), 200)],
+        };
+        let r = problem.run(40, &|| false, &|| {}).unwrap();
+        let se = standard_errors(&decay, &params, &names);
+        (names.iter().zip(&truths).zip(se))
+            .map(|((name, want), se)| {
+                let i = r.intervals[name];
+                (i.standard_error / se, i.lower < *want && *want < i.upper)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn on_a_smooth_cost_with_white_errors_the_bootstrap_agrees_with_the_standard_errors() {
+        // 20 data sets: each bootstrap standard error within the ±3σ of 40
+        // replicates' (±34 %) of σ²(JᵀJ)⁻¹'s, their mean within 10 %, and the
+        // intervals' coverage of the truth at least 16 of 20 (P(≤ 15) = 0.26 % at
+        // 95 %).
+        let cases: Vec<Vec<(f64, bool)>> = (0..20).into_par_iter().map(decay_case).collect();
+        for p in 0..2 {
+            let ratios: Vec<f64> = cases.iter().map(|c| c[p].0).collect();
+            assert!(
+                ratios.iter().all(|r| (0.66..1.34).contains(r)),
+                "{ratios:?}"
+            );
+            let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
+            assert!((0.9..1.1).contains(&mean), "mean ratio {mean}");
+            let held = cases.iter().filter(|c| c[p].1).count();
+            assert!(
+                held >= 16,
+                "parameter {p}: {held} of 20 intervals hold the truth"
+            );
+        }
+    }
+
+    #[test]
+    fn too_few_residuals_are_refused_naming_the_experiment() {
+        let p = presets::load("worm-gear").unwrap();
+        let decay = Decay {
+            t: vec![0.0, 0.5, 1.0, 1.5],
+            y: vec![1.0, 0.5, 0.2, -0.1],
+        };
+        let problem = Problem {
+            names: vec!["Kw".into()],
+            fit: vec![3.1e5],
+            initial: vec![3.1e5],
+            bounds: vec![("Kw".into(), Bound { lo: 1e5, hi: 1e6 })],
+            params: &p,
+            objective: &decay,
+            settings: Settings::default(),
+            parts: vec![("unbalance.json [unbalance_step]".into(), 4)],
+        };
+        let e = problem.run(20, &|| false, &|| {}).unwrap_err().to_string();
+        assert!(
+            e.contains("unbalance.json [unbalance_step] has 4 residual(s)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn white_residuals_get_blocks_of_one_and_correlated_ones_longer() {
+        let mut rng = StdRng::seed_from_u64(3);
+        let white: Vec<f64> = (0..2000).map(|_| rng.random_range(-1.0..1.0)).collect();
+        assert_eq!(block_length(&white), 1);
+        // AR(1) with φ = 0.9: the autocorrelation 0.9^k falls below e⁻² at k = 19.
+        let mut x = 0.0;
+        let ar: Vec<f64> = white
+            .iter()
+            .map(|e| {
+                x = 0.9 * x + e;
+                x
+            })
+            .collect();
+        let l = block_length(&ar);
+        assert!((14..=25).contains(&l), "block length {l}");
+    }
+
+    #[test]
+    fn a_draw_keeps_each_segment_within_itself() {
+        let r: Vec<f64> = (0..30).map(|i| if i < 10 { 1.0 } else { -1.0 }).collect();
+        let segments = vec![0..10, 10..30];
+        let d = draw(&r, &segments, &[3, 4], 5);
+        assert_eq!(d.len(), 30);
+        assert!(d[..10].iter().all(|&x| x == 1.0));
+        assert!(d[10..].iter().all(|&x| x == -1.0));
+    }
+
+    #[test]
+    fn the_interval_is_moved_against_the_bias() {
+        let i = interval(1.0, &[1.1, 1.2, 1.3]);
+        assert!((i.bias - 0.2).abs() < 1e-12);
+        assert!((i.standard_error - 0.1).abs() < 1e-12);
+        assert!((i.lower - (0.8 - Z * 0.1)).abs() < 1e-12);
+        assert!((i.upper - (0.8 + Z * 0.1)).abs() < 1e-12);
+    }
+}

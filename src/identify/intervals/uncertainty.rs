@@ -1,0 +1,282 @@
+//! How well the data determine the identified parameters: standard errors from the
+//! Jacobian at the optimum, σ²(JᵀJ)⁻¹ with σ² = Σr²/(m − n), the correlation matrix,
+//! and warnings for what the data cannot separate (|correlation| > 0.95, or a JᵀJ
+//! that is singular to working precision).
+//!
+//! The Jacobian is taken with respect to ln p for positive parameters (so the
+//! standard error is relative, then converted back) by central differences of
+//! relative step `step`, the 2n evaluations in parallel. Columns are scaled to unit
+//! norm before the singular-value check, so units do not decide identifiability.
+
+use crate::identify::result::uncertainty::Uncertainty;
+use nalgebra::{DMatrix, SVD};
+use rayon::prelude::*;
+
+use crate::identify::result::warning::Warning;
+use crate::identify::space::ParamSpace;
+use crate::objectives::{Objective, ObjectiveError};
+
+/// Above this |correlation| two parameters are reported as not separable.
+pub const CORRELATION_LIMIT: f64 = 0.95;
+/// Below this ratio of smallest to largest singular value (of the column-scaled
+/// Jacobian) JᵀJ counts as singular.
+pub const SINGULAR_RATIO: f64 = 1e-6;
+
+/// The uncertainty and what it warns of.
+#[derive(Clone, Debug)]
+pub struct Assessed {
+    pub uncertainty: Uncertainty,
+    pub warnings: Vec<Warning>,
+}
+
+/// Evaluates the uncertainty at `values`.
+pub fn at_optimum(
+    space: &ParamSpace,
+    objective: &dyn Objective,
+    values: &[f64],
+    step: f64,
+) -> Result<Assessed, ObjectiveError> {
+    let r0 = objective.residuals(&space.params(values)?)?;
+    with_residuals(space, objective, values, &r0, step)
+}
+
+/// [`at_optimum`] when the residuals `r0` at `values` are known already.
+pub(crate) fn with_residuals(
+    space: &ParamSpace,
+    objective: &dyn Objective,
+    values: &[f64],
+    r0: &[f64],
+    step: f64,
+) -> Result<Assessed, ObjectiveError> {
+    let jac = jacobian(space, objective, values, step)?;
+    let (m, n) = jac.shape();
+    let sigma2 = if m > n {
+        r0.iter().map(|r| r * r).sum::<f64>() / (m - n) as f64
+    } else {
+        f64::NAN
+    };
+    Ok(from_jacobian(space, values, &jac, sigma2))
+}
+
+/// The uncertainty at `values` from the Jacobian `jac` (columns as [`jacobian`]
+/// takes them) and the residual variance `sigma2` (NaN: unknown): what the data of
+/// a fit determine, or — with a stated σ² — what a planned test would
+/// ([`crate::identify::design`]).
+pub(crate) fn from_jacobian(
+    space: &ParamSpace,
+    values: &[f64],
+    jac: &DMatrix<f64>,
+    sigma2: f64,
+) -> Assessed {
+    let names: Vec<String> = space.names.iter().map(|s| s.to_string()).collect();
+    let shape = Shape::of(jac);
+    let mut warnings = shape.warnings(&names);
+    let inv = (shape.conditioning >= SINGULAR_RATIO)
+        .then(|| (jac.transpose() * jac).try_inverse())
+        .flatten();
+    let correlation = correlation(inv.as_ref(), &shape);
+    warnings.extend(correlated(&correlation, &names));
+    let standard_errors = names
+        .iter()
+        .enumerate()
+        .map(|(j, name)| {
+            (
+                name.clone(),
+                standard_error(space, values, inv.as_ref(), sigma2, j),
+            )
+        })
+        .collect();
+    Assessed {
+        uncertainty: Uncertainty {
+            standard_errors,
+            names,
+            correlation: zero_undefined(correlation),
+            residual_variance: if sigma2.is_finite() { sigma2 } else { 0.0 },
+            conditioning: shape.conditioning,
+        },
+        warnings,
+    }
+}
+
+/// Central-difference Jacobian of the residuals: each column ∂r/∂ln p (log
+/// parameters) or ∂r/∂p scaled by the range, the 2n evaluations in parallel.
+pub(crate) fn jacobian(
+    space: &ParamSpace,
+    objective: &dyn Objective,
+    values: &[f64],
+    step: f64,
+) -> Result<DMatrix<f64>, ObjectiveError> {
+    let shifted = |j: usize, sign: f64| -> Result<Vec<f64>, ObjectiveError> {
+        let mut v = values.to_vec();
+        let b = space.bounds[j];
+        v[j] = if b.log() {
+            values[j] * (sign * step).exp()
+        } else {
+            values[j] + sign * step * (b.hi - b.lo)
+        };
+        objective.residuals(&space.params(&v)?)
+    };
+    let columns: Vec<Vec<f64>> = (0..space.dim())
+        .into_par_iter()
+        .map(|j| {
+            let (up, down) = (shifted(j, 1.0)?, shifted(j, -1.0)?);
+            Ok(up
+                .iter()
+                .zip(&down)
+                .map(|(a, b)| (a - b) / (2.0 * step))
+                .collect())
+        })
+        .collect::<Result<_, ObjectiveError>>()?;
+    let m = columns.first().map_or(0, Vec::len);
+    Ok(DMatrix::from_fn(m, space.dim(), |i, j| columns[j][i]))
+}
+
+/// The Jacobian with its columns scaled to unit norm, and its singular values.
+struct Shape {
+    residuals: usize,
+    norms: Vec<f64>,
+    scaled: DMatrix<f64>,
+    svd: SVD<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    conditioning: f64,
+}
+
+impl Shape {
+    fn of(jac: &DMatrix<f64>) -> Shape {
+        let (m, n) = jac.shape();
+        let norms: Vec<f64> = (0..n).map(|j| jac.column(j).norm()).collect();
+        let scaled = DMatrix::from_fn(m, n, |i, j| jac[(i, j)] / norms[j].max(f64::MIN_POSITIVE));
+        let svd = SVD::new(scaled.clone(), false, true);
+        let (smax, smin) = svd
+            .singular_values
+            .iter()
+            .fold((0.0f64, f64::INFINITY), |(a, b), &s| (a.max(s), b.min(s)));
+        Shape {
+            residuals: m,
+            norms,
+            scaled,
+            svd,
+            conditioning: if smax > 0.0 { smin / smax } else { 0.0 },
+        }
+    }
+
+    /// What the shape alone says: parameters without effect, too few residuals, a
+    /// singular JᵀJ and the combination it cannot separate.
+    fn warnings(&self, names: &[String]) -> Vec<Warning> {
+        let n = names.len();
+        let mut out: Vec<Warning> = self
+            .norms
+            .iter()
+            .zip(names)
+            .filter(|(c, _)| **c == 0.0)
+            .map(|(_, name)| Warning::NoEffect { name: name.clone() })
+            .collect();
+        if self.residuals < n {
+            out.push(Warning::TooFewResiduals {
+                residuals: self.residuals,
+                parameters: n,
+            });
+        }
+        if self.conditioning < SINGULAR_RATIO {
+            if let Some(vt) = self.svd.v_t.as_ref() {
+                let k = self
+                    .svd
+                    .singular_values
+                    .iter()
+                    .enumerate()
+                    .min_by(|a, b| a.1.total_cmp(b.1))
+                    .map_or(0, |(k, _)| k);
+                out.push(Warning::Singular {
+                    conditioning: self.conditioning,
+                    names: (0..n)
+                        .filter(|&j| vt[(k, j)].abs() > 0.1)
+                        .map(|j| names[j].clone())
+                        .collect(),
+                });
+            }
+        }
+        out
+    }
+}
+
+/// The correlation matrix, from (JᵀJ)⁻¹ — or, when JᵀJ is singular, from the
+/// pseudo-inverse of the scaled matrix, so that a ±1 still shows (correlations do not
+/// depend on σ²). NaN where undefined.
+fn correlation(inv: Option<&DMatrix<f64>>, shape: &Shape) -> Vec<Vec<f64>> {
+    let n = shape.norms.len();
+    let cov = match inv {
+        Some(c) => c.clone(),
+        None => {
+            let st = shape.scaled.transpose() * &shape.scaled;
+            let pinv = st
+                .pseudo_inverse(1e-14)
+                .unwrap_or_else(|_| DMatrix::zeros(n, n));
+            DMatrix::from_fn(n, n, |a, b| {
+                pinv[(a, b)] / (shape.norms[a] * shape.norms[b]).max(f64::MIN_POSITIVE)
+            })
+        }
+    };
+    (0..n)
+        .map(|a| {
+            (0..n)
+                .map(|b| {
+                    let d = (cov[(a, a)] * cov[(b, b)]).sqrt();
+                    if d > 0.0 {
+                        cov[(a, b)] / d
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// A warning for each pair correlated beyond [`CORRELATION_LIMIT`].
+fn correlated(correlation: &[Vec<f64>], names: &[String]) -> Vec<Warning> {
+    let n = names.len();
+    let mut out = Vec::new();
+    for a in 0..n {
+        for b in a + 1..n {
+            let c = correlation[a][b];
+            if c.abs() > CORRELATION_LIMIT {
+                out.push(Warning::Correlated {
+                    a: names[a].clone(),
+                    b: names[b].clone(),
+                    correlation: c,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The standard error of parameter `j` in its own unit (`None` when undefined).
+fn standard_error(
+    space: &ParamSpace,
+    values: &[f64],
+    inv: Option<&DMatrix<f64>>,
+    sigma2: f64,
+    j: usize,
+) -> Option<f64> {
+    let s = (sigma2 * inv?[(j, j)]).sqrt();
+    let b = space.bounds[j];
+    s.is_finite().then(|| {
+        if b.log() {
+            values[j] * s
+        } else {
+            s * (b.hi - b.lo)
+        }
+    })
+}
+
+/// Undefined correlations written as 0 (JSON has no NaN).
+fn zero_undefined(correlation: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+    correlation
+        .into_iter()
+        .map(|row| {
+            row.into_iter()
+                .map(|c| if c.is_finite() { c } else { 0.0 })
+                .collect()
+        })
+        .collect()
+}

@@ -1,0 +1,142 @@
+//! The identified point assessed: each experiment's residuals (one evaluation serves
+//! the report, the cost and the uncertainty), the uncertainty, and the warnings a
+//! user should read.
+
+use crate::identify::error::IdentifyError;
+use crate::identify::intervals::uncertainty;
+use crate::identify::pipeline::stages::Ran;
+use crate::identify::plan::Plan;
+use crate::identify::result::starts::StartRecord;
+use crate::identify::result::uncertainty::Uncertainty;
+use crate::identify::result::warning::Warning;
+use crate::identify::result::{ExperimentResidual, NonlinearCheck};
+use crate::identify::search::problem::{describe, Best, Monitor};
+use crate::identify::space::ParamSpace;
+use crate::model::Params;
+use crate::objectives::{sum_of_squares, Detail, Joint};
+
+/// What the assessment finds.
+pub struct Assessment {
+    pub residuals: Vec<ExperimentResidual>,
+    pub cost: f64,
+    pub uncertainty: Option<Uncertainty>,
+    pub nonlinear_check: Option<Vec<NonlinearCheck>>,
+    pub warnings: Vec<Warning>,
+}
+
+/// A resonance missed by more than this, Hz, is worth a warning.
+const RESONANCE_MISS_HZ: f64 = 1.0;
+
+/// Assesses the best point `best` (= `params`) of the stages `ran`.
+pub fn assess(
+    plan: &Plan,
+    space: &ParamSpace,
+    ran: &Ran,
+    best: &Best,
+    params: &Params,
+    monitor: &Monitor,
+) -> Result<Assessment, IdentifyError> {
+    let interrupted = monitor.stopped();
+    let joint = &ran.joint;
+    let mut warnings = search_warnings(space, &ran.starts, best, monitor);
+    let parts = joint.part_residuals(params)?;
+    let stacked = joint.stack(&parts);
+    let residuals = residual_report(joint, parts);
+    warnings.extend(resonance_misses(&residuals));
+    let uncertainty = if interrupted {
+        None
+    } else {
+        let a = uncertainty::with_residuals(
+            space,
+            joint,
+            &best.values,
+            &stacked,
+            plan.uncertainty_step(ran.stages),
+        )?;
+        warnings.extend(a.warnings);
+        if plan.declared.rough {
+            warnings.push(Warning::RoughCost);
+        }
+        Some(a.uncertainty)
+    };
+    Ok(Assessment {
+        residuals,
+        cost: sum_of_squares(&stacked),
+        uncertainty,
+        nonlinear_check: ran.check.clone(),
+        warnings,
+    })
+}
+
+/// How the search went: stopped, failures, distinct optima of the same cost,
+/// parameters at their bounds.
+fn search_warnings(
+    space: &ParamSpace,
+    starts: &[StartRecord],
+    best: &Best,
+    monitor: &Monitor,
+) -> Vec<Warning> {
+    let mut out = Vec::new();
+    if monitor.stopped() {
+        out.push(Warning::Interrupted {
+            evaluations: monitor.evaluations(),
+        });
+    }
+    if let Some(example) = monitor.failure() {
+        out.push(Warning::EvaluationFailures { example });
+    }
+    for s in starts {
+        let Some(v) = &s.result else { continue };
+        let far = v
+            .iter()
+            .zip(&best.values)
+            .any(|(a, b)| ((a - b) / b).abs() > 0.05);
+        if far && s.cost_or_infinity() <= best.cost.max(1e-6) * 1.5 + 1e-6 {
+            out.push(Warning::DistinctSolution {
+                start: s.index + 1,
+                solution: describe(space, v),
+            });
+        }
+    }
+    for (name, side) in space.at_bounds(&best.values) {
+        out.push(Warning::AtBound {
+            name: name.into(),
+            side,
+        });
+    }
+    out
+}
+
+/// Each part's residuals at the result, with their details in the measurement's units.
+fn residual_report(joint: &Joint, parts: Vec<Vec<f64>>) -> Vec<ExperimentResidual> {
+    joint
+        .parts
+        .iter()
+        .zip(parts)
+        .map(|(part, r)| ExperimentResidual {
+            source: part.source.clone(),
+            objective: part.objective.name().into(),
+            weight: part.weight,
+            scale: part.objective.scale(),
+            rms: (sum_of_squares(&r) / r.len().max(1) as f64).sqrt(),
+            detail: part.objective.detail(&r),
+            residuals: r,
+        })
+        .collect()
+}
+
+/// Resonances the fitted model misses by more than [`RESONANCE_MISS_HZ`].
+fn resonance_misses(residuals: &[ExperimentResidual]) -> Vec<Warning> {
+    residuals
+        .iter()
+        .filter_map(|r| match &r.detail {
+            Some(Detail::Resonance { max_miss_hz, .. }) if *max_miss_hz > RESONANCE_MISS_HZ => {
+                Some(Warning::ResonanceMiss {
+                    source: r.source.clone(),
+                    max_miss_hz: *max_miss_hz,
+                })
+            }
+            _ => None,
+        })
+        .collect()
+}

@@ -1,0 +1,166 @@
+//! Each warning's text for people: one short function per variant, chosen by
+//! [`text`]. The texts say what the data cannot tell and what to change.
+
+use super::{Side, Warning};
+use crate::names::Num;
+
+/// The message of `w`.
+pub(super) fn text(w: &Warning) -> String {
+    match w {
+        Warning::MethodSwitched {
+            residuals,
+            parameters,
+        } => method_switched(*residuals, *parameters),
+        Warning::CheckpointNotWritten { path, error } => {
+            format!("the checkpoint {path} could not be written: {error}")
+        }
+        Warning::Interrupted { evaluations } => interrupted(*evaluations),
+        Warning::EvaluationFailures { example } => {
+            format!("some trial parameter sets could not be evaluated, e.g. {example}")
+        }
+        Warning::DistinctSolution { start, solution } => distinct_solution(*start, solution),
+        Warning::AtBound { name, side } => at_bound(name, *side),
+        Warning::ResonanceMiss {
+            source,
+            max_miss_hz,
+        } => resonance_miss(source, *max_miss_hz),
+        Warning::NoEffect { name } => {
+            format!("{name} has no effect on the residuals: the data say nothing about it")
+        }
+        Warning::TooFewResiduals {
+            residuals,
+            parameters,
+        } => format!(
+            "{residuals} residuals for {parameters} parameters: the data cannot determine them all"
+        ),
+        Warning::Singular {
+            conditioning,
+            names,
+        } => singular(*conditioning, names),
+        Warning::Correlated { a, b, correlation } => correlated(a, b, *correlation),
+        Warning::RoughCost => ROUGH_COST.to_string(),
+        Warning::EstimateUnused { source, values } => estimate_unused(source, values),
+        Warning::Escalated {
+            source,
+            model_hz,
+            measured_hz,
+            max_miss_hz,
+            max_miss_percent,
+            linear_misfit_db,
+        } => escalated(
+            source,
+            (model_hz, measured_hz),
+            (*max_miss_hz, *max_miss_percent),
+            *linear_misfit_db,
+        ),
+        Warning::ProfileOpen {
+            name,
+            side,
+            bound,
+            family,
+        } => profile_open(name, *side, *bound, family),
+        Warning::ProfileBetterFit {
+            name,
+            value,
+            cost,
+            fit_cost,
+        } => profile_better_fit(name, *value, *cost, *fit_cost),
+    }
+}
+
+fn method_switched(residuals: usize, parameters: usize) -> String {
+    format!(
+        "{residuals} residuals for {parameters} parameters: Gauss–Newton cannot run (JᵀJ singular), Nelder–Mead used instead"
+    )
+}
+
+fn interrupted(evaluations: usize) -> String {
+    format!(
+        "the search was stopped after {evaluations} evaluations: this is the best point found so far, not a converged fit (resuming from the checkpoint continues it)"
+    )
+}
+
+fn distinct_solution(start: usize, solution: &str) -> String {
+    format!(
+        "start {start} ended at a different solution ({solution}) with the same cost: the data do not determine a unique solution"
+    )
+}
+
+fn at_bound(name: &str, side: Side) -> String {
+    format!(
+        "{name} ended at its {side} bound: the data pull it further — widen its bounds, or another parameter (fixed now) must change"
+    )
+}
+
+fn resonance_miss(source: &str, max_miss_hz: f64) -> String {
+    format!(
+        "{source}: the fitted model misses the measured resonances by up to {max_miss_hz:.1} Hz — the fitted parameters alone cannot reach them"
+    )
+}
+
+fn singular(conditioning: f64, names: &[String]) -> String {
+    format!(
+        "JᵀJ is singular (conditioning {conditioning:.1e}): the data cannot separate {}",
+        names.join(", ")
+    )
+}
+
+fn correlated(a: &str, b: &str, correlation: f64) -> String {
+    format!(
+        "{a} and {b} are correlated {correlation:+.3}: the data cannot separate them (fix one, or add an experiment that moves them differently)"
+    )
+}
+
+const ROUGH_COST: &str = "the standard errors of a fit to a closed-loop simulation (torque curve, unbalance test, servo trace) count the residuals' scatter only: the quantised encoders make the cost rough, and the search stops in its local minima (fm +0.67 % against a 0.08 % standard error on the worm fixture from fm 0.2): read them as lower bounds, or run --resample for an interval that holds";
+
+fn estimate_unused(source: &str, values: &str) -> String {
+    format!(
+        "{source}: its direct estimate ({values}) is not a valid parameter set, so the search starts at the given values instead — check the record (too little motion, a wrong unit or sign)"
+    )
+}
+
+/// The resonances of the nonlinear test (`model`) against the measured ones, the
+/// largest miss in Hz and %, and the linear gain's misfit.
+fn escalated(
+    source: &str,
+    (model_hz, measured_hz): (&[f64], &[f64]),
+    (max_miss_hz, max_miss_percent): (f64, f64),
+    linear_misfit_db: f64,
+) -> String {
+    format!(
+        "{source}: the linear fit does not explain the data — the nonlinear virtual test at its parameters puts the resonances at {} Hz (measured {} Hz), up to {max_miss_hz:.2} Hz ({max_miss_percent:.2} %) off, and the linear model's gain misses the measured curve by {linear_misfit_db:.2} dB RMS — beyond 0.5 % (a stiffness biased twice as much) or 1 dB (a flattened or misplaced peak): backlash or friction at the test's amplitude. So the result is the nonlinear fit, the linear one corrected by the nonlinear test",
+        hz(model_hz),
+        hz(measured_hz)
+    )
+}
+
+fn hz(v: &[f64]) -> String {
+    v.iter()
+        .map(|x| format!("{x:.2}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn profile_open(name: &str, side: Side, bound: f64, family: &[(String, f64)]) -> String {
+    let mut text = format!(
+        "{name}'s profile stays below the 95 % level up to its {side} bound {}: the data do not bound it on that side",
+        Num(bound)
+    );
+    if !family.is_empty() {
+        let moved: Vec<String> = family.iter().map(|(n, r)| format!("{n} ×{r:.2}")).collect();
+        let names: Vec<&str> = family.iter().map(|(n, _)| n.as_str()).collect();
+        text += &format!(
+            "; along the profile {} moved with it: the data determine a combination of {name}, {}, not each",
+            moved.join(", "),
+            names.join(", ")
+        );
+    }
+    text
+}
+
+fn profile_better_fit(name: &str, value: f64, cost: f64, fit_cost: f64) -> String {
+    format!(
+        "holding {name} at {} fits better than the result (cost {cost:.4e} against {fit_cost:.4e}): the search stopped short of the optimum — rerun with more --starts, or from there",
+        Num(value)
+    )
+}

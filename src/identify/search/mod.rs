@@ -1,0 +1,152 @@
+//! Several starts of one local search, in parallel (rayon): the given start, then a
+//! Latin hypercube in the bounds. Each start's record is handed to a callback as it
+//! finishes (to checkpoint); a start finished before a resume is not run again, one
+//! interrupted continues from where it had got to.
+
+pub mod problem;
+pub mod progress;
+pub mod settings;
+pub mod solvers;
+
+use rayon::prelude::*;
+
+use crate::identify::result::starts::StartRecord;
+use crate::identify::space::ParamSpace;
+use crate::objectives::Objective;
+use problem::{Monitor, Problem};
+use settings::Settings;
+use solvers::Limits;
+
+/// Runs the starts of `settings` (skipping those `done` already holds as finished),
+/// in parallel; `on_done` is called after each start (to checkpoint). Returns every
+/// start, in index order. The best point of all evaluations is in `monitor`.
+pub fn search(
+    space: &ParamSpace,
+    objective: &dyn Objective,
+    settings: &Settings,
+    monitor: &Monitor,
+    done: &[StartRecord],
+    on_done: &(dyn Fn(&StartRecord) + Sync),
+) -> Vec<StartRecord> {
+    for d in done.iter().filter(|d| d.finished()) {
+        if let (Some(v), Some(c)) = (&d.result, d.cost) {
+            monitor.offer(c, v);
+        }
+    }
+    let to_run = (0..settings.starts)
+        .filter(|i| !done.iter().any(|d| d.index == *i && d.finished()))
+        .count();
+    monitor.progress().plan(to_run as u64 * settings.max_iters);
+    let mut records: Vec<StartRecord> = space
+        .starts(settings.starts, settings.seed)
+        .into_par_iter()
+        .enumerate()
+        .map(|(index, initial)| {
+            if let Some(d) = done.iter().find(|d| d.index == index && d.finished()) {
+                return d.clone();
+            }
+            let record = one_start(space, objective, settings, monitor, done, index, initial);
+            on_done(&record);
+            record
+        })
+        .collect();
+    records.sort_by_key(|r| r.index);
+    records
+}
+
+/// Start `index` from `initial`, or from where an interrupted run of it had got to.
+fn one_start(
+    space: &ParamSpace,
+    objective: &dyn Objective,
+    settings: &Settings,
+    monitor: &Monitor,
+    done: &[StartRecord],
+    index: usize,
+    initial: Vec<f64>,
+) -> StartRecord {
+    let from = done
+        .iter()
+        .find(|d| d.index == index)
+        .and_then(|d| d.result.clone())
+        .unwrap_or_else(|| initial.clone());
+    let problem = Problem::new(space, objective, monitor, settings);
+    let limits = Limits {
+        max_iters: settings.max_iters,
+        simplex_step: settings.simplex_step,
+        seed: settings.seed.wrapping_add(index as u64),
+    };
+    let out = solvers::run(settings.method, problem, space.to_solver(&from), limits);
+    // The budget this start did not use: done, as far as the progress is concerned.
+    monitor
+        .progress()
+        .advance(settings.max_iters.saturating_sub(out.iterations));
+    let result =
+        (!out.x.is_empty()).then(|| space.physical(&nalgebra::DVector::from_vec(out.x.clone())));
+    StartRecord {
+        index,
+        initial,
+        result,
+        cost: out.cost.is_finite().then_some(out.cost),
+        iterations: out.iterations,
+        termination: out.termination,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identify::search::settings::Method;
+    use crate::identify::Bound;
+    use crate::model::{presets, Params};
+    use crate::objectives::ObjectiveError;
+
+    /// Residuals of Kw and Kg from 3e5 and 900, relative.
+    struct Bowl;
+
+    impl Objective for Bowl {
+        fn name(&self) -> &'static str {
+            "bowl"
+        }
+        fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+            Ok(vec![
+                p.kw / 3e5 - 1.0,
+                p.kg.unwrap_or(0.0) / 900.0 - 1.0,
+                0.0,
+            ])
+        }
+        fn len(&self) -> usize {
+            3
+        }
+        fn scale(&self) -> String {
+            String::new()
+        }
+    }
+
+    /// Every method's iterations, counted by the observer, plus the budget the
+    /// converged starts give back, add up to the budget exactly: the bar ends full,
+    /// never past it.
+    #[test]
+    fn the_iterations_done_end_equal_to_the_budget() {
+        let base = presets::load("worm-gear").unwrap();
+        let names = ["Kw".to_string(), "Kg".to_string()];
+        let bounds = [
+            ("Kw".to_string(), Bound { lo: 1e5, hi: 1e6 }),
+            ("Kg".to_string(), Bound { lo: 1e2, hi: 1e4 }),
+        ];
+        let space = ParamSpace::new(base, &names, &bounds).unwrap();
+        for method in [Method::Lsq, Method::NelderMead, Method::Pso] {
+            let monitor = Monitor::default();
+            let settings = Settings {
+                method,
+                starts: 3,
+                max_iters: 30,
+                ..Settings::default()
+            };
+            let records = search(&space, &Bowl, &settings, &monitor, &[], &|_| {});
+            let (done, budget) = monitor.progress().iterations();
+            assert_eq!(budget, 90, "{method:?}");
+            assert_eq!(done, budget, "{method:?}: {records:?}");
+            assert_eq!(monitor.progress().fraction(), Some(1.0));
+        }
+    }
+}
