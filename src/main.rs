@@ -54,8 +54,15 @@ fn colour(c: clap::Command) -> clap::Command {
 /// own check ("--amplitude-nm -1: must be positive") instead of clap's "unexpected
 /// argument '-1'", which does not name the option.
 fn negative_numbers(c: clap::Command) -> clap::Command {
-    c.mut_args(|a| a.allow_negative_numbers(true))
-        .mut_subcommands(negative_numbers)
+    // Only options that take values: on a flag clap's debug build refuses the setting.
+    c.mut_args(|a| {
+        if a.get_action().takes_values() {
+            a.allow_negative_numbers(true)
+        } else {
+            a
+        }
+    })
+    .mut_subcommands(negative_numbers)
 }
 
 /// `rtid … | head`: when the reader closes the pipe, `println!` panics with
