@@ -432,3 +432,84 @@ fn absurd_option_values_fail_cleanly() {
     assert!(n >= 84, "{n} cases");
     failures.assert_none(n);
 }
+
+/// The files labs export (fixtures/formats/) cut, corrupted and emptied: `rtid import
+/// --list` reads what is left or names the file, never panics or hangs.
+#[test]
+fn malformed_lab_exports_fail_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut sources: Vec<PathBuf> = Vec::new();
+    for folder in ["matlab", "twincat-scope", "epos", "uff"] {
+        let mut found: Vec<PathBuf> = files_under(&fixture("formats").join(folder))
+            .into_iter()
+            .filter(|p| {
+                matches!(
+                    p.extension().and_then(|e| e.to_str()),
+                    Some("mat" | "csv" | "uff")
+                )
+            })
+            .collect();
+        found.sort();
+        sources.extend(found.into_iter().take(3));
+    }
+    assert!(
+        sources.len() >= 8,
+        "the format fixtures are there: {sources:?}"
+    );
+    let mut failures = Failures::default();
+    let mut cases = 0;
+    for source in &sources {
+        let bytes = std::fs::read(source).unwrap();
+        let ext = source.extension().unwrap().to_str().unwrap();
+        for (k, case) in byte_mutations(&bytes).into_iter().enumerate() {
+            let name = format!(
+                "{}-{k}.{ext}",
+                source.file_stem().unwrap().to_string_lossy()
+            );
+            std::fs::write(dir.path().join(&name), &case).unwrap();
+            let args = strings(&["import", &name, "--list", "--json"]);
+            failures.check(&args, &rtid(&args, dir.path()), &name);
+            cases += 1;
+        }
+    }
+    failures.assert_none(cases);
+}
+
+/// Every file below `dir`.
+fn files_under(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            out.extend(files_under(&path));
+        } else {
+            out.push(path);
+        }
+    }
+    out
+}
+
+/// A file's bytes cut short (in the header, in the middle, one byte before the end),
+/// emptied, with a block overwritten by garbage, and with every byte of its first
+/// kilobyte flipped.
+fn byte_mutations(bytes: &[u8]) -> Vec<Vec<u8>> {
+    let n = bytes.len();
+    let mut out = vec![
+        Vec::new(),
+        bytes[..n.min(64)].to_vec(),
+        bytes[..n / 2].to_vec(),
+        bytes[..n.saturating_sub(1)].to_vec(),
+    ];
+    let mut garbage = bytes.to_vec();
+    let (a, b) = (n / 3, (n / 3 + 512).min(n));
+    for (i, x) in garbage[a..b].iter_mut().enumerate() {
+        *x = (i as u8).wrapping_mul(151).wrapping_add(7);
+    }
+    out.push(garbage);
+    let mut flipped = bytes.to_vec();
+    for x in flipped.iter_mut().take(1024) {
+        *x = !*x;
+    }
+    out.push(flipped);
+    out
+}

@@ -6,6 +6,7 @@ mod compare;
 mod evaluate;
 mod experiment;
 mod identify;
+mod import;
 mod model;
 #[cfg(test)]
 mod properties;
@@ -71,6 +72,10 @@ pub enum Command {
     /// Identify stiffness, damping and friction from experiment files.
     #[command(long_about = identify::LONG_ABOUT)]
     Identify(identify::Args),
+    /// Read the files labs export (MAT, TwinCAT Scope, EPOS Studio, UFF 58, delimited
+    /// text): list their channels, or write an experiment file from them.
+    #[command(long_about = import::LONG_ABOUT)]
+    Import(import::Args),
     /// Evaluate a measured or virtual experiment file (statistics, plot).
     #[command(long_about = evaluate::LONG_ABOUT)]
     Evaluate(evaluate::Args),
@@ -105,6 +110,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Params(a) => model::params::run(a),
         Command::Experiment { test } => experiment::run(test),
         Command::Identify(a) => identify::run(a),
+        Command::Import(a) => import::run(a),
         Command::Evaluate(a) => evaluate::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Sweep(a) => sweep::run(a),

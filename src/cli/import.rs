@@ -1,0 +1,404 @@
+//! `rtid import`: records as labs export them — what is in a file (`--list`), and an
+//! rtid experiment file made of its channels (`--kind … --map … --out DIR`).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+use serde_json::{json, Map, Value};
+
+use rtid::io::experiment_file::{self, Conditions};
+use rtid::io::formats::detect::{self, Format};
+use rtid::io::formats::{Abscissa, Channel, Recording, Samples};
+use rtid::io::import::kinds::ImportKind;
+use rtid::io::import::{self, mapping, Source};
+
+pub const LONG_ABOUT: &str = "\
+Reads the files labs export — MATLAB MAT-files (v5/v7), Beckhoff TwinCAT Scope View CSV, \
+Maxon EPOS Studio data-recorder CSV, UFF datasets 58/58b, delimited text with a header — \
+as they are, and writes rtid experiment files (manifest + CSV in SI units) from them \
+(docs/import.md).
+
+First see what a file holds, without choosing anything:
+  rtid import DATA_EMPS.mat --list
+lists each channel's name as the file spells it, its unit, number of samples, sample \
+period (or abscissa), first, last and mean value — after the scale factors and offsets \
+the file itself declares. --json prints the same as {\"channels\": [...], \"format\", \
+\"notes\"} (an array of them for several files).
+
+Then map channels onto the roles of an experiment kind:
+  rtid import FILE --kind KIND --map ROLE=CHANNEL[*SCALE][:UNIT] ... --out DIR
+Each role is taken from the named channel (exactly as --list spells it), multiplied by \
+SCALE (a number; *-1 flips a sign), in UNIT — the unit of CHANNEL×SCALE; without UNIT the \
+channel's own unit label. rtid converts to its SI columns. A computed role is a scaled \
+channel: the force of a drive is its controller output (V) times the drive gain (N/V): \
+effort=vir*35.15:N.
+
+Units: s, ms, µs (us); rad, deg, arcsec, rev; m, mm, µm (um), nm; rad/s, deg/s, rpm, \
+m/s, mm/s, mm/min; N·m (Nm), mN·m (mNm), N; A, mA; V; Hz; dB; 1 (a ratio). Per cent of a \
+nominal value: %(9.84 mN·m). Encoder increments with their resolution: inc(4096/rev), \
+inc(1000/mm).
+
+Kinds and their roles (time or frequency defaults to the channels' own abscissa):
+  servo-trace              time, reference_position, position, table_position, effort, \
+controller_output, controller_added
+  torque-curve             time, effort, position
+  frequency-response       frequency, frf (a complex channel) or gain (dB or ratio) and \
+phase
+  frequency-response-time  time, motor_torque or motor_current, motor_angle, table_angle
+  positioning              target, deviation, direction (> 0 up, < 0 down), run (from 1)
+--condition NAME=VALUE sets a manifest condition (docs/experiment-files.md), e.g. \
+drive_gain=35.15, loop_period_s=0.001.
+
+Nothing is smoothed silently: a sample more than 10 robust deviations from its \
+neighbours is reported with file, line and value (and kept), a gap in the time base \
+names its line. The manifest records the source files with their SHA-256, their format, \
+the maps and conditions as given, and rtid's version.
+
+Examples:
+  rtid import fixtures/formats/matlab/DATA_EMPS.mat --list
+  rtid import fixtures/formats/matlab/DATA_EMPS.mat --kind servo-trace \\
+      --map time=t:s --map position=qm:m --map reference_position=qg:m \\
+      --map controller_output=vir:V --map effort=vir*35.15065188248547:N \\
+      --condition drive_gain=35.15065188248547 --condition loop_period_s=0.001 --out emps
+  rtid import run.csv --kind torque-curve --map time=t:ms \\
+      --map 'effort=Torque actual value*-1:%(9.84 mN·m)' --out runs/torque";
+
+/// Arguments of `rtid import`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The files to read (one experiment: several files are read together, their
+    /// channels named as in each).
+    #[arg(value_name = "FILE", required = true)]
+    pub files: Vec<PathBuf>,
+    /// List each file's channels (name, unit, samples, sample period, first, last,
+    /// mean) and write nothing.
+    #[arg(long, conflicts_with_all = ["kind", "map", "out"])]
+    pub list: bool,
+    /// The reader to use (default: recognised from the file's first bytes).
+    #[arg(long, value_name = "FORMAT", value_parser = parse_format)]
+    pub format: Option<Format>,
+    /// The experiment to write: servo-trace, torque-curve, frequency-response,
+    /// frequency-response-time, positioning.
+    #[arg(long, value_name = "KIND", value_parser = parse_kind, requires = "out")]
+    pub kind: Option<ImportKind>,
+    /// ROLE=CHANNEL[*SCALE][:UNIT]; repeatable, one per role.
+    #[arg(
+        long,
+        value_name = "ROLE=CHANNEL[*SCALE][:UNIT]",
+        allow_hyphen_values = true
+    )]
+    pub map: Vec<String>,
+    /// NAME=VALUE, a manifest condition; repeatable.
+    #[arg(long, value_name = "NAME=VALUE", allow_hyphen_values = true)]
+    pub condition: Vec<String>,
+    /// The manifest's `mechanism` (free text).
+    #[arg(long, value_name = "TEXT")]
+    pub mechanism: Option<String>,
+    /// The manifest's file name in DIR, without `.json` (default: the kind's name,
+    /// e.g. servo_trace).
+    #[arg(long, value_name = "NAME")]
+    pub name: Option<String>,
+    /// The folder to write the manifest and its CSV into.
+    #[arg(long, value_name = "DIR", requires = "kind")]
+    pub out: Option<PathBuf>,
+    /// Print JSON instead of tables.
+    #[arg(long)]
+    pub json: bool,
+    /// No notes on stderr.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+fn parse_format(s: &str) -> Result<Format, String> {
+    Format::parse(s).ok_or_else(|| {
+        let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
+        format!("unknown format `{s}`: expected {}", names.join(", "))
+    })
+}
+
+fn parse_kind(s: &str) -> Result<ImportKind, String> {
+    ImportKind::parse(s).ok_or_else(|| {
+        let names: Vec<&str> = ImportKind::ALL.iter().map(|k| k.name()).collect();
+        format!(
+            "`{s}` is not a kind import writes: expected {}",
+            names.join(", ")
+        )
+    })
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let sources = read_all(&a.files, a.format)?;
+    if a.list || a.kind.is_none() {
+        return list(&sources, a.json);
+    }
+    let request = request(&a)?;
+    let imported = import::build(&sources, &request)?;
+    let out = a
+        .out
+        .as_deref()
+        .context("--out DIR is needed with --kind")?;
+    let name = a
+        .name
+        .clone()
+        .unwrap_or_else(|| request.kind.kind().to_string());
+    let manifest_path = out.join(format!("{name}.json"));
+    refuse_overwriting_inputs(&manifest_path, &a.files)?;
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    experiment_file::write(&manifest_path, &imported.manifest, &imported.data)?;
+    report(&manifest_path, &imported, a.json, a.quiet)
+}
+
+/// Every file read, with its SHA-256.
+fn read_all(files: &[PathBuf], format: Option<Format>) -> anyhow::Result<Vec<Source>> {
+    files
+        .iter()
+        .map(|path| {
+            let recording = detect::read(path, format)?;
+            let sha256 = rtid::io::provenance::sha256(path)
+                .with_context(|| format!("cannot read {}", path.display()))?;
+            Ok(Source {
+                path: path.clone(),
+                sha256,
+                recording,
+            })
+        })
+        .collect()
+}
+
+fn request(a: &Args) -> anyhow::Result<import::Request> {
+    let kind = a.kind.context("--kind is needed to write an experiment")?;
+    if a.map.is_empty() {
+        bail!(
+            "--map: no channel mapped; {} takes {} (rtid import FILE --list shows the channels)",
+            kind.name(),
+            kind.describe_roles()
+        );
+    }
+    let maps = a
+        .map
+        .iter()
+        .map(|m| mapping::parse(m).map_err(|e| anyhow::anyhow!("--map {e}")))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    Ok(import::Request {
+        kind,
+        maps,
+        conditions: conditions(&a.condition)?,
+        conditions_given: a.condition.clone(),
+        mechanism: a.mechanism.clone(),
+    })
+}
+
+/// `--condition NAME=VALUE`s as the manifest's conditions: VALUE read as JSON (a
+/// number, `true`, `[1, 2]`), else as text.
+fn conditions(given: &[String]) -> anyhow::Result<Conditions> {
+    let mut map = Map::new();
+    for c in given {
+        let (name, value) = c
+            .split_once('=')
+            .with_context(|| format!("--condition {c}: write NAME=VALUE"))?;
+        let name = name.trim();
+        if map.contains_key(name) {
+            bail!("--condition {c}: `{name}` is given twice");
+        }
+        let value =
+            serde_json::from_str::<Value>(value.trim()).unwrap_or_else(|_| json!(value.trim()));
+        if let Some(v) = value.as_f64().filter(|v| !v.is_finite()) {
+            bail!("--condition {c}: {v} is not a finite number");
+        }
+        map.insert(name.to_string(), value);
+    }
+    serde_json::from_value(Value::Object(map)).context("--condition: a value of the wrong type")
+}
+
+fn refuse_overwriting_inputs(manifest: &Path, inputs: &[PathBuf]) -> anyhow::Result<()> {
+    let csv = manifest.with_extension("csv");
+    for input in inputs {
+        let same = |p: &Path| match (p.canonicalize(), input.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        };
+        if same(manifest) || same(&csv) {
+            bail!(
+                "--out: {} would be written over the input {}",
+                manifest.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+fn report(path: &Path, imported: &import::Imported, json: bool, quiet: bool) -> anyhow::Result<()> {
+    if json {
+        let out = json!({
+            "manifest": path.display().to_string(),
+            "kind": imported.manifest.kind.to_string(),
+            "rows": imported.data.len(),
+            "findings": imported.findings,
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    println!(
+        "wrote {} ({}, {} rows)",
+        path.display(),
+        imported.manifest.kind,
+        imported.data.len()
+    );
+    if !quiet {
+        for f in &imported.findings {
+            eprintln!("note: {f}");
+        }
+    }
+    Ok(())
+}
+
+/// `--list`: each file's channels.
+fn list(sources: &[Source], json: bool) -> anyhow::Result<()> {
+    if json {
+        let all: Vec<Value> = sources.iter().map(list_json).collect();
+        let out = if all.len() == 1 {
+            all[0].clone()
+        } else {
+            Value::Array(all)
+        };
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    for s in sources {
+        println!(
+            "{} ({}, {} channels)",
+            s.path.display(),
+            s.recording.format,
+            s.recording.channels.len()
+        );
+        println!("{}", list_table(&s.recording));
+        for note in s.recording.notes.iter().chain(&glitch_notes(s)) {
+            println!("note: {note}");
+        }
+    }
+    Ok(())
+}
+
+/// Each channel's glitches (and gaps, in a channel in seconds), as `--list` says them.
+fn glitch_notes(s: &Source) -> Vec<String> {
+    s.recording
+        .channels
+        .iter()
+        .flat_map(|c| {
+            let is_time = rtid::io::formats::units::lookup(&c.unit)
+                .is_some_and(|u| u.quantity == rtid::io::formats::units::Quantity::Time);
+            import::channel_findings(&s.path, c, is_time)
+        })
+        .collect()
+}
+
+/// (first, last, mean) of a channel's samples (the magnitude of a complex one).
+fn stats(c: &Channel) -> (f64, f64, f64) {
+    let v: Vec<f64> = match &c.samples {
+        Samples::Real(v) => v.clone(),
+        Samples::Complex { re, im } => re.iter().zip(im).map(|(a, b)| a.hypot(*b)).collect(),
+    };
+    let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+    (
+        v.first().copied().unwrap_or(f64::NAN),
+        v.last().copied().unwrap_or(f64::NAN),
+        mean,
+    )
+}
+
+/// The sample period in s, where the abscissa is a time evenly spaced.
+fn sample_period_s(c: &Channel) -> Option<f64> {
+    use rtid::io::formats::units::{self, Quantity};
+    let time = |unit: &str| {
+        units::parse(unit)
+            .ok()
+            .filter(|u| u.quantity == Quantity::Time)
+    };
+    match &c.abscissa {
+        Abscissa::Uniform { step, unit, .. } => time(unit).map(|u| step * u.si),
+        Abscissa::Values { values, unit } => {
+            let u = time(unit)?;
+            let times: Vec<f64> = values.iter().map(|v| v * u.si).collect();
+            experiment_file::sample_period(&times)
+        }
+        Abscissa::Index => None,
+    }
+}
+
+fn abscissa_text(c: &Channel) -> String {
+    match (&c.abscissa, sample_period_s(c)) {
+        (_, Some(p)) => format!("{} s", rtid::names::Num(p)),
+        (Abscissa::Uniform { start, step, unit }, None) => format!("{start} + k·{step} {unit}"),
+        (Abscissa::Values { values, unit }, None) => match (values.first(), values.last()) {
+            (Some(a), Some(b)) => format!("{a} … {b} {unit}"),
+            _ => "—".into(),
+        },
+        (Abscissa::Index, None) => "sample index".into(),
+    }
+}
+
+fn list_json(s: &Source) -> Value {
+    let channels: Vec<Value> = s
+        .recording
+        .channels
+        .iter()
+        .map(|c| {
+            let (first, last, mean) = stats(c);
+            let mut o = json!({
+                "name": c.name,
+                "unit": c.unit,
+                "samples": c.samples.len(),
+            });
+            // An empty channel has no first, last or mean: left out, never null.
+            for (key, v) in [("first", first), ("last", last), ("mean", mean)] {
+                if v.is_finite() {
+                    o[key] = json!(v);
+                }
+            }
+            if matches!(c.samples, Samples::Complex { .. }) {
+                o["complex"] = json!(true);
+            }
+            match sample_period_s(c) {
+                Some(p) => o["sample_period_s"] = json!(p),
+                None => o["abscissa"] = json!(abscissa_text(c)),
+            }
+            o
+        })
+        .collect();
+    json!({
+        "file": s.path.display().to_string(),
+        "format": s.recording.format,
+        "channels": channels,
+        "notes": s.recording.notes.iter().chain(&glitch_notes(s)).collect::<Vec<_>>(),
+    })
+}
+
+fn list_table(r: &Recording) -> Table {
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header([
+        "channel",
+        "unit",
+        "samples",
+        "sample period / abscissa",
+        "first",
+        "last",
+        "mean",
+    ]);
+    for c in &r.channels {
+        let (first, last, mean) = stats(c);
+        let num = |v: f64| rtid::names::Num(v).to_string();
+        t.add_row([
+            c.name.clone(),
+            c.unit.clone(),
+            c.samples.len().to_string(),
+            abscissa_text(c),
+            num(first),
+            num(last),
+            num(mean),
+        ]);
+    }
+    t
+}

@@ -1,0 +1,608 @@
+//! Records as labs export them, mapped onto rtid's experiment files: the channels of
+//! a [`Recording`] (read by [`crate::io::formats`]) named to the roles of a kind
+//! ([`kinds`]) by `--map ROLE=CHANNEL[*SCALE][:UNIT]` ([`mapping`]), converted to SI
+//! ([`crate::io::formats::units`]), checked for glitches and gaps ([`glitches`]), and returned as the
+//! experiment's [`Data`] with a manifest that records where they came from.
+
+pub mod glitches;
+pub mod kinds;
+pub mod mapping;
+
+use std::path::PathBuf;
+
+use serde_json::{json, Value};
+
+use crate::io::experiment_file::{
+    CommandUnit, Conditions, Data, Direction, Manifest, ServoTrace, Signal,
+};
+use crate::io::formats::units::{self, Quantity};
+use crate::io::formats::{Abscissa, Channel, Recording, Samples};
+use crate::model::Axis;
+use kinds::{ImportKind, Role};
+use mapping::{MapSpec, Resolved};
+
+/// A file read, with what its provenance needs.
+#[derive(Clone, Debug)]
+pub struct Source {
+    pub path: PathBuf,
+    pub sha256: String,
+    pub recording: Recording,
+}
+
+/// What to write.
+#[derive(Clone, Debug)]
+pub struct Request {
+    pub kind: ImportKind,
+    pub maps: Vec<MapSpec>,
+    pub conditions: Conditions,
+    /// `--condition` as given, for the provenance.
+    pub conditions_given: Vec<String>,
+    pub mechanism: Option<String>,
+}
+
+/// The experiment made of the sources.
+#[derive(Clone, Debug)]
+pub struct Imported {
+    pub data: Data,
+    pub manifest: Manifest,
+    /// Glitches, gaps and the readers' notes, each naming file and line or sample.
+    pub findings: Vec<String>,
+}
+
+/// Why a mapping could not make an experiment: one message naming the option, role,
+/// channel or file.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct ImportError(pub String);
+
+/// One role's values in SI, and the channel they came from.
+struct Filled<'a> {
+    role: &'static Role,
+    resolved: Resolved<'a>,
+    values: Vec<f64>,
+}
+
+/// Builds the experiment `request` asks for from `sources`.
+pub fn build(sources: &[Source], request: &Request) -> Result<Imported, ImportError> {
+    let recordings: Vec<Recording> = sources.iter().map(|s| s.recording.clone()).collect();
+    let filled = fill(&recordings, request)?;
+    let data = if request.kind == ImportKind::Positioning {
+        positioning(&filled)?
+    } else {
+        let axis_values = abscissa_of(&filled, request.kind)?;
+        assemble(request.kind, &filled, axis_values)?
+    };
+    let findings = findings(sources, &filled);
+    let manifest = manifest(sources, request, &findings);
+    Ok(Imported {
+        data,
+        manifest,
+        findings,
+    })
+}
+
+/// Every map resolved to its role and converted.
+fn fill<'a>(
+    recordings: &'a [Recording],
+    request: &Request,
+) -> Result<Vec<Filled<'a>>, ImportError> {
+    let kind = request.kind;
+    let mut filled: Vec<Filled> = Vec::new();
+    for spec in &request.maps {
+        let role = kind
+            .roles()
+            .iter()
+            .find(|r| r.name == spec.role)
+            .ok_or_else(|| {
+                ImportError(format!(
+                    "--map {}: `{}` is not a role of {}; its roles: {}",
+                    spec.given,
+                    spec.role,
+                    kind.name(),
+                    kind.describe_roles()
+                ))
+            })?;
+        if filled.iter().any(|f| f.role.name == role.name) {
+            return Err(ImportError(format!(
+                "--map: the role `{}` is mapped twice",
+                role.name
+            )));
+        }
+        let resolved = resolve(spec, role, recordings)?;
+        let values = converted(&resolved, role)?;
+        filled.push(Filled {
+            role,
+            resolved,
+            values,
+        });
+    }
+    let missing: Vec<&str> = kind
+        .roles()
+        .iter()
+        .filter(|r| r.required && !filled.iter().any(|f| f.role.name == r.name))
+        .map(|r| r.name)
+        .collect();
+    if !missing.is_empty() {
+        return Err(ImportError(format!(
+            "{} needs --map for {} (its roles: {})",
+            kind.name(),
+            missing.join(", "),
+            kind.describe_roles()
+        )));
+    }
+    Ok(filled)
+}
+
+/// The map resolved, its unit checked against what the role measures. A complex
+/// response (`frf`) is a ratio whatever the file calls its unit.
+fn resolve<'a>(
+    spec: &MapSpec,
+    role: &Role,
+    recordings: &'a [Recording],
+) -> Result<Resolved<'a>, ImportError> {
+    let resolved = match mapping::resolve(spec, recordings) {
+        Err(e) if role.quantities == [Quantity::Number] && !e.contains("no channel") => {
+            let bare = MapSpec {
+                unit: Some("1".into()),
+                ..spec.clone()
+            };
+            mapping::resolve(&bare, recordings)
+        }
+        other => other,
+    }
+    .map_err(|e| ImportError(format!("--map {e}")))?;
+    if !role.quantities.contains(&resolved.unit.quantity) {
+        let wanted: Vec<&str> = role.quantities.iter().map(|q| q.name()).collect();
+        return Err(ImportError(format!(
+            "--map {}: {} is {} ({}), but `{}` takes {}",
+            spec.given,
+            resolved.channel.name,
+            resolved.unit.quantity.name(),
+            resolved.unit.symbol,
+            role.name,
+            wanted.join(" or ")
+        )));
+    }
+    Ok(resolved)
+}
+
+/// The channel's samples in SI (a complex channel only for `frf`, as magnitude-phase
+/// pairs interleaved: |H|, ∠H, …).
+fn converted(r: &Resolved, role: &Role) -> Result<Vec<f64>, ImportError> {
+    match (&r.channel.samples, role.name) {
+        // `+ 0.0` writes a flipped zero as 0, not -0.
+        (Samples::Real(v), _) => Ok(v.iter().map(|x| x * r.factor + 0.0).collect()),
+        (Samples::Complex { re, im }, "frf") => Ok(re
+            .iter()
+            .zip(im)
+            .flat_map(|(a, b)| {
+                [
+                    a.hypot(*b) * r.factor.abs(),
+                    b.atan2(*a) + sign_turn(r.factor),
+                ]
+            })
+            .collect()),
+        (Samples::Complex { .. }, _) => Err(ImportError(format!(
+            "--map {}: `{}` is complex; only `frf` takes a complex channel",
+            r.spec.given, r.channel.name
+        ))),
+    }
+}
+
+/// A negative scale turns a complex response by half a turn.
+fn sign_turn(factor: f64) -> f64 {
+    if factor < 0.0 {
+        std::f64::consts::PI
+    } else {
+        0.0
+    }
+}
+
+/// The time (or frequency) base: the mapped `time`/`frequency` role, else the
+/// abscissa every mapped channel shares, in SI.
+fn abscissa_of(filled: &[Filled], kind: ImportKind) -> Result<Vec<f64>, ImportError> {
+    let axis_role = if kind == ImportKind::FrequencyResponse {
+        "frequency"
+    } else {
+        "time"
+    };
+    if let Some(f) = filled.iter().find(|f| f.role.name == axis_role) {
+        return Ok(f.values.clone());
+    }
+    let first = filled
+        .first()
+        .ok_or_else(|| ImportError("no --map given".into()))?
+        .resolved
+        .channel;
+    if let Some(other) = filled
+        .iter()
+        .find(|f| f.resolved.channel.abscissa != first.abscissa)
+    {
+        return Err(ImportError(format!(
+            "`{}` and `{}` have different {axis_role} bases: map {axis_role}=CHANNEL",
+            first.name, other.resolved.channel.name
+        )));
+    }
+    abscissa_values(first, axis_role)
+}
+
+fn abscissa_values(channel: &Channel, axis_role: &str) -> Result<Vec<f64>, ImportError> {
+    let n = channel.samples.len();
+    let (unit, values) = match &channel.abscissa {
+        Abscissa::Uniform { start, step, unit } => (
+            unit,
+            (0..n)
+                .map(|i| start + i as f64 * step)
+                .collect::<Vec<f64>>(),
+        ),
+        Abscissa::Values { values, unit } => (unit, values.clone()),
+        Abscissa::Index => {
+            return Err(ImportError(format!(
+                "`{}` has no {axis_role} base in its file: map {axis_role}=CHANNEL:UNIT",
+                channel.name
+            )))
+        }
+    };
+    let si = units::parse(unit)
+        .ok()
+        .filter(|u| matches!(u.quantity, Quantity::Time | Quantity::Frequency))
+        .ok_or_else(|| {
+            ImportError(format!(
+                "`{}`: its abscissa's unit `{unit}` is not a time or frequency: map {axis_role}=CHANNEL:UNIT",
+                channel.name
+            ))
+        })?
+        .si;
+    Ok(values.into_iter().map(|v| v * si).collect())
+}
+
+/// The values of role `name`, if mapped.
+fn role<'a>(filled: &'a [Filled], name: &str) -> Option<&'a Filled<'a>> {
+    filled.iter().find(|f| f.role.name == name)
+}
+
+/// The experiment's data, every role the length of the time base.
+fn assemble(kind: ImportKind, filled: &[Filled], base: Vec<f64>) -> Result<Data, ImportError> {
+    for f in filled {
+        let n = if f.role.name == "frf" {
+            f.values.len() / 2
+        } else {
+            f.values.len()
+        };
+        if n != base.len() {
+            return Err(ImportError(format!(
+                "`{}` ({}) has {n} samples but the {} base {}",
+                f.resolved.channel.name,
+                f.role.name,
+                if kind == ImportKind::FrequencyResponse {
+                    "frequency"
+                } else {
+                    "time"
+                },
+                base.len()
+            )));
+        }
+    }
+    match kind {
+        ImportKind::ServoTrace => servo_trace(filled, base),
+        ImportKind::TorqueCurve => torque_curve(filled, base),
+        ImportKind::FrequencyResponse => frequency_response(filled, base),
+        ImportKind::FrequencyResponseTime => frequency_response_time(filled, base),
+        ImportKind::Positioning => positioning(filled),
+    }
+}
+
+/// The axis the positions say (all alike), and the effort agreeing with it.
+fn axis(filled: &[Filled]) -> Result<Axis, ImportError> {
+    let mut found: Option<(Axis, &str)> = None;
+    for f in filled {
+        let positional = matches!(f.role.name, "effort" | "target" | "deviation")
+            || f.role.name.ends_with("position");
+        let this = match f.resolved.unit.quantity {
+            Quantity::Angle | Quantity::Torque if positional => Axis::Rotary,
+            Quantity::Length | Quantity::Force if positional => Axis::Linear,
+            _ => continue,
+        };
+        match found {
+            Some((a, other)) if a != this => {
+                return Err(ImportError(format!(
+                    "`{}` is {} but `{other}` {}: one axis is rotary (rad, N·m) or linear (m, N)",
+                    f.role.name,
+                    f.resolved.unit.quantity.name(),
+                    if a == Axis::Rotary {
+                        "rotary"
+                    } else {
+                        "linear"
+                    }
+                )))
+            }
+            _ => found = Some((this, f.role.name)),
+        }
+    }
+    Ok(found.map_or(Axis::Rotary, |(a, _)| a))
+}
+
+fn values(filled: &[Filled], name: &str) -> Option<Vec<f64>> {
+    role(filled, name).map(|f| f.values.clone())
+}
+
+fn signal(filled: &[Filled], name: &str) -> Option<Signal> {
+    role(filled, name).map(|f| Signal {
+        unit: match f.resolved.unit.quantity {
+            Quantity::Voltage => CommandUnit::Volt,
+            Quantity::Current => CommandUnit::Ampere,
+            Quantity::Torque => CommandUnit::NewtonMetre,
+            _ => CommandUnit::Newton,
+        },
+        values: f.values.clone(),
+    })
+}
+
+fn servo_trace(filled: &[Filled], time_s: Vec<f64>) -> Result<Data, ImportError> {
+    let axis = axis(filled)?;
+    let need =
+        |name: &str| values(filled, name).ok_or_else(|| ImportError(format!("{name} not mapped")));
+    Ok(Data::ServoTrace(ServoTrace {
+        axis,
+        time_s,
+        reference_position: need("reference_position")?,
+        position: need("position")?,
+        table_position: values(filled, "table_position"),
+        effort: need("effort")?,
+        controller_output: signal(filled, "controller_output"),
+        controller_added: signal(filled, "controller_added"),
+        extra: Default::default(),
+    }))
+}
+
+fn torque_curve(filled: &[Filled], time_s: Vec<f64>) -> Result<Data, ImportError> {
+    let effort = values(filled, "effort").ok_or_else(|| ImportError("effort not mapped".into()))?;
+    let position = values(filled, "position");
+    Ok(match axis(filled)? {
+        Axis::Rotary => Data::TorqueCurve {
+            time_s,
+            motor_torque_nm: effort,
+            table_angle_rad: position,
+            extra: Default::default(),
+        },
+        Axis::Linear => Data::ForceCurve {
+            time_s,
+            force_n: effort,
+            table_position_m: position,
+            extra: Default::default(),
+        },
+    })
+}
+
+fn frequency_response(filled: &[Filled], frequency_hz: Vec<f64>) -> Result<Data, ImportError> {
+    let (gain_db, phase_rad) =
+        match (role(filled, "frf"), role(filled, "gain")) {
+            (Some(_), Some(_)) => {
+                return Err(ImportError(
+                    "map either frf (complex) or gain (and phase), not both".into(),
+                ))
+            }
+            (Some(f), None) => {
+                if role(filled, "phase").is_some() {
+                    return Err(ImportError(
+                        "frf gives the phase: do not map phase too".into(),
+                    ));
+                }
+                let gain = f.values.chunks(2).map(|p| 20.0 * p[0].log10()).collect();
+                let phase = f.values.chunks(2).map(|p| wrap(p[1])).collect();
+                (gain, Some(phase))
+            }
+            (None, Some(g)) => {
+                let gain = match g.resolved.unit.quantity {
+                    Quantity::Decibel => g.values.clone(),
+                    _ => g.values.iter().map(|r| 20.0 * r.log10()).collect(),
+                };
+                (gain, values(filled, "phase"))
+            }
+            (None, None) => return Err(ImportError(
+                "frequency-response needs --map frf=CHANNEL (a complex response) or gain=CHANNEL"
+                    .into(),
+            )),
+        };
+    Ok(Data::FrequencyResponse {
+        frequency_hz,
+        gain_db,
+        phase_rad,
+        extra: Default::default(),
+    })
+}
+
+/// A phase in (−π, π].
+fn wrap(phase: f64) -> f64 {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let w = phase - two_pi * (phase / two_pi).round();
+    if w <= -std::f64::consts::PI {
+        w + two_pi
+    } else {
+        w
+    }
+}
+
+fn frequency_response_time(filled: &[Filled], time_s: Vec<f64>) -> Result<Data, ImportError> {
+    let angle =
+        |name: &str| values(filled, name).ok_or_else(|| ImportError(format!("{name} not mapped")));
+    match (
+        values(filled, "motor_torque"),
+        values(filled, "motor_current"),
+    ) {
+        (Some(motor_torque_nm), None) => Ok(Data::FrequencyResponseTime {
+            time_s,
+            motor_torque_nm,
+            motor_angle_rad: angle("motor_angle")?,
+            table_angle_rad: angle("table_angle")?,
+            extra: Default::default(),
+        }),
+        (None, Some(motor_current_a)) => Ok(Data::FrequencyResponseTimeCurrent {
+            time_s,
+            motor_current_a,
+            motor_angle_rad: angle("motor_angle")?,
+            table_angle_rad: angle("table_angle")?,
+            extra: Default::default(),
+        }),
+        _ => Err(ImportError(
+            "frequency-response-time needs exactly one of motor_torque and motor_current".into(),
+        )),
+    }
+}
+
+/// One row per approach: the four roles of equal length, directions by sign, runs
+/// whole numbers from 1.
+fn positioning(filled: &[Filled]) -> Result<Data, ImportError> {
+    let get =
+        |name: &str| role(filled, name).ok_or_else(|| ImportError(format!("{name} not mapped")));
+    let (target, deviation) = (get("target")?, get("deviation")?);
+    let (direction, run) = (get("direction")?, get("run")?);
+    let n = target.values.len();
+    if let Some(f) = [deviation, direction, run]
+        .into_iter()
+        .find(|f| f.values.len() != n)
+    {
+        return Err(ImportError(format!(
+            "`{}` ({}) has {} rows but `{}` (target) {n}",
+            f.resolved.channel.name,
+            f.role.name,
+            f.values.len(),
+            target.resolved.channel.name
+        )));
+    }
+    let directions = direction
+        .values
+        .iter()
+        .enumerate()
+        .map(|(i, &d)| match d {
+            d if d > 0.0 => Ok(Direction::Up),
+            d if d < 0.0 => Ok(Direction::Down),
+            _ => Err(ImportError(format!(
+                "`{}` row {}: direction {d}, neither positive nor negative",
+                direction.resolved.channel.name,
+                i + 1
+            ))),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let runs = run
+        .values
+        .iter()
+        .enumerate()
+        .map(|(i, &r)| {
+            (r >= 1.0 && r.fract() == 0.0 && r <= u32::MAX as f64)
+                .then_some(r as u32)
+                .ok_or_else(|| {
+                    ImportError(format!(
+                        "`{}` row {}: run {r} is not a whole number from 1",
+                        run.resolved.channel.name,
+                        i + 1
+                    ))
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(match axis(filled)? {
+        Axis::Rotary => Data::Positioning {
+            target_rad: target.values.clone(),
+            direction: directions,
+            run: runs,
+            deviation_rad: deviation.values.clone(),
+            extra: Default::default(),
+        },
+        Axis::Linear => Data::LinearPositioning {
+            target_m: target.values.clone(),
+            direction: directions,
+            run: runs,
+            deviation_m: deviation.values.clone(),
+            extra: Default::default(),
+        },
+    })
+}
+
+/// Glitches in every mapped real channel, gaps in the time base, and the readers'
+/// notes, each naming the file and the line (or sample).
+fn findings(sources: &[Source], filled: &[Filled]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for s in sources {
+        for note in &s.recording.notes {
+            out.push(format!("{}: {note}", s.path.display()));
+        }
+    }
+    for f in filled {
+        let file = &sources[f.resolved.file].path;
+        out.extend(channel_findings(
+            file,
+            f.resolved.channel,
+            f.role.name == "time",
+        ));
+    }
+    out
+}
+
+/// What [`glitches`] finds in one channel of `file`: gaps if it is a time base, else
+/// its glitches; each naming the line (or the sample, in a binary file) and the value.
+pub fn channel_findings(file: &std::path::Path, channel: &Channel, is_time: bool) -> Vec<String> {
+    let Samples::Real(raw) = &channel.samples else {
+        return Vec::new();
+    };
+    let place = |index: usize| match channel.first_line {
+        Some(line) => format!("{}, line {}", file.display(), line + index),
+        None => format!("{}, sample {}", file.display(), index + 1),
+    };
+    if is_time {
+        return glitches::gaps(raw)
+            .into_iter()
+            .map(|index| {
+                format!(
+                    "{}: a gap in the time base `{}` ({} after {})",
+                    place(index),
+                    channel.name,
+                    raw[index],
+                    raw[index - 1]
+                )
+            })
+            .collect();
+    }
+    glitches::glitches(raw)
+        .into_iter()
+        .map(|g| {
+            format!(
+                "{}: `{}` = {} is a glitch, {:.0} robust deviations from what its neighbours give ({}); kept, not smoothed",
+                place(g.index),
+                channel.name,
+                g.value,
+                g.deviations,
+                crate::names::Num(g.neighbours)
+            )
+        })
+        .collect()
+}
+
+/// The manifest: the kind, conditions and mechanism asked, and where the data came
+/// from (files with their SHA-256 and format, the maps and conditions as given,
+/// rtid's version, the findings).
+fn manifest(sources: &[Source], request: &Request, findings: &[String]) -> Manifest {
+    let mut m = Manifest::new(request.kind.kind());
+    m.mechanism = request.mechanism.clone();
+    m.conditions = request.conditions.clone();
+    let files: Vec<Value> = sources
+        .iter()
+        .map(|s| {
+            json!({
+                "file": s.path.display().to_string(),
+                "sha256": s.sha256,
+                "format": s.recording.format,
+            })
+        })
+        .collect();
+    m.extra.insert(
+        "import".into(),
+        json!({
+            "sources": files,
+            "map": request.maps.iter().map(|m| m.given.clone()).collect::<Vec<_>>(),
+            "conditions": request.conditions_given,
+            "findings": findings,
+            "rtid": crate::VERSION,
+        }),
+    );
+    m
+}
