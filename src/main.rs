@@ -55,9 +55,23 @@ fn colour(c: clap::Command) -> clap::Command {
 /// argument '-1'", which does not name the option.
 fn negative_numbers(c: clap::Command) -> clap::Command {
     // Only options that take values: on a flag clap's debug build refuses the setting.
+    // A number option takes any hyphenated value too (clap does not read `-1e-5` as a
+    // negative number): what is not a number is refused by its parser, naming it.
     c.mut_args(|a| {
-        if a.get_action().takes_values() {
-            a.allow_negative_numbers(true)
+        if !a.get_action().takes_values() {
+            return a;
+        }
+        let id = |p: clap::builder::ValueParser| p.type_id();
+        let numeric = [
+            id(clap::value_parser!(f64).into()),
+            id(clap::value_parser!(u64).into()),
+            id(clap::value_parser!(u32).into()),
+            id(clap::value_parser!(usize).into()),
+        ]
+        .contains(&a.get_value_parser().type_id());
+        let a = a.allow_negative_numbers(true);
+        if numeric {
+            a.allow_hyphen_values(true)
         } else {
             a
         }

@@ -513,3 +513,102 @@ fn byte_mutations(bytes: &[u8]) -> Vec<Vec<u8>> {
     out.push(flipped);
     out
 }
+
+/// Lists with an empty name and repeated ranges are refused naming the option, not
+/// fitted with the default parameters or the last range silently (issue 28).
+#[test]
+fn empty_names_and_repeated_bounds_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = fixture("worm-gear/frequency_response.json");
+    let data = data.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["--fit", ""], "--fit"),
+        (&["--fit", "Kw,"], "--fit"),
+        (&["--fit", "Kw,,Kg"], "--fit"),
+        (&["--fit", "Kw", "--fit", "Kw"], "Kw"),
+        (
+            &[
+                "--fit",
+                "Kw",
+                "--bound",
+                "Kw=1e5..1e7",
+                "--bound",
+                "Kw=1e5..1e6",
+            ],
+            "--bound",
+        ),
+    ];
+    for (extra, culprit) in cases {
+        let mut args = strings(&[
+            "identify",
+            data,
+            "--preset",
+            "worm-gear",
+            "--model",
+            "linear",
+            "--starts",
+            "1",
+            "--max-iters",
+            "1",
+            "--quiet",
+        ]);
+        args.extend(strings(extra));
+        let run = rtid(&args, dir.path());
+        assert_eq!(run.code, Some(1), "{extra:?} is refused: {}", run.stderr);
+        check(&args, &run, culprit);
+    }
+}
+
+/// A negative number in exponent form and a negative shard reach the option's own
+/// check, which names the option, rather than clap's "unexpected argument '-1'".
+#[test]
+fn negative_values_reach_the_options_own_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &[
+                "simulate",
+                "--preset",
+                "worm-gear",
+                "--input",
+                "sine:freq_hz=100,amp_nm=5",
+                "--duration-s",
+                "0.01",
+                "--dt-s",
+                "-1e-5",
+                "--out",
+                "r.csv",
+            ],
+            "--dt-s -1e-5",
+        ),
+        (
+            &[
+                "sweep",
+                "--preset",
+                "worm-gear",
+                "--method",
+                "local",
+                "--vary",
+                "Kw",
+                "--outputs",
+                "resonances",
+                "--shard",
+                "-1/2",
+                "--out",
+                "s.csv",
+            ],
+            "'-1/2' for '--shard",
+        ),
+    ];
+    for (args, culprit) in cases {
+        let args = strings(args);
+        let run = rtid(&args, dir.path());
+        assert!(
+            !run.stderr.contains("unexpected argument"),
+            "{}",
+            run.stderr
+        );
+        assert_ne!(run.code, Some(0), "{args:?} is refused");
+        check(&args, &run, culprit);
+    }
+}

@@ -152,7 +152,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub overwrite: bool,
     /// Compute only shard I of N (1 ≤ I ≤ N) of the design, for a job array.
-    #[arg(long, value_name = "I/N")]
+    #[arg(long, value_name = "I/N", allow_hyphen_values = true)]
     pub shard: Option<Shard>,
     /// Worker threads (default: one per core).
     #[arg(long)]

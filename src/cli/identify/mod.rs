@@ -263,6 +263,12 @@ impl From<FidelityArg> for FidelityChoice {
 }
 
 /// Parses `NAME=LO..HI`.
+/// The first name that occurs twice, if any.
+fn repeated<'a>(names: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    let mut seen = std::collections::BTreeSet::new();
+    names.into_iter().find(|n| !seen.insert(*n))
+}
+
 pub(super) fn parse_bound(s: &str) -> anyhow::Result<(String, Bound)> {
     let (name, range) = s
         .split_once('=')
@@ -292,11 +298,19 @@ impl Args {
         let base = self.model.load()?;
         let experiments = self.experiment_specs()?;
         self.refuse_overwrites(&experiments)?;
-        let bounds = self
+        let bounds: Vec<(String, Bound)> = self
             .bounds
             .iter()
             .map(|b| parse_bound(b))
             .collect::<anyhow::Result<_>>()?;
+        if let Some(name) = repeated(bounds.iter().map(|(n, _)| n.as_str())) {
+            anyhow::bail!("--bound: {name} is given twice; give each parameter one range");
+        }
+        anyhow::ensure!(
+            self.fit.iter().all(|n| !n.trim().is_empty()),
+            "--fit `{}`: an empty name in the list; write the names comma-separated, e.g. --fit Kw,Kg",
+            self.fit.join(",")
+        );
         anyhow::ensure!(
             self.starts != Some(0),
             "--starts 0: at least one start is needed"
@@ -308,12 +322,7 @@ impl Args {
         Ok(Config {
             experiments,
             base,
-            fit: self
-                .fit
-                .iter()
-                .map(|s| s.trim().to_string())
-                .filter(|s| !s.is_empty())
-                .collect(),
+            fit: self.fit.iter().map(|s| s.trim().to_string()).collect(),
             bounds,
             fidelity: self.fidelity.into(),
             search: SearchOptions {
