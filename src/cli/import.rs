@@ -149,18 +149,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     report(&manifest_path, &imported, a.json, a.quiet)
 }
 
-/// Every file read, with its SHA-256.
+/// Every file read.
 fn read_all(files: &[PathBuf], format: Option<Format>) -> anyhow::Result<Vec<Source>> {
     files
         .iter()
         .map(|path| {
-            let recording = detect::read(path, format)?;
-            let sha256 = rtid::io::provenance::sha256(path)
-                .with_context(|| format!("cannot read {}", path.display()))?;
             Ok(Source {
                 path: path.clone(),
-                sha256,
-                recording,
+                recording: detect::read(path, format)?,
             })
         })
         .collect()
@@ -296,16 +292,16 @@ fn glitch_notes(s: &Source) -> Vec<String> {
 
 /// (first, last, mean) of a channel's samples (the magnitude of a complex one).
 fn stats(c: &Channel) -> (f64, f64, f64) {
-    let v: Vec<f64> = match &c.samples {
-        Samples::Real(v) => v.clone(),
-        Samples::Complex { re, im } => re.iter().zip(im).map(|(a, b)| a.hypot(*b)).collect(),
-    };
-    let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
-    (
-        v.first().copied().unwrap_or(f64::NAN),
-        v.last().copied().unwrap_or(f64::NAN),
-        mean,
-    )
+    fn of(mut v: impl ExactSizeIterator<Item = f64> + Clone) -> (f64, f64, f64) {
+        let n = v.len().max(1) as f64;
+        let mean = v.clone().sum::<f64>() / n;
+        let first = v.next().unwrap_or(f64::NAN);
+        (first, v.last().unwrap_or(first), mean)
+    }
+    match &c.samples {
+        Samples::Real(v) => of(v.iter().copied()),
+        Samples::Complex { re, im } => of(re.iter().zip(im).map(|(a, b)| a.hypot(*b))),
+    }
 }
 
 /// The sample period in s, where the abscissa is a time evenly spaced.
@@ -327,8 +323,9 @@ fn sample_period_s(c: &Channel) -> Option<f64> {
     }
 }
 
-fn abscissa_text(c: &Channel) -> String {
-    match (&c.abscissa, sample_period_s(c)) {
+/// The abscissa in words, given the sample period [`sample_period_s`] found.
+fn abscissa_text(c: &Channel, period: Option<f64>) -> String {
+    match (&c.abscissa, period) {
         (_, Some(p)) => format!("{} s", rtid::names::Num(p)),
         (Abscissa::Uniform { start, step, unit }, None) => format!("{start} + k·{step} {unit}"),
         (Abscissa::Values { values, unit }, None) => match (values.first(), values.last()) {
@@ -362,7 +359,7 @@ fn list_json(s: &Source) -> Value {
             }
             match sample_period_s(c) {
                 Some(p) => o["sample_period_s"] = json!(p),
-                None => o["abscissa"] = json!(abscissa_text(c)),
+                None => o["abscissa"] = json!(abscissa_text(c, None)),
             }
             o
         })
@@ -394,7 +391,7 @@ fn list_table(r: &Recording) -> Table {
             c.name.clone(),
             c.unit.clone(),
             c.samples.len().to_string(),
-            abscissa_text(c),
+            abscissa_text(c, sample_period_s(c)),
             num(first),
             num(last),
             num(mean),

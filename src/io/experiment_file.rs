@@ -20,7 +20,7 @@ mod units;
 mod writer;
 
 pub use conditions::{Conditions, Excitation};
-pub use data::{Data, ServoTrace, Signal, TimeRecord};
+pub use data::{Approaches, Data, ServoTrace, Signal, TimeRecord};
 pub use sampling::{check_uniform, sample_period, NonUniform, SAMPLING_TOLERANCE};
 pub use units::{Axis, CommandUnit};
 pub use writer::write;

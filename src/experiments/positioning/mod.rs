@@ -15,7 +15,7 @@ use rand_distr::{Distribution, Normal};
 
 use crate::controller::quantise;
 use crate::input::Move;
-use crate::io::experiment_file::{Data, Kind, Manifest};
+use crate::io::experiment_file::{Approaches, Data, Kind, Manifest};
 use crate::model::idx::THETA_T;
 use crate::model::params::{Axis, LoopMode, Params};
 use crate::model::rest::{rest_state, Preload};
@@ -145,26 +145,13 @@ pub fn run(
 /// The experiment-file form of a positioning test's readings on `axis` (angles in
 /// rad, or lengths in m).
 pub fn to_data(measurements: &[Measurement], axis: Axis) -> Data {
-    let target = measurements.iter().map(|m| m.target).collect();
-    let direction = measurements.iter().map(|m| m.direction).collect();
-    let run = measurements.iter().map(|m| m.run).collect();
-    let deviation = measurements.iter().map(|m| m.deviation).collect();
-    match axis {
-        Axis::Rotary => Data::Positioning {
-            target_rad: target,
-            direction,
-            run,
-            deviation_rad: deviation,
-            extra: Default::default(),
-        },
-        Axis::Linear => Data::LinearPositioning {
-            target_m: target,
-            direction,
-            run,
-            deviation_m: deviation,
-            extra: Default::default(),
-        },
-    }
+    let approaches = Approaches {
+        target: measurements.iter().map(|m| m.target).collect(),
+        direction: measurements.iter().map(|m| m.direction).collect(),
+        run: measurements.iter().map(|m| m.run).collect(),
+        deviation: measurements.iter().map(|m| m.deviation).collect(),
+    };
+    Data::positioning(axis, approaches)
 }
 
 /// The readings of a positioning experiment file (`None` for another kind): rad on

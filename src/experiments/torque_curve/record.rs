@@ -7,25 +7,12 @@ use crate::model::params::{Axis, Params};
 /// The experiment-file form of a recorded curve on `axis` (torque and angle, or
 /// force and position).
 pub fn to_data(curve: &TorqueCurve, axis: Axis) -> Data {
-    let (time_s, effort, position) = (
+    Data::effort_curve(
+        axis,
         curve.time.clone(),
         curve.motor_torque.clone(),
         Some(curve.table_angle.clone()),
-    );
-    match axis {
-        Axis::Rotary => Data::TorqueCurve {
-            time_s,
-            motor_torque_nm: effort,
-            table_angle_rad: position,
-            extra: Default::default(),
-        },
-        Axis::Linear => Data::ForceCurve {
-            time_s,
-            force_n: effort,
-            table_position_m: position,
-            extra: Default::default(),
-        },
-    }
+    )
 }
 
 /// The curve of a torque-curve experiment file (`None` for another kind); on a

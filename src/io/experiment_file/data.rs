@@ -143,7 +143,62 @@ pub struct TimeRecord<'a> {
     pub table_angle_rad: &'a [f64],
 }
 
+/// The rows of a `positioning` experiment, in SI: one per approach.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Approaches {
+    /// Targets, rad or m.
+    pub target: Vec<f64>,
+    pub direction: Vec<Direction>,
+    pub run: Vec<u32>,
+    /// Measured − target, rad or m.
+    pub deviation: Vec<f64>,
+}
+
 impl Data {
+    /// A `torque_curve` on `axis`: effort in N·m and position in rad on a rotary axis,
+    /// N and m on a linear one.
+    pub fn effort_curve(
+        axis: Axis,
+        time_s: Vec<f64>,
+        effort: Vec<f64>,
+        position: Option<Vec<f64>>,
+    ) -> Data {
+        match axis {
+            Axis::Rotary => Data::TorqueCurve {
+                time_s,
+                motor_torque_nm: effort,
+                table_angle_rad: position,
+                extra: Columns::new(),
+            },
+            Axis::Linear => Data::ForceCurve {
+                time_s,
+                force_n: effort,
+                table_position_m: position,
+                extra: Columns::new(),
+            },
+        }
+    }
+
+    /// A `positioning` test on `axis` (ISO 230-2 in angles or in lengths).
+    pub fn positioning(axis: Axis, a: Approaches) -> Data {
+        match axis {
+            Axis::Rotary => Data::Positioning {
+                target_rad: a.target,
+                direction: a.direction,
+                run: a.run,
+                deviation_rad: a.deviation,
+                extra: Columns::new(),
+            },
+            Axis::Linear => Data::LinearPositioning {
+                target_m: a.target,
+                direction: a.direction,
+                run: a.run,
+                deviation_m: a.deviation,
+                extra: Columns::new(),
+            },
+        }
+    }
+
     /// The channels of a `frequency_response_time` record (torque- or current-driven);
     /// `None` for other kinds.
     pub fn time_record(&self) -> Option<TimeRecord<'_>> {

@@ -17,6 +17,7 @@
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 
+use super::text::parse_number;
 use super::units::{self, Quantity};
 use super::{Abscissa, Channel, FormatError, Location, Recording, Samples};
 
@@ -144,13 +145,7 @@ impl<'a> Table<'a> {
     }
 
     fn number(&self, cell: &str) -> Option<f64> {
-        let cell = cell.trim();
-        let text = if self.separator.decimal_comma() {
-            cell.replace(',', ".")
-        } else {
-            cell.to_string()
-        };
-        text.parse::<f64>().ok().filter(|v| v.is_finite())
+        parse_number(cell.as_bytes(), self.separator.decimal_comma()).filter(|v| v.is_finite())
     }
 
     fn push(&mut self, line: usize, text: &str) -> Result<(), FormatError> {

@@ -64,7 +64,7 @@
 use std::io::BufReader;
 use std::path::Path;
 
-use super::twincat_scope::text::Lines;
+use super::text::Lines;
 use super::{Abscissa, Channel, FormatError, Location, Recording, Samples};
 
 mod cells;

@@ -13,6 +13,7 @@ pub mod delimited;
 pub mod detect;
 pub mod epos_studio;
 pub mod mat;
+mod text;
 pub mod twincat_scope;
 pub mod uff;
 pub mod units;

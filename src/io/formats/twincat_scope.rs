@@ -68,7 +68,6 @@ use super::{Abscissa, Channel, FormatError, Location, Recording, Samples};
 mod data;
 mod header;
 mod properties;
-pub(in crate::io::formats) mod text;
 
 #[cfg(test)]
 mod tests;
@@ -92,7 +91,7 @@ pub fn sniff(first_line: &str) -> bool {
 pub fn read(path: &Path) -> Result<Recording, FormatError> {
     let file = crate::io::open_input(path)
         .map_err(|e| FormatError::new(path, Location::File, format!("cannot open: {e}")))?;
-    let mut lines = text::Lines::new(BufReader::with_capacity(1 << 16, file));
+    let mut lines = super::text::Lines::new(BufReader::with_capacity(1 << 16, file));
     let (header, pending) = header::read(&mut lines, path)?;
     let mut columns = data::Columns::new(&header);
     let (first_line, row_notes) = data::read_rows(&mut lines, pending, &mut columns, path)?;

@@ -99,21 +99,24 @@ struct Local {
 /// their median slope, so that a ramp or a sine, even at the record's ends, predicts
 /// itself and a glitch among the neighbours moves nothing.
 fn local(values: &[f64], i: usize) -> Local {
+    const W: usize = 2 * HALF_WINDOW;
     let n = values.len();
-    let lo = i.saturating_sub(HALF_WINDOW).min(n - 2 * HALF_WINDOW - 1);
-    let hi = lo + 2 * HALF_WINDOW + 1;
-    let mut slopes: Vec<f64> = (lo..hi - 1)
-        .filter(|&j| j != i && j + 1 != i)
-        .map(|j| values[j + 1] - values[j])
-        .collect();
-    let slope = median(&mut slopes);
+    let lo = i.saturating_sub(HALF_WINDOW).min(n - W - 1);
+    let neighbours = (lo..=lo + W).filter(|&j| j != i);
+    // On the stack: this runs once per sample of every channel.
+    let (mut slopes, mut k) = ([0.0; W], 0);
+    for j in (lo..lo + W).filter(|&j| j != i && j + 1 != i) {
+        slopes[k] = values[j + 1] - values[j];
+        k += 1;
+    }
+    let slope = median(&mut slopes[..k]);
     let slope = if slope.is_nan() { 0.0 } else { slope };
-    let carried: Vec<f64> = (lo..hi)
-        .filter(|&j| j != i)
-        .map(|j| values[j] + (i as f64 - j as f64) * slope)
-        .collect();
-    let prediction = median(&mut carried.clone());
-    let mut spread: Vec<f64> = carried.iter().map(|c| (c - prediction).abs()).collect();
+    let mut carried = [0.0; W];
+    for (c, j) in carried.iter_mut().zip(neighbours) {
+        *c = values[j] + (i as f64 - j as f64) * slope;
+    }
+    let prediction = median(&mut carried);
+    let mut spread = carried.map(|c| (c - prediction).abs());
     Local {
         prediction,
         scale: 1.4826 * median(&mut spread),

@@ -90,7 +90,7 @@ pub struct Resolved<'a> {
 
 /// Looks the map's channel up in `recordings` (CHANNEL as split, else the whole
 /// right-hand side), and its unit: the map's, else the channel's own label.
-pub fn resolve<'a>(spec: &MapSpec, recordings: &'a [Recording]) -> Result<Resolved<'a>, String> {
+pub fn resolve<'a>(spec: &MapSpec, recordings: &[&'a Recording]) -> Result<Resolved<'a>, String> {
     let (spec, (file, channel)) = match (
         find(recordings, &spec.channel),
         find(recordings, &spec.right),
@@ -132,7 +132,7 @@ pub fn resolve<'a>(spec: &MapSpec, recordings: &'a [Recording]) -> Result<Resolv
 }
 
 /// How many of the recordings have a channel named `name`.
-fn files_with(recordings: &[Recording], name: &str) -> usize {
+fn files_with(recordings: &[&Recording], name: &str) -> usize {
     recordings
         .iter()
         .filter(|r| r.channels.iter().any(|c| c.name == name))
@@ -141,7 +141,7 @@ fn files_with(recordings: &[Recording], name: &str) -> usize {
 
 /// The channel named `name`, and its file's index: the first file that has one
 /// ([`resolve`] refuses a name several files share).
-fn find<'a>(recordings: &'a [Recording], name: &str) -> Option<(usize, &'a Channel)> {
+fn find<'a>(recordings: &[&'a Recording], name: &str) -> Option<(usize, &'a Channel)> {
     recordings
         .iter()
         .enumerate()
@@ -149,7 +149,7 @@ fn find<'a>(recordings: &'a [Recording], name: &str) -> Option<(usize, &'a Chann
 }
 
 /// The message for a channel not found: the ones there are.
-fn missing(spec: &MapSpec, recordings: &[Recording]) -> String {
+fn missing(spec: &MapSpec, recordings: &[&Recording]) -> String {
     let names: Vec<String> = recordings
         .iter()
         .flat_map(|r| r.channels.iter().map(|c| format!("`{}`", c.name)))
@@ -217,12 +217,16 @@ mod tests {
     #[test]
     fn a_channel_named_with_star_and_colon_is_found_whole() {
         let recs = [recording(&[("a*b:c", "V"), ("q", "")])];
-        let r = resolve(&parse("x=a*b:c").unwrap(), &recs).unwrap();
+        let r = resolve(&parse("x=a*b:c").unwrap(), &recs.iter().collect::<Vec<_>>()).unwrap();
         assert_eq!(r.channel.name, "a*b:c");
         assert_eq!(r.factor, 1.0);
-        let e = resolve(&parse("x=q").unwrap(), &recs).unwrap_err();
+        let e = resolve(&parse("x=q").unwrap(), &recs.iter().collect::<Vec<_>>()).unwrap_err();
         assert!(e.contains("no unit"), "{e}");
-        let e = resolve(&parse("x=nope:m").unwrap(), &recs).unwrap_err();
+        let e = resolve(
+            &parse("x=nope:m").unwrap(),
+            &recs.iter().collect::<Vec<_>>(),
+        )
+        .unwrap_err();
         assert!(e.contains("`a*b:c`") && e.contains("`q`"), "{e}");
     }
 
@@ -232,16 +236,20 @@ mod tests {
             recording(&[("speed", "rpm")]),
             recording(&[("speed", "rpm")]),
         ];
-        let e = resolve(&parse("x=speed").unwrap(), &recs).unwrap_err();
+        let e = resolve(&parse("x=speed").unwrap(), &recs.iter().collect::<Vec<_>>()).unwrap_err();
         assert!(e.contains("several of the files"), "{e}");
     }
 
     #[test]
     fn the_unit_is_that_of_channel_times_scale() {
         let recs = [recording(&[("vir", "V"), ("w", "rpm")])];
-        let r = resolve(&parse("effort=vir*35.15:N").unwrap(), &recs).unwrap();
+        let r = resolve(
+            &parse("effort=vir*35.15:N").unwrap(),
+            &recs.iter().collect::<Vec<_>>(),
+        )
+        .unwrap();
         assert_eq!(r.factor, 35.15);
-        let r = resolve(&parse("speed=w").unwrap(), &recs).unwrap();
+        let r = resolve(&parse("speed=w").unwrap(), &recs.iter().collect::<Vec<_>>()).unwrap();
         assert!((r.factor - std::f64::consts::PI / 30.0).abs() < 1e-15);
     }
 }

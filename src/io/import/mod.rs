@@ -13,7 +13,7 @@ use std::path::PathBuf;
 use serde_json::{json, Value};
 
 use crate::io::experiment_file::{
-    CommandUnit, Conditions, Data, Direction, Manifest, ServoTrace, Signal,
+    Approaches, CommandUnit, Conditions, Data, Direction, Manifest, ServoTrace, Signal,
 };
 use crate::io::formats::units::{self, Quantity};
 use crate::io::formats::{Abscissa, Channel, Recording, Samples};
@@ -21,11 +21,10 @@ use crate::model::Axis;
 use kinds::{ImportKind, Role};
 use mapping::{MapSpec, Resolved};
 
-/// A file read, with what its provenance needs.
+/// A file read.
 #[derive(Clone, Debug)]
 pub struct Source {
     pub path: PathBuf,
-    pub sha256: String,
     pub recording: Recording,
 }
 
@@ -59,12 +58,15 @@ pub struct ImportError(pub String);
 struct Filled<'a> {
     role: &'static Role,
     resolved: Resolved<'a>,
+    /// The samples; a complex response's (`frf`) magnitudes.
     values: Vec<f64>,
+    /// A complex response's phases, rad.
+    phase: Option<Vec<f64>>,
 }
 
 /// Builds the experiment `request` asks for from `sources`.
 pub fn build(sources: &[Source], request: &Request) -> Result<Imported, ImportError> {
-    let recordings: Vec<Recording> = sources.iter().map(|s| s.recording.clone()).collect();
+    let recordings: Vec<&Recording> = sources.iter().map(|s| &s.recording).collect();
     let filled = fill(&recordings, request)?;
     let data = if request.kind == ImportKind::Positioning {
         positioning(&filled)?
@@ -73,7 +75,7 @@ pub fn build(sources: &[Source], request: &Request) -> Result<Imported, ImportEr
         assemble(request.kind, &filled, axis_values)?
     };
     let findings = findings(sources, &filled);
-    let manifest = manifest(sources, request, &findings);
+    let manifest = manifest(sources, request, &findings)?;
     Ok(Imported {
         data,
         manifest,
@@ -83,7 +85,7 @@ pub fn build(sources: &[Source], request: &Request) -> Result<Imported, ImportEr
 
 /// Every map resolved to its role and converted.
 fn fill<'a>(
-    recordings: &'a [Recording],
+    recordings: &[&'a Recording],
     request: &Request,
 ) -> Result<Vec<Filled<'a>>, ImportError> {
     let kind = request.kind;
@@ -109,11 +111,12 @@ fn fill<'a>(
             )));
         }
         let resolved = resolve(spec, role, recordings)?;
-        let values = converted(&resolved, role)?;
+        let (values, phase) = converted(&resolved, role)?;
         filled.push(Filled {
             role,
             resolved,
             values,
+            phase,
         });
     }
     let missing: Vec<&str> = kind
@@ -138,7 +141,7 @@ fn fill<'a>(
 fn resolve<'a>(
     spec: &MapSpec,
     role: &Role,
-    recordings: &'a [Recording],
+    recordings: &[&'a Recording],
 ) -> Result<Resolved<'a>, ImportError> {
     let resolved = match mapping::resolve(spec, recordings) {
         Err(e) if role.quantities == [Quantity::Number] && !e.contains("no channel") => {
@@ -166,22 +169,18 @@ fn resolve<'a>(
     Ok(resolved)
 }
 
-/// The channel's samples in SI (a complex channel only for `frf`, as magnitude-phase
-/// pairs interleaved: |H|, ∠H, …).
-fn converted(r: &Resolved, role: &Role) -> Result<Vec<f64>, ImportError> {
+/// The channel's samples in SI; a complex channel (only for `frf`) as magnitudes and
+/// phases.
+fn converted(r: &Resolved, role: &Role) -> Result<(Vec<f64>, Option<Vec<f64>>), ImportError> {
     match (&r.channel.samples, role.name) {
         // `+ 0.0` writes a flipped zero as 0, not -0.
-        (Samples::Real(v), _) => Ok(v.iter().map(|x| x * r.factor + 0.0).collect()),
-        (Samples::Complex { re, im }, "frf") => Ok(re
-            .iter()
-            .zip(im)
-            .flat_map(|(a, b)| {
-                [
-                    a.hypot(*b) * r.factor.abs(),
-                    b.atan2(*a) + sign_turn(r.factor),
-                ]
-            })
-            .collect()),
+        (Samples::Real(v), _) => Ok((v.iter().map(|x| x * r.factor + 0.0).collect(), None)),
+        (Samples::Complex { re, im }, "frf") => {
+            let pairs = re.iter().zip(im);
+            let magnitude = pairs.clone().map(|(a, b)| a.hypot(*b) * r.factor.abs());
+            let phase = pairs.map(|(a, b)| wrap(b.atan2(*a) + sign_turn(r.factor)));
+            Ok((magnitude.collect(), Some(phase.collect())))
+        }
         (Samples::Complex { .. }, _) => Err(ImportError(format!(
             "--map {}: `{}` is complex; only `frf` takes a complex channel",
             r.spec.given, r.channel.name
@@ -264,11 +263,7 @@ fn role<'a>(filled: &'a [Filled], name: &str) -> Option<&'a Filled<'a>> {
 /// The experiment's data, every role the length of the time base.
 fn assemble(kind: ImportKind, filled: &[Filled], base: Vec<f64>) -> Result<Data, ImportError> {
     for f in filled {
-        let n = if f.role.name == "frf" {
-            f.values.len() / 2
-        } else {
-            f.values.len()
-        };
+        let n = f.values.len();
         if n != base.len() {
             return Err(ImportError(format!(
                 "`{}` ({}) has {n} samples but the {} base {}",
@@ -357,21 +352,12 @@ fn servo_trace(filled: &[Filled], time_s: Vec<f64>) -> Result<Data, ImportError>
 
 fn torque_curve(filled: &[Filled], time_s: Vec<f64>) -> Result<Data, ImportError> {
     let effort = values(filled, "effort").ok_or_else(|| ImportError("effort not mapped".into()))?;
-    let position = values(filled, "position");
-    Ok(match axis(filled)? {
-        Axis::Rotary => Data::TorqueCurve {
-            time_s,
-            motor_torque_nm: effort,
-            table_angle_rad: position,
-            extra: Default::default(),
-        },
-        Axis::Linear => Data::ForceCurve {
-            time_s,
-            force_n: effort,
-            table_position_m: position,
-            extra: Default::default(),
-        },
-    })
+    Ok(Data::effort_curve(
+        axis(filled)?,
+        time_s,
+        effort,
+        values(filled, "position"),
+    ))
 }
 
 fn frequency_response(filled: &[Filled], frequency_hz: Vec<f64>) -> Result<Data, ImportError> {
@@ -388,9 +374,8 @@ fn frequency_response(filled: &[Filled], frequency_hz: Vec<f64>) -> Result<Data,
                         "frf gives the phase: do not map phase too".into(),
                     ));
                 }
-                let gain = f.values.chunks(2).map(|p| 20.0 * p[0].log10()).collect();
-                let phase = f.values.chunks(2).map(|p| wrap(p[1])).collect();
-                (gain, Some(phase))
+                let gain = f.values.iter().map(|m| 20.0 * m.log10()).collect();
+                (gain, f.phase.clone())
             }
             (None, Some(g)) => {
                 let gain = match g.resolved.unit.quantity {
@@ -500,22 +485,13 @@ fn positioning(filled: &[Filled]) -> Result<Data, ImportError> {
                 })
         })
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(match axis(filled)? {
-        Axis::Rotary => Data::Positioning {
-            target_rad: target.values.clone(),
-            direction: directions,
-            run: runs,
-            deviation_rad: deviation.values.clone(),
-            extra: Default::default(),
-        },
-        Axis::Linear => Data::LinearPositioning {
-            target_m: target.values.clone(),
-            direction: directions,
-            run: runs,
-            deviation_m: deviation.values.clone(),
-            extra: Default::default(),
-        },
-    })
+    let approaches = Approaches {
+        target: target.values.clone(),
+        direction: directions,
+        run: runs,
+        deviation: deviation.values.clone(),
+    };
+    Ok(Data::positioning(axis(filled)?, approaches))
 }
 
 /// Glitches in every mapped real channel, gaps in the time base, and the readers'
@@ -580,20 +556,27 @@ pub fn channel_findings(file: &std::path::Path, channel: &Channel, is_time: bool
 /// The manifest: the kind, conditions and mechanism asked, and where the data came
 /// from (files with their SHA-256 and format, the maps and conditions as given,
 /// rtid's version, the findings).
-fn manifest(sources: &[Source], request: &Request, findings: &[String]) -> Manifest {
+fn manifest(
+    sources: &[Source],
+    request: &Request,
+    findings: &[String],
+) -> Result<Manifest, ImportError> {
     let mut m = Manifest::new(request.kind.kind());
     m.mechanism = request.mechanism.clone();
     m.conditions = request.conditions.clone();
-    let files: Vec<Value> = sources
+    let files = sources
         .iter()
         .map(|s| {
-            json!({
+            let sha256 = crate::io::provenance::sha256(&s.path).map_err(|e| {
+                ImportError(format!("{}: cannot read to hash it: {e}", s.path.display()))
+            })?;
+            Ok(json!({
                 "file": s.path.display().to_string(),
-                "sha256": s.sha256,
+                "sha256": sha256,
                 "format": s.recording.format,
-            })
+            }))
         })
-        .collect();
+        .collect::<Result<Vec<Value>, ImportError>>()?;
     m.extra.insert(
         "import".into(),
         json!({
@@ -604,5 +587,5 @@ fn manifest(sources: &[Source], request: &Request, findings: &[String]) -> Manif
             "rtid": crate::VERSION,
         }),
     );
-    m
+    Ok(m)
 }

@@ -5,7 +5,7 @@ use std::io::BufRead;
 use std::path::Path;
 
 use super::cells::{split, Split};
-use crate::io::formats::twincat_scope::text::{Encoding, Lines};
+use crate::io::formats::text::{Encoding, Lines};
 use crate::io::formats::{FormatError, Location};
 
 /// How many `Key:` lines may precede the names.

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use super::cells::split;
 use super::header::{Header, Quirks};
-use crate::io::formats::twincat_scope::text::Lines;
+use crate::io::formats::text::Lines;
 use crate::io::formats::{FormatError, Location};
 
 /// Rows reserved before reading, whatever the header declares.

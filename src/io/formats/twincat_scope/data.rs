@@ -10,7 +10,7 @@ use std::io::BufRead;
 use std::path::Path;
 
 use super::header::{is_blank, starts_with_number, Header, PendingRow};
-use super::text::{parse_number, Lines};
+use crate::io::formats::text::{parse_number, Lines};
 use crate::io::formats::{FormatError, Location};
 
 /// A time above this many milliseconds (317 years) is a Windows file time (export
@@ -270,7 +270,7 @@ impl RowState {
 
 #[cfg(test)]
 mod tests {
-    use super::super::text::parse_number;
+    use crate::io::formats::text::parse_number;
 
     #[test]
     fn numbers_with_either_decimal_mark() {

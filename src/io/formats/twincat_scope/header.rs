@@ -13,7 +13,7 @@ use std::io::BufRead;
 use std::path::Path;
 
 use super::properties::{self, Property};
-use super::text::{Encoding, Lines};
+use crate::io::formats::text::{Encoding, Lines};
 use crate::io::formats::{FormatError, Location};
 
 /// How many lines may precede the channel block's `Name` row.
@@ -77,7 +77,7 @@ pub(super) fn read<R: BufRead>(
     path: &Path,
 ) -> Result<(Header, Option<PendingRow>), FormatError> {
     let at = |n: usize, m: String| FormatError::new(path, Location::Line(n), m);
-    let line_error = |n: usize, e: super::text::LineError| at(n, e.to_string());
+    let line_error = |n: usize, e: crate::io::formats::text::LineError| at(n, e.to_string());
     let first = match lines.next_line().map_err(|e| line_error(1, e))? {
         Some(l) => l,
         None => return Err(FormatError::new(path, Location::File, "the file is empty")),
@@ -160,7 +160,7 @@ pub(super) fn is_blank(bytes: &[u8], sep: u8) -> bool {
 /// Whether a line's first cell is a number (a data row, not a property row).
 pub(super) fn starts_with_number(bytes: &[u8], sep: u8) -> bool {
     let cell = bytes.split(|&b| b == sep).next().unwrap_or(&[]);
-    super::text::parse_number(cell, sep != b',').is_some()
+    crate::io::formats::text::parse_number(cell, sep != b',').is_some()
 }
 
 /// The header from its property rows: layout first, then what each channel declares.

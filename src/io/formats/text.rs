@@ -1,5 +1,6 @@
-//! A text export read line by line, for the delimited formats (TwinCAT Scope here,
-//! and [`super::super::epos_studio`]): 1-based line numbers, LF or CR LF line ends,
+//! A text export read line by line, for the text formats ([`super::twincat_scope`],
+//! [`super::epos_studio`]), and numbers with a decimal point or comma
+//! ([`parse_number`], [`super::delimited`] too): 1-based line numbers, LF or CR LF line ends,
 //! whether the last line was cut off before its line end, and the decoding of header
 //! text that is UTF-8 or, failing that, Windows-1252.
 //!
@@ -140,7 +141,7 @@ fn windows_1252(b: u8) -> char {
 /// A number as TwinCAT writes it: with a decimal point, or a decimal comma when the
 /// comma is not the separator (the export's "DecimalMark"). `NaN` and `inf` are read
 /// as such (a REAL can hold them).
-pub(super) fn parse_number(cell: &[u8], comma_is_decimal: bool) -> Option<f64> {
+pub(in crate::io::formats) fn parse_number(cell: &[u8], comma_is_decimal: bool) -> Option<f64> {
     let cell = cell.trim_ascii();
     let mut buf = [0u8; 64];
     let text = if comma_is_decimal && cell.contains(&b',') {
