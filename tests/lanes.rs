@@ -230,3 +230,36 @@ fn lanes_of_the_direct_drive_and_two_mass_topologies_equal_lone_simulations() {
         "{stuck:?}"
     );
 }
+
+#[test]
+fn lanes_with_a_stribeck_law_equal_lone_simulations() {
+    // The worm with a Stribeck rise on every body, driven slowly enough that bodies
+    // stick and break away at their static levels in different lanes, and the
+    // direct drive's one body likewise.
+    let mut worm = presets::load("worm-gear").unwrap();
+    (worm.fsm, worm.vsm) = (0.5 * worm.fm, 2.0);
+    (worm.fsw, worm.vsw) = (0.5 * worm.fw, 1.0);
+    (worm.fst, worm.vst, worm.stribeck_shape) = (0.5 * worm.ft, 0.05, 1.0);
+    let cases: [Case; 8] = std::array::from_fn(|l| Case {
+        hz: 5.0 + 7.0 * l as f64,
+        amplitude: 0.3 + 0.4 * l as f64,
+        offset: 0.0,
+        load: if l == 4 { 2.0 } else { 0.0 },
+        y0: [0.0; NSTATE],
+    });
+    let lone = compare(&worm, &cases, 20_000);
+    let stuck: Vec<usize> = lone.iter().map(|r| r.stuck_steps).collect();
+    assert!(stuck.windows(2).any(|w| w[0] != w[1]), "{stuck:?}");
+    let mut direct = presets::load("direct-drive").unwrap();
+    (direct.fst, direct.vst) = (0.5, 0.2);
+    let cases: [Case; 8] = std::array::from_fn(|l| Case {
+        hz: 2.0 + 3.0 * l as f64,
+        amplitude: 0.5 + 1.5 * l as f64,
+        offset: 0.0,
+        load: 0.0,
+        y0: [0.0; NSTATE],
+    });
+    let lone = compare(&direct, &cases, 20_000);
+    let stuck: Vec<usize> = lone.iter().map(|r| r.stuck_steps).collect();
+    assert!(stuck.iter().any(|&s| s > 0), "{stuck:?}");
+}

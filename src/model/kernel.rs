@@ -18,7 +18,9 @@
 //! Jt·ωt' = Tw − Ct·ωt − m·g·e·sin(θt + ψ) + Tload − friction_t
 //! ```
 //!
-//! Friction is the stick/slip clamp of friction.rs. Tload is the lane's external
+//! Friction is the stick/slip clamp of friction.rs: Coulomb levels, or a Stribeck
+//! law whose level is evaluated at each stage's velocity (the kernel is compiled for
+//! both, `S`, and the drive picks one outside the step loop). Tload is the lane's external
 //! table torque, which includes the drive's constant `Tload` parameter (added by
 //! the caller, see [`Kernel::step`]).
 //!
@@ -61,7 +63,10 @@
 
 use super::backlash::mesh_torque_lanes;
 use super::drive::{idx::*, taylor_sin_cos, Drive, NSTATE, PHASE_RESYNC, SMALL_ANGLE};
-use super::friction::{decide_lanes, stop_at_reversal, stop_at_reversal_lanes, Friction};
+use super::friction::Stribeck;
+use super::friction::{
+    decide_direction_lanes, decide_lanes, stop_at_reversal, stop_at_reversal_lanes, Friction,
+};
 use super::lanes::Lanes;
 
 /// The state of `L` lanes: `y[i][l]` is state `i` (see [`idx`](super::drive::idx)) of lane `l`.
@@ -76,6 +81,9 @@ struct LaneState<const L: usize> {
     friction: [[f64; L]; 3],
     /// 1 while the body moves, 0 while it sticks.
     free: [[f64; L]; 3],
+    /// With a Stribeck law: the sign of the friction of motor, shaft, table (±1
+    /// against the motion, 0 when stuck), its level evaluated at each stage.
+    direction: [[f64; L]; 3],
     /// free / inertia: net torque → acceleration (0 while stuck).
     gain: [[f64; L]; 3],
     /// Shaft angle, and sin, cos of the fluctuation phase there.
@@ -98,6 +106,7 @@ impl<const L: usize> Default for LaneState<L> {
         LaneState {
             friction: [[0.0; L]; 3],
             free: [[1.0; L]; 3],
+            direction: [[0.0; L]; 3],
             gain: [[0.0; L]; 3],
             shaft: [0.0; L],
             sin: [0.0; L],
@@ -116,6 +125,7 @@ impl<const L: usize> LaneState<L> {
         LaneState {
             friction: self.friction.map(|b| [b[l]]),
             free: self.free.map(|b| [b[l]]),
+            direction: self.direction.map(|b| [b[l]]),
             gain: self.gain.map(|b| [b[l]]),
             shaft: [self.shaft[l]],
             sin: [self.sin[l]],
@@ -132,6 +142,7 @@ impl<const L: usize> LaneState<L> {
         for b in 0..3 {
             self.friction[b][l] = one.friction[b][0];
             self.free[b][l] = one.free[b][0];
+            self.direction[b][l] = one.direction[b][0];
             self.gain[b][l] = one.gain[b][0];
         }
         self.shaft[l] = one.shaft[0];
@@ -148,20 +159,39 @@ impl<const L: usize> LaneState<L> {
     }
 
     /// Decides the friction of body `b` (inverse inertia `inv_j`) from the sum `t`
-    /// of its other torques.
+    /// of its other torques and its velocity `w`: with the Coulomb level (`S` false)
+    /// its torque for the whole step, with the Stribeck law its direction.
     #[inline(always)]
-    fn decide(&mut self, b: usize, t: Lanes<L>, w: Lanes<L>, fc: f64, inv_j: f64) {
-        let (torque, free) = decide_lanes(t, w, fc);
-        self.friction[b] = torque.0;
+    fn decide<const S: bool>(&mut self, d: &Drive, b: usize, t: Lanes<L>, w: Lanes<L>, inv_j: f64) {
+        let free = match (S, &d.stribeck) {
+            (true, Some(law)) => {
+                let (direction, free) = decide_direction_lanes(t, w, law.fs[b]);
+                self.direction[b] = direction.0;
+                free
+            }
+            _ => {
+                let (torque, free) = decide_lanes(t, w, d.fc[b]);
+                self.friction[b] = torque.0;
+                free
+            }
+        };
         self.free[b] = free.0;
         self.gain[b] = (free * inv_j).0;
     }
 
-    /// The acceleration of body `b` under the other torques `t`: (t − friction)/J,
-    /// 0 while stuck. (free ∈ {0, 1}, so this equals ((t − friction)·free)/J exactly.)
+    /// The acceleration of body `b` at velocity `w` under the other torques `t`:
+    /// (t − friction)/J, 0 while stuck. (free ∈ {0, 1}, so this equals
+    /// ((t − friction)·free)/J exactly.) With the Stribeck law (`S`) the friction's
+    /// level is that of `w`.
     #[inline(always)]
-    fn accel(&self, b: usize, t: Lanes<L>) -> Lanes<L> {
-        (t - Lanes(self.friction[b])) * Lanes(self.gain[b])
+    fn accel<const S: bool>(&self, d: &Drive, b: usize, t: Lanes<L>, w: Lanes<L>) -> Lanes<L> {
+        let friction = match (S, &d.stribeck) {
+            (true, Some(law)) => {
+                Lanes(self.direction[b]).zip(w, |sign, w| sign * law.level(b, w.abs()))
+            }
+            _ => Lanes(self.friction[b]),
+        };
+        (t - friction) * Lanes(self.gain[b])
     }
 
     /// e and e' at a step's start: sin/cos of the phase carried from the previous
@@ -334,10 +364,11 @@ impl<const L: usize> Kernel<L> {
         load: &[f64; L],
         h: f64,
     ) {
-        if d.spur {
-            self.step_with_events::<true>(d, y, motor, load, h);
-        } else {
-            self.step_with_events::<false>(d, y, motor, load, h);
+        match (d.spur, d.stribeck.is_some()) {
+            (true, false) => self.step_with_events::<true, false>(d, y, motor, load, h),
+            (false, false) => self.step_with_events::<false, false>(d, y, motor, load, h),
+            (true, true) => self.step_with_events::<true, true>(d, y, motor, load, h),
+            (false, true) => self.step_with_events::<false, true>(d, y, motor, load, h),
         }
     }
 
@@ -351,7 +382,11 @@ impl<const L: usize> Kernel<L> {
         load: &[f64; L],
         h: f64,
     ) {
-        rigid_rk4(d, &mut self.lanes, y, motor, load, h);
+        if d.stribeck.is_some() {
+            rigid_rk4::<L, true>(d, &mut self.lanes, y, motor, load, h);
+        } else {
+            rigid_rk4::<L, false>(d, &mut self.lanes, y, motor, load, h);
+        }
     }
 
     /// Whether motor, shaft and table of lane `l` were stuck during the last step.
@@ -370,7 +405,7 @@ impl<const L: usize> Kernel<L> {
     }
 
     #[inline(always)]
-    fn step_with_events<const SPUR: bool>(
+    fn step_with_events<const SPUR: bool, const S: bool>(
         &mut self,
         d: &Drive,
         y: &mut States<L>,
@@ -379,7 +414,7 @@ impl<const L: usize> Kernel<L> {
         h: f64,
     ) {
         let y0 = *y;
-        rk4::<L, SPUR>(d, &mut self.lanes, &y0, y, motor, load, Lanes::splat(h));
+        rk4::<L, SPUR, S>(d, &mut self.lanes, &y0, y, motor, load, Lanes::splat(h));
         let gaps = [SPUR && d.bg > 0.0, d.bw > 0.0];
         if !(gaps[0] || gaps[1]) {
             return;
@@ -412,7 +447,7 @@ impl<const L: usize> Kernel<L> {
             changed |= region_changed(Lanes(st.twist[1]), twist[1], d.bw);
         }
         if changed {
-            self.resolve_events::<SPUR>(d, &y0, y, motor, load, h, &twist, &rate);
+            self.resolve_events::<SPUR, S>(d, &y0, y, motor, load, h, &twist, &rate);
         }
     }
 
@@ -420,7 +455,7 @@ impl<const L: usize> Kernel<L> {
     #[cold]
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
-    fn resolve_events<const SPUR: bool>(
+    fn resolve_events<const SPUR: bool, const S: bool>(
         &mut self,
         d: &Drive,
         y0: &States<L>,
@@ -445,7 +480,7 @@ impl<const L: usize> Kernel<L> {
                 }
             }
             if let Some(s) = earliest.filter(|&s| s > 0.0 && s < 1.0) {
-                self.split_lane::<SPUR>(d, y0, y, motor, load, h, l, s);
+                self.split_lane::<SPUR, S>(d, y0, y, motor, load, h, l, s);
             }
         }
     }
@@ -454,7 +489,7 @@ impl<const L: usize> Kernel<L> {
     /// `s` of the step, alone (`L = 1`), so that its result does not depend on the
     /// other lanes.
     #[allow(clippy::too_many_arguments)]
-    fn split_lane<const SPUR: bool>(
+    fn split_lane<const SPUR: bool, const S: bool>(
         &mut self,
         d: &Drive,
         y0: &States<L>,
@@ -476,8 +511,8 @@ impl<const L: usize> Kernel<L> {
         let m2 = [s, 0.5 * (1.0 + s), 1.0].map(|at| [quadratic(&m, at)]);
         let load = [load[l]];
         let mut mid = part;
-        rk4::<1, SPUR>(d, &mut one, &part, &mut mid, &m1, &load, Lanes([s * h]));
-        rk4::<1, SPUR>(
+        rk4::<1, SPUR, S>(d, &mut one, &part, &mut mid, &m1, &load, Lanes([s * h]));
+        rk4::<1, SPUR, S>(
             d,
             &mut one,
             &mid,
@@ -580,7 +615,7 @@ fn unbalance_torque(d: &Drive, table_angle: f64) -> f64 {
 /// per step on the roller-gear cam, mostly spills). Each lane is computed alone, so
 /// lanes equal lone runs.
 #[inline(never)]
-fn rigid_rk4<const L: usize>(
+fn rigid_rk4<const L: usize, const S: bool>(
     d: &Drive,
     st: &mut LaneState<L>,
     y: &mut States<L>,
@@ -593,27 +628,87 @@ fn rigid_rk4<const L: usize>(
         let m = [motor[0][l], motor[1][l], motor[2][l]];
         let torque = |t: f64, w: f64, m: f64| m - d.ct * w + rigid_unbalance(d, t) + load[l];
         let first = torque(t1, w1, m[0]);
-        let friction = Friction::decide(first, w1, d.fc[2]);
-        let accel = |t: f64| friction.net(t) * d.inv_jt;
-        let a1 = accel(first);
+        let friction = rigid_friction::<S>(d, first, w1);
+        let accel = |t: f64, w: f64| friction.net(t, w) * d.inv_jt;
+        let a1 = accel(first, w1);
         let (t2, w2) = (t1 + 0.5 * h * w1, w1 + 0.5 * h * a1);
-        let a2 = accel(torque(t2, w2, m[1]));
+        let a2 = accel(torque(t2, w2, m[1]), w2);
         let (t3, w3) = (t1 + 0.5 * h * w2, w1 + 0.5 * h * a2);
-        let a3 = accel(torque(t3, w3, m[1]));
+        let a3 = accel(torque(t3, w3, m[1]), w3);
         let (t4, w4) = (t1 + h * w3, w1 + h * a3);
-        let a4 = accel(torque(t4, w4, m[2]));
+        let a4 = accel(torque(t4, w4, m[2]), w4);
         let sixth = h * (1.0 / 6.0);
         let angle = t1 + sixth * (w1 + 2.0 * (w2 + w3) + w4);
         let mut speed = w1 + sixth * (a1 + 2.0 * (a2 + a3) + a4);
-        stop_at_reversal(w1, &mut speed, d.fc[2]);
+        stop_at_reversal(w1, &mut speed, static_level::<S>(d, 2));
         for (pos, vel) in [(THETA_M, OMEGA_M), (THETA_W, OMEGA_W), (THETA_T, OMEGA_T)] {
             y[pos][l] = angle;
             y[vel][l] = speed;
         }
         // Motor and shaft are the table: they stick when it does.
         for b in 0..3 {
-            st.free[b][l] = friction.free;
+            st.free[b][l] = friction.free();
         }
+    }
+}
+
+/// The rigid body's friction over one step: the Coulomb decision, or the Stribeck
+/// direction with the law to evaluate at each stage.
+#[derive(Clone, Copy)]
+enum RigidFriction<'a> {
+    Coulomb(Friction),
+    Stribeck {
+        direction: f64,
+        free: f64,
+        law: &'a Stribeck,
+    },
+}
+
+impl RigidFriction<'_> {
+    /// The net torque at velocity `w` under the other torques `t` (0 while stuck).
+    #[inline(always)]
+    fn net(self, t: f64, w: f64) -> f64 {
+        match self {
+            RigidFriction::Coulomb(f) => f.net(t),
+            RigidFriction::Stribeck {
+                direction,
+                free,
+                law,
+            } => (t - direction * law.level(2, w.abs())) * free,
+        }
+    }
+
+    fn free(self) -> f64 {
+        match self {
+            RigidFriction::Coulomb(f) => f.free,
+            RigidFriction::Stribeck { free, .. } => free,
+        }
+    }
+}
+
+/// The rigid body's stick decision from the torque `t` on it at velocity `w`.
+#[inline(always)]
+fn rigid_friction<const S: bool>(d: &Drive, t: f64, w: f64) -> RigidFriction<'_> {
+    match (S, &d.stribeck) {
+        (true, Some(law)) => {
+            let (direction, free) = decide_direction_lanes(Lanes([t]), Lanes([w]), law.fs[2]);
+            RigidFriction::Stribeck {
+                direction: direction.0[0],
+                free: free.0[0],
+                law,
+            }
+        }
+        _ => RigidFriction::Coulomb(Friction::decide(t, w, d.fc[2])),
+    }
+}
+
+/// The level body `b` must exceed to break away: its Coulomb friction, or with the
+/// Stribeck law (`S`) its static friction.
+#[inline(always)]
+fn static_level<const S: bool>(d: &Drive, b: usize) -> f64 {
+    match (S, &d.stribeck) {
+        (true, Some(law)) => law.fs[b],
+        _ => d.fc[b],
     }
 }
 
@@ -641,7 +736,7 @@ fn axpy<const L: usize>(y: &States<L>, a: Lanes<L>, k: &States<L>) -> States<L> 
 /// the stop of sliding bodies whose velocity reversed (friction.rs). Stage values
 /// are locals, not fields, so the compiler can keep them in registers.
 #[inline(always)]
-fn rk4<const L: usize, const SPUR: bool>(
+fn rk4<const L: usize, const SPUR: bool, const S: bool>(
     d: &Drive,
     st: &mut LaneState<L>,
     y0: &States<L>,
@@ -652,32 +747,33 @@ fn rk4<const L: usize, const SPUR: bool>(
 ) {
     let half = h.map(|h| 0.5 * h);
     let load = Lanes(*load);
-    let k1 = derivative::<L, SPUR, true>(d, y0, Lanes(motor[0]), load, st);
-    let k2 = derivative::<L, SPUR, false>(d, &axpy(y0, half, &k1), Lanes(motor[1]), load, st);
-    let k3 = derivative::<L, SPUR, false>(d, &axpy(y0, half, &k2), Lanes(motor[1]), load, st);
-    let k4 = derivative::<L, SPUR, false>(d, &axpy(y0, h, &k3), Lanes(motor[2]), load, st);
+    let k1 = derivative::<L, SPUR, true, S>(d, y0, Lanes(motor[0]), load, st);
+    let k2 = derivative::<L, SPUR, false, S>(d, &axpy(y0, half, &k1), Lanes(motor[1]), load, st);
+    let k3 = derivative::<L, SPUR, false, S>(d, &axpy(y0, half, &k2), Lanes(motor[1]), load, st);
+    let k4 = derivative::<L, SPUR, false, S>(d, &axpy(y0, h, &k3), Lanes(motor[2]), load, st);
     let sixth = h.map(|h| h * (1.0 / 6.0));
     for i in 0..NSTATE {
         let (a, b, c, e) = (Lanes(k1[i]), Lanes(k2[i]), Lanes(k3[i]), Lanes(k4[i]));
         y[i] = (Lanes(y0[i]) + sixth * (a + 2.0 * (b + c) + e)).0;
     }
-    let stop =
-        |y: &States<L>, i: usize, fc: f64| stop_at_reversal_lanes(Lanes(y0[i]), Lanes(y[i]), fc).0;
-    y[OMEGA_M] = stop(y, OMEGA_M, d.fc[0]);
+    let stop = |y: &States<L>, i: usize, b: usize| {
+        stop_at_reversal_lanes(Lanes(y0[i]), Lanes(y[i]), static_level::<S>(d, b)).0
+    };
+    y[OMEGA_M] = stop(y, OMEGA_M, 0);
     if SPUR {
-        y[OMEGA_W] = stop(y, OMEGA_W, d.fc[1]);
+        y[OMEGA_W] = stop(y, OMEGA_W, 1);
     } else {
         y[THETA_W] = y[THETA_M];
         y[OMEGA_W] = y[OMEGA_M];
     }
-    y[OMEGA_T] = stop(y, OMEGA_T, d.fc[2]);
+    y[OMEGA_T] = stop(y, OMEGA_T, 2);
 }
 
 /// The right-hand side of the equations of motion for every lane. With `FIRST`
 /// (a step's first stage), each body's stick state is decided from the torques at
 /// `y`, and the step-start values are stored in `st` for the later stages.
 #[inline(always)]
-fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
+fn derivative<const L: usize, const SPUR: bool, const FIRST: bool, const S: bool>(
     d: &Drive,
     y: &States<L>,
     motor: Lanes<L>,
@@ -711,9 +807,9 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
     };
     let table = tw - d.ct * wt + unbalance + load;
     if FIRST {
-        st.decide(2, table, wt, d.fc[2], d.inv_jt);
+        st.decide::<S>(d, 2, table, wt, d.inv_jt);
     }
-    let at = st.accel(2, table);
+    let at = st.accel::<S>(d, 2, table, wt);
     let ax = (-d.cb * vw - d.kb * xw - tw * d.inv_r) * d.inv_mw;
 
     let mut out = [[0.0; L]; NSTATE];
@@ -728,18 +824,18 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool>(
         let m = motor - d.cm * wm - d.rg * tg;
         let s = tg - d.cw * ws - lever * tw;
         if FIRST {
-            st.decide(0, m, wm, d.fc[0], d.inv_jm);
-            st.decide(1, s, ws, d.fc[1], d.inv_jw);
+            st.decide::<S>(d, 0, m, wm, d.inv_jm);
+            st.decide::<S>(d, 1, s, ws, d.inv_jw);
         }
-        out[OMEGA_W] = st.accel(1, s).0;
+        out[OMEGA_W] = st.accel::<S>(d, 1, s, ws).0;
         out[THETA_W] = ws.0;
-        st.accel(0, m)
+        st.accel::<S>(d, 0, m, wm)
     } else {
         let m = motor - d.cm * wm - lever * tw;
         if FIRST {
-            st.decide(0, m, wm, d.fc[0], d.inv_jm);
+            st.decide::<S>(d, 0, m, wm, d.inv_jm);
         }
-        let a = st.accel(0, m);
+        let a = st.accel::<S>(d, 0, m, wm);
         out[OMEGA_W] = a.0;
         out[THETA_W] = wm.0;
         a

@@ -257,6 +257,23 @@ pub struct Params {
     pub fw: f64,
     /// Table Coulomb friction torque, N·m (N).
     pub ft: f64,
+    /// Stribeck rise of the motor's friction: its static (break-away) level above
+    /// `fm`, N·m (N); 0, the default, is the Coulomb law (docs/model.md §2).
+    pub fsm: f64,
+    /// Stribeck rise of the driving shaft's friction above `fw`, N·m; spur gear only.
+    pub fsw: f64,
+    /// Stribeck rise of the table's friction above `ft`, N·m (N).
+    pub fst: f64,
+    /// Stribeck speed of the motor's friction, rad/s (m/s): the rise falls to 1/e at
+    /// this speed.
+    pub vsm: f64,
+    /// Stribeck speed of the driving shaft's friction, rad/s; spur gear only.
+    pub vsw: f64,
+    /// Stribeck speed of the table's friction, rad/s (m/s).
+    pub vst: f64,
+    /// Shape exponent δ of the Stribeck curves, exp(−(|ω|/vs)^δ): 2 (Gaussian, the
+    /// default) or 1 (exponential), or any positive value.
+    pub stribeck_shape: f64,
     /// Spur-gear torsional stiffness, N·m/rad in driving-shaft units; spur gear only.
     pub kg: Option<f64>,
     /// Drive torsional stiffness, N·m/rad in table units (two_mass: the coupling;
@@ -428,6 +445,7 @@ impl Params {
                 meaning: s.meaning,
             });
         }
+        self.check_stribeck()?;
         if self.unbalance_mass > 0.0 && self.unbalance_radius == 0.0 {
             return Err(ParamError::Inconsistent {
                 name: "unbalance_radius",
@@ -447,6 +465,29 @@ impl Params {
                          motor_encoder_resolution, not both"
                     .into(),
             });
+        }
+        Ok(())
+    }
+}
+
+impl Params {
+    /// A Stribeck rise needs a Stribeck speed: where it falls off.
+    fn check_stribeck(&self) -> Result<(), ParamError> {
+        for (rise, rise_name, speed, speed_name) in [
+            (self.fsm, "fsm", self.vsm, "vsm"),
+            (self.fsw, "fsw", self.vsw, "vsw"),
+            (self.fst, "fst", self.vst, "vst"),
+        ] {
+            if rise > 0.0 && speed <= 0.0 {
+                return Err(ParamError::Inconsistent {
+                    name: speed_name,
+                    value: speed,
+                    reason: format!(
+                        "{rise_name} = {} (a Stribeck rise) needs a Stribeck speed {speed_name} > 0, the speed at which the rise has fallen to 1/e",
+                        Num(rise)
+                    ),
+                });
+            }
         }
         Ok(())
     }

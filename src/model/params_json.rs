@@ -3,12 +3,13 @@
 //!
 //! A field that applies to the file's topology is required unless it has a default
 //! (`Jw`, `Cw`, `fw`, `theta_bw`, `W`, `fluct_order`, `fluct_phase`, the unbalance,
-//! `encoder_delay`, `Tload`); a field that does not apply is left out when written, and
+//! `encoder_delay`, `Tload`, the Stribeck law's `fsm` … `stribeck_shape`); a field that does not apply is left out when written, and
 //! if a file gives it, [`Params::validate`] refuses it by name (values equal to the
 //! registry's `unused` value, e.g. `Rw: 1` on a two-mass drive, are harmless and
 //! accepted). Files of the `spur_gear` and `direct` topologies written before the other
 //! topologies existed read and write exactly as they did; `axis` is written only for
-//! a linear axis and `Tload` only when it is not zero.
+//! a linear axis, `Tload` and the Stribeck parameters only when they differ from their
+//! defaults.
 
 use std::collections::BTreeMap;
 
@@ -51,6 +52,20 @@ pub struct ParamsJson {
     fw: Option<f64>,
     #[serde(rename = "ft")]
     ft: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    fsm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    fsw: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    fst: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    vsm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    vsw: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    vst: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    stribeck_shape: Option<f64>,
     #[serde(rename = "Kg", default, skip_serializing_if = "Option::is_none")]
     kg: Option<f64>,
     #[serde(rename = "Kw", default, skip_serializing_if = "Option::is_none")]
@@ -119,6 +134,13 @@ impl Form {
         given.unwrap_or_else(|| spec(name).expect("registered").unused)
     }
 
+    /// An optional field as written: present where it applies and differs from its
+    /// default, so that files without it (every Coulomb drive) read and write as before.
+    fn unless_default(&self, name: &'static str, value: f64) -> Option<f64> {
+        let s = spec(name).expect("the file form names registered parameters");
+        self.written(name, value).filter(|v| *v != s.unused)
+    }
+
     /// The field as written: present where it applies.
     fn written(&self, name: &'static str, value: f64) -> Option<f64> {
         let s = spec(name).expect("the file form names registered parameters");
@@ -151,6 +173,13 @@ impl TryFrom<ParamsJson> for Params {
             fm: f.required("fm", j.fm)?,
             fw: f.optional("fw", j.fw),
             ft: j.ft,
+            fsm: f.optional("fsm", j.fsm),
+            fsw: f.optional("fsw", j.fsw),
+            fst: f.optional("fst", j.fst),
+            vsm: f.optional("vsm", j.vsm),
+            vsw: f.optional("vsw", j.vsw),
+            vst: f.optional("vst", j.vst),
+            stribeck_shape: f.optional("stribeck_shape", j.stribeck_shape),
             kg: j.kg,
             kw: f.required("Kw", j.kw)?,
             kb: f.required("Kb", j.kb)?,
@@ -196,6 +225,13 @@ impl From<Params> for ParamsJson {
             fm: f.written("fm", p.fm),
             fw: f.written("fw", p.fw),
             ft: p.ft,
+            fsm: f.unless_default("fsm", p.fsm),
+            fsw: f.unless_default("fsw", p.fsw),
+            fst: f.unless_default("fst", p.fst),
+            vsm: f.unless_default("vsm", p.vsm),
+            vsw: f.unless_default("vsw", p.vsw),
+            vst: f.unless_default("vst", p.vst),
+            stribeck_shape: f.unless_default("stribeck_shape", p.stribeck_shape),
             kg: p.kg,
             kw: f.written("Kw", p.kw),
             kb: f.written("Kb", p.kb),
