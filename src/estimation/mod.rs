@@ -11,9 +11,16 @@
 //!   drive's resonance and antiresonance determine);
 //! - signals over angle: [`spectrum`];
 //! - [`inverse_dynamics`]: the friction law and inertia of a rigid axis by least
-//!   squares (IDIM-LS) from any recorded motion and effort.
+//!   squares (IDIM-LS) from any recorded motion and effort;
+//! - [`friction_law`]: Coulomb and Stribeck laws, symmetric or not, fitted to a
+//!   friction map (each constant-speed run's mean speed and effort), with standard
+//!   errors and the law the data support;
+//! - [`information`]: AIC, AICc, BIC, Akaike weights and nested F-tests of fits of the
+//!   same data, from plain figures.
 
 pub mod extrema;
+pub mod friction_law;
+pub mod information;
 pub mod inverse_dynamics;
 pub mod local_mode_fit;
 pub mod peaks;

@@ -12,76 +12,15 @@
 //!   F = ((SSR_r − SSR_f)/(k_f − k_r)) / (SSR_f/(n − k_f)) and its p-value: a small
 //!   p says the extra parameters lower the cost by more than noise would.
 //!
+//! The arithmetic is [`crate::estimation::information`]'s, on each result's figures.
 //! These compare fits of the same residuals only: the same experiment files with the
 //! same objectives, weights and scales. That is checked, and fits of other data are
 //! refused (their costs are not on one scale).
 
-use serde::Serialize;
-use statrs::distribution::{ContinuousCDF, FisherSnedecor};
-
+use crate::estimation::information::{self, Figures, InformationError};
 use crate::identify::result::IdentifyResult;
 
-/// One result's figures.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Candidate {
-    /// The result's label (its file).
-    pub label: String,
-    /// The fitted parameters.
-    pub fitted: Vec<String>,
-    /// Residuals n, fitted parameters k, the cost.
-    pub n: usize,
-    pub k: usize,
-    pub cost: f64,
-    pub aic: f64,
-    /// `None` when n − k − 1 ≤ 0 (the correction is undefined).
-    pub aicc: Option<f64>,
-    pub bic: f64,
-    /// The ranking criterion ([`Selection::criterion`]) minus the lowest of all.
-    pub delta: f64,
-    /// Akaike weight: the relative support of this model among those compared.
-    pub weight: f64,
-}
-
-/// The F-test of a nested pair.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Nested {
-    /// The smaller (restricted) and the larger (full) result's labels.
-    pub restricted: String,
-    pub full: String,
-    /// The parameters the full fit adds.
-    pub added: Vec<String>,
-    pub f: f64,
-    /// Degrees of freedom (k_f − k_r, n − k_f).
-    pub df: (usize, usize),
-    pub p_value: f64,
-    /// The full fit's cost is above the restricted one's, which it contains: it
-    /// stopped short of its optimum (F is then 0, and says nothing).
-    pub full_stopped_short: bool,
-}
-
-impl Nested {
-    /// What the test says, in words.
-    pub fn verdict(&self) -> &'static str {
-        if self.full_stopped_short {
-            "but its cost is above the smaller fit's, which it contains: it stopped short of its optimum (more --max-iters or --starts), and the test says nothing"
-        } else if self.p_value < 0.05 {
-            "the data ask for it"
-        } else {
-            "not supported by the data"
-        }
-    }
-}
-
-/// The comparison of several results.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Selection {
-    /// What ranks them: `aicc`, or `aic` when a fit has too few residuals for the
-    /// correction (n ≤ k + 1) — one criterion for all, never a mix.
-    pub criterion: &'static str,
-    /// By the criterion, best first.
-    pub candidates: Vec<Candidate>,
-    pub nested: Vec<Nested>,
-}
+pub use crate::estimation::information::{Candidate, Nested, Selection};
 
 /// Why results cannot be compared.
 #[derive(Debug, thiserror::Error)]
@@ -129,29 +68,12 @@ pub fn select(results: &[(String, IdentifyResult)]) -> Result<Selection, Selecti
     for (label, r) in results {
         check(label, r, first_label, first)?;
     }
-    let mut candidates: Vec<Candidate> = results.iter().map(|(l, r)| candidate(l, r)).collect();
-    let corrected = candidates.iter().all(|c| c.aicc.is_some());
-    let score = |c: &Candidate| {
-        if corrected {
-            c.aicc.unwrap_or(c.aic)
-        } else {
-            c.aic
+    let figures = results.iter().map(|(l, r)| figures(l, r)).collect();
+    information::compare(figures).map_err(|e| match e {
+        InformationError::Degenerate { label, cost, n } => {
+            SelectionError::Degenerate { label, cost, n }
         }
-    };
-    let best = candidates.iter().map(score).fold(f64::INFINITY, f64::min);
-    for c in &mut candidates {
-        c.delta = score(c) - best;
-    }
-    let total: f64 = candidates.iter().map(|c| (-0.5 * c.delta).exp()).sum();
-    for c in &mut candidates {
-        c.weight = (-0.5 * c.delta).exp() / total;
-    }
-    let nested = nested_tests(&candidates);
-    candidates.sort_by(|a, b| a.delta.total_cmp(&b.delta));
-    Ok(Selection {
-        criterion: if corrected { "aicc" } else { "aic" },
-        candidates,
-        nested,
+        _ => SelectionError::TooFew,
     })
 }
 
@@ -199,59 +121,15 @@ fn check(
     Ok(())
 }
 
-/// The figures of one result (Δ and weight filled in by [`select`]).
-fn candidate(label: &str, r: &IdentifyResult) -> Candidate {
-    let n = r.residuals.iter().map(|e| e.residuals.len()).sum::<usize>();
-    let k = r.parameters.len();
-    let (nf, kf) = (n as f64, k as f64);
-    let fit = nf * (r.cost / nf).ln();
-    let aic = fit + 2.0 * kf;
-    let aicc = (n > k + 1).then(|| aic + 2.0 * kf * (kf + 1.0) / (nf - kf - 1.0));
-    Candidate {
+/// The figures of one result.
+fn figures(label: &str, r: &IdentifyResult) -> Figures {
+    Figures {
         label: label.into(),
         fitted: r.parameters.keys().cloned().collect(),
-        n,
-        k,
+        n: r.residuals.iter().map(|e| e.residuals.len()).sum::<usize>(),
+        k: r.parameters.len(),
         cost: r.cost,
-        aic,
-        aicc,
-        bic: fit + kf * nf.ln(),
-        delta: 0.0,
-        weight: 0.0,
     }
-}
-
-/// The F-test of every pair whose fitted sets nest (the smaller inside the larger).
-fn nested_tests(candidates: &[Candidate]) -> Vec<Nested> {
-    let mut out = Vec::new();
-    for r in candidates {
-        for f in candidates {
-            let inside = r.k < f.k && r.fitted.iter().all(|p| f.fitted.contains(p));
-            if !inside || f.n <= f.k {
-                continue;
-            }
-            let df = (f.k - r.k, f.n - f.k);
-            let stat = ((r.cost - f.cost).max(0.0) / df.0 as f64) / (f.cost / df.1 as f64);
-            let p_value = FisherSnedecor::new(df.0 as f64, df.1 as f64)
-                .map(|d| 1.0 - d.cdf(stat))
-                .unwrap_or(f64::NAN);
-            out.push(Nested {
-                restricted: r.label.clone(),
-                full: f.label.clone(),
-                added: f
-                    .fitted
-                    .iter()
-                    .filter(|p| !r.fitted.contains(p))
-                    .cloned()
-                    .collect(),
-                f: stat,
-                df,
-                p_value,
-                full_stopped_short: f.cost > r.cost * (1.0 + 1e-9),
-            });
-        }
-    }
-    out
 }
 
 #[cfg(test)]
