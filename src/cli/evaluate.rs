@@ -6,8 +6,8 @@ use anyhow::bail;
 
 use crate::cli::common::model_args::ModelArgs;
 use crate::cli::experiment::{
-    fluctuation, frequency_response, frequency_response_time, positioning, servo_trace,
-    torque_curve,
+    fluctuation, friction_map, frequency_response, frequency_response_time, positioning,
+    servo_trace, torque_curve,
 };
 use rtid::io::experiment_file::{self, Kind};
 
@@ -47,6 +47,7 @@ Plots: FILE.svg (gain) and FILE-coherence.svg.
   unbalance     as fluctuation; the step (largest change of the deviation across 0.5° of \
 table angle, and where) is the backlash crossed when the unbalance moment overcomes the \
 friction. Plots: FILE.svg (Fig. 14) and FILE-spectrum.svg.
+  friction_map  one row per constant-speed run (mean speed and effort at the motor): the friction laws fitted by least squares with standard errors — coulomb (Fc·sgn v + Fv·v + Fo), stribeck (sgn v·(Fc + (Fs − Fc)·exp(−(|v|/vs)^delta)) + Fv·v + Fo), and per direction coulomb_asymmetric and stribeck_asymmetric — compared by AIC, AICc and BIC, and the law the data support (lowest AICc). A map with one direction only, a single speed per direction, or efforts of one sign is refused. Plots: FILE.svg (effort over speed with the laws) and FILE-residuals.svg.
   servo_trace   a recorded closed-loop run (reference, loop encoder, drive effort; rotary or linear). The friction law F = M·a + Fv·v + Fc·sign(v) + OF by inverse-dynamic least squares (IDIM-LS), with standard errors; with --params or --preset, the trace replayed on that model through its sampled servo, closed loop, and the simulation error: position RMS and largest, force RMS (SI in --json; µm or arc-seconds and N or N·m in the table). Plots: FILE.svg (following error, measured and replayed) and FILE-effort.svg.
 
 Example:
@@ -117,6 +118,7 @@ fn report(
         Kind::FrequencyResponseTime => {
             frequency_response_time::report_with(exp, plot, a.json, &a.estimate.options())
         }
+        Kind::FrictionMap => friction_map::report(exp, plot, a.json),
         other => bail!(
             "{}: evaluating `{}` experiments is not part of this version yet",
             a.file.display(),

@@ -32,6 +32,19 @@ pub fn perturb_by_rms(values: &mut [f64], percent: f64, seed: u64) {
     }
 }
 
+/// Multiplies each value by (1 + ε), ε ~ N(0, (percent/100)²): a scatter of that
+/// percentage of each value (the runs of a friction map).
+pub fn perturb_relative(values: &mut [f64], percent: f64, seed: u64) {
+    if percent <= 0.0 {
+        return;
+    }
+    let normal = Normal::new(0.0, percent / 100.0).expect("finite σ");
+    let mut rng = StdRng::seed_from_u64(seed);
+    for v in values {
+        *v *= 1.0 + normal.sample(&mut rng);
+    }
+}
+
 /// Adds N(0, σ²) to every sample (σ in the values' unit): e.g. encoder-reading noise
 /// on an angle record.
 pub fn perturb_absolute(values: &mut [f64], sigma: f64, seed: u64) {

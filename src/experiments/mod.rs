@@ -18,6 +18,7 @@
 
 pub mod compare;
 pub mod fluctuation;
+pub mod friction_map;
 pub mod frequency_response;
 pub mod measurement_noise;
 pub mod positioning;

@@ -13,6 +13,8 @@
 //! - [`torque_curve`]: error of the motor torque of the closed-loop torque test;
 //! - [`unbalance_step`]: error of the table angles where the unbalance test's
 //!   deviation steps across the backlash (the table friction ft);
+//! - [`friction_map`]: error of the steady-state motor torque at each run of a
+//!   friction map (the friction law: Coulomb, Stribeck, viscous, offset);
 //! - [`joint`]: several of these, weighted, as one.
 //!
 //! Every objective is a plain `Sync` struct holding the measured data; the simulator
@@ -20,6 +22,7 @@
 //! Adding an objective is one new file (the struct, its `Objective` impl and its
 //! `DEFINITION`) and one line in [`registry::REGISTRY`].
 
+pub mod friction_map;
 pub mod gain_curve;
 pub mod joint;
 pub mod measured;

@@ -11,7 +11,7 @@ use crate::names::UnknownName;
 
 /// The objectives, in the order their residuals are stacked and their parameters
 /// listed.
-pub static REGISTRY: [&Definition; 7] = [
+pub static REGISTRY: [&Definition; 8] = [
     &super::resonance::DEFINITION,
     &super::peak_amplitude::DEFINITION,
     &super::gain_curve::DEFINITION,
@@ -19,6 +19,7 @@ pub static REGISTRY: [&Definition; 7] = [
     &super::torque_curve::DEFINITION,
     &super::unbalance_step::DEFINITION,
     &super::servo_trace::DEFINITION,
+    &super::friction_map::DEFINITION,
 ];
 
 /// Which default set of objectives: that of a search, or that of the nonlinear

@@ -3,6 +3,7 @@
 
 pub mod figure;
 pub mod fluctuation;
+pub mod friction_map;
 pub mod frequency_response;
 pub mod frequency_response_time;
 pub mod html;

@@ -4,6 +4,7 @@
 
 pub mod check;
 pub mod fluctuation;
+pub mod friction_map;
 pub mod frequency_response;
 pub mod frequency_response_time;
 pub mod periodic_summary;
@@ -46,6 +47,9 @@ pub enum Test {
     /// Vertical table with an offset mass: the backlash step (paper §4.5, Fig. 14).
     #[command(long_about = unbalance::LONG_ABOUT)]
     Unbalance(unbalance::Args),
+    /// Friction map: the mean motor torque at constant speeds in both directions, and the friction law it shows.
+    #[command(long_about = friction_map::LONG_ABOUT)]
+    FrictionMap(friction_map::Args),
     /// A servo trace of the model along point-to-point moves, as a drive's oscilloscope records it.
     #[command(long_about = servo_trace::LONG_ABOUT)]
     ServoTrace(servo_trace::Args),
@@ -114,5 +118,6 @@ pub fn run(test: Test) -> anyhow::Result<()> {
         Test::Fluctuation(a) => fluctuation::run(a),
         Test::Unbalance(a) => unbalance::run(a),
         Test::ServoTrace(a) => servo_trace::run(a),
+        Test::FrictionMap(a) => friction_map::run(a),
     }
 }

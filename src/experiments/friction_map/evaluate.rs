@@ -1,0 +1,82 @@
+//! What a friction map says: its runs, the friction laws fitted to their mean efforts
+//! with standard errors (estimation/friction_law), and which law the data support
+//! (AICc, as `rtid select` ranks fits).
+
+use serde::Serialize;
+
+use crate::estimation::friction_law::{fit_all, Comparison, Law};
+use crate::io::experiment_file::{Axis, FrictionMap};
+
+/// A map's evaluation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MapEvaluation {
+    /// `rotary` (rad/s, N·m) or `linear` (m/s, N).
+    pub axis: Axis,
+    /// The runs, in order of increasing speed.
+    pub runs: Vec<Run>,
+    /// The laws fitted and their comparison.
+    pub laws: Comparison,
+}
+
+/// One run of the map, SI.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Run {
+    pub speed: f64,
+    pub effort: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub effort_std: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub samples: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dropped: Option<f64>,
+    /// The selected law's residual here: measured − law.
+    pub residual: f64,
+}
+
+impl MapEvaluation {
+    /// The law the data support, fitted.
+    pub fn selected(&self) -> &crate::estimation::friction_law::LawFit {
+        self.laws
+            .fit(self.laws.selected)
+            .expect("the selected law is one of the fits")
+    }
+
+    /// The model-side law closest to the selected one: the symmetric law of its family
+    /// (the model's friction is the same in both directions; a load's offset is
+    /// `Tload`), if fitted.
+    pub fn symmetric(&self) -> Option<&crate::estimation::friction_law::LawFit> {
+        let law = if self.laws.selected.is_stribeck() {
+            Law::Stribeck
+        } else {
+            Law::Coulomb
+        };
+        self.laws.fit(law).or_else(|| self.laws.fit(Law::Coulomb))
+    }
+}
+
+/// Evaluates `map`; the message of a map no law can be fitted to (one direction, a
+/// single speed, efforts of one sign) otherwise.
+pub fn evaluate(map: &FrictionMap) -> Result<MapEvaluation, String> {
+    let map = map.sorted();
+    let laws = fit_all(&map.speed, &map.effort).map_err(|e| e.to_string())?;
+    let residuals = &laws
+        .fit(laws.selected)
+        .expect("the selected law is fitted")
+        .residuals;
+    let at = |v: &Option<Vec<f64>>, i: usize| v.as_ref().map(|v| v[i]);
+    let runs = (0..map.len())
+        .map(|i| Run {
+            speed: map.speed[i],
+            effort: map.effort[i],
+            effort_std: at(&map.effort_std, i),
+            samples: at(&map.samples, i),
+            dropped: at(&map.dropped, i),
+            residual: residuals[i],
+        })
+        .collect();
+    Ok(MapEvaluation {
+        axis: map.axis,
+        runs,
+        laws,
+    })
+}
