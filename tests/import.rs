@@ -266,3 +266,259 @@ fn a_laser_table_becomes_a_linear_positioning_test() {
     ));
     assert!(e.contains("`r` row 1") && e.contains("from 1"), "{e}");
 }
+
+const EPOS_SPEED: &str = "speed=Velocity actual value averaged*-1:rpm";
+const EPOS_EFFORT: &str = "effort=Torque actual value averaged*-1:%(9.84 mN·m)";
+
+/// The velocity (rpm) and torque (%) columns of an EPOS Studio export, read here
+/// independently of rtid's reader: the rows after the units row.
+fn epos_columns(text: &str) -> (Vec<f64>, Vec<f64>) {
+    let rows = text.lines().skip_while(|l| !l.starts_with("ms;")).skip(1);
+    rows.filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let cells: Vec<f64> = l.split(';').map(|c| c.trim().parse().unwrap()).collect();
+            (cells[1], cells[2])
+        })
+        .unzip()
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+fn import_map(files: &[&str], dir: &Path) -> Output {
+    let mut args = vec!["import"];
+    args.extend_from_slice(files);
+    args.extend([
+        "--kind",
+        "friction-map",
+        "--map",
+        EPOS_SPEED,
+        "--map",
+        EPOS_EFFORT,
+        "--out",
+        "map",
+    ]);
+    rtid(&args, dir)
+}
+
+#[test]
+fn epos_steady_state_runs_become_a_friction_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let epos = root().join("fixtures/formats/epos");
+    let files = [
+        epos.join("driveNo1/steady_state/10.csv"),
+        epos.join("driveNo2/steady_state/n50.csv"),
+    ];
+    let names: Vec<&str> = files.iter().map(|f| f.to_str().unwrap()).collect();
+    let out = import_map(&names, dir.path());
+    assert!(ok(&out).contains("wrote map/friction_map.json (friction_map, 2 rows)"));
+    let e = experiment_file::read(&dir.path().join("map/friction_map.json")).unwrap();
+    let Data::FrictionMap(m) = &e.data else {
+        panic!("a friction map: {:?}", e.data.kind());
+    };
+    assert_eq!(m.axis, rtid::model::Axis::Rotary);
+    // Rows by speed: n50 (−50 rpm after the sign flip), then 10 (+10 rpm). Each the
+    // plain mean of its 500 samples (no glitch, no transient), flipped and in SI.
+    for (row, file) in [(0, &files[1]), (1, &files[0])] {
+        let (rpm, percent) = epos_columns(&std::fs::read_to_string(file).unwrap());
+        assert_eq!(rpm.len(), 500);
+        let speed = -mean(&rpm) * std::f64::consts::PI / 30.0;
+        let effort = -mean(&percent) * 9.84e-3 / 100.0;
+        assert!((m.speed[row] - speed).abs() < 1e-12, "{}", m.speed[row]);
+        assert!((m.effort[row] - effort).abs() < 1e-12, "{}", m.effort[row]);
+        assert_eq!(m.samples.as_ref().unwrap()[row], 500.0);
+        assert_eq!(m.dropped.as_ref().unwrap()[row], 0.0);
+        assert_eq!(m.transient.as_ref().unwrap()[row], 0.0);
+    }
+    assert!(m.speed[0] < -5.0 && m.effort[0] < 0.0);
+    // +10 rpm is π/3 rad/s.
+    assert!((m.speed[1] - std::f64::consts::FRAC_PI_3).abs() < 1e-3 && m.effort[1] > 0.0);
+    let import = &e.manifest.extra["import"];
+    assert_eq!(import["sources"].as_array().unwrap().len(), 2);
+    let findings: Vec<&str> = import["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    let run = findings
+        .iter()
+        .find(|f| f.contains("10.csv: a run at 1.047 rad/s (10 rpm as mapped)"))
+        .unwrap_or_else(|| panic!("{findings:#?}"));
+    assert!(run.contains("500 samples averaged (lines 15–514)"), "{run}");
+    assert_eq!(import["runs"][1]["averaged"], "lines 15–514");
+}
+
+#[test]
+fn a_glitch_is_dropped_from_its_run_and_an_unsettled_run_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let epos = root().join("fixtures/formats/epos/driveNo1/steady_state");
+    // 10.csv with the torque of line 120 written over by a recorder glitch.
+    let text = std::fs::read_to_string(epos.join("10.csv")).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let cells: Vec<&str> = lines[119].split(';').collect();
+    lines[119] = format!("{};{};-400.0", cells[0], cells[1]);
+    std::fs::write(dir.path().join("10.csv"), lines.join("\r\n") + "\r\n").unwrap();
+    let out = import_map(&["10.csv"], dir.path());
+    let stderr = String::from_utf8(out.stderr.clone()).unwrap();
+    ok(&out);
+    assert!(
+        stderr.contains("10.csv, line 120: `Torque actual value averaged` = -400 is a glitch")
+            && stderr.contains("dropped from the run's means"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("499 samples averaged (lines 15–514), 1 dropped as glitches"),
+        "{stderr}"
+    );
+    let e = experiment_file::read(&dir.path().join("map/friction_map.json")).unwrap();
+    let Data::FrictionMap(m) = &e.data else {
+        panic!("a friction map");
+    };
+    let (_, mut percent) = epos_columns(&text);
+    percent.remove(119 - 14);
+    assert!((m.effort[0] + mean(&percent) * 9.84e-5).abs() < 1e-12);
+    assert_eq!(
+        (
+            m.samples.as_ref().unwrap()[0],
+            m.dropped.as_ref().unwrap()[0]
+        ),
+        (499.0, 1.0)
+    );
+
+    // At −2 rpm drive 1's speed readings jump between 0 and 15 rpm about its median
+    // of 1: a fifth of them outside the settle band, so the run has not settled.
+    let n2 = epos.join("n2.csv");
+    let e = err(&import_map(&["10.csv", n2.to_str().unwrap()], dir.path()));
+    assert!(
+        e.contains("n2.csv: not settled:") && e.contains("lie outside the settle band"),
+        "{e}"
+    );
+    // The maps apply to each file: a channel one file lacks names that file.
+    std::fs::write(
+        dir.path().join("other.csv"),
+        "t,w,q
+s,rpm,N·m
+0,1,1
+",
+    )
+    .unwrap();
+    let e = err(&import_map(&["10.csv", "other.csv"], dir.path()));
+    assert!(
+        e.contains("other.csv: --map speed=Velocity actual value averaged*-1:rpm: no channel"),
+        "{e}"
+    );
+}
+
+/// A stepped-speed record of one file (delimited text, as a DAQ script writes it):
+/// ±20 and ±50 rpm held for 60 samples each, joined by changes of 5 samples, from rest.
+fn stepped_record() -> (String, Vec<(usize, usize, f64)>) {
+    let levels = [20.0, -20.0, 50.0, -50.0];
+    let mut speed = vec![0.0; 10];
+    let mut holds = Vec::new();
+    let mut from = 0.0;
+    for level in levels {
+        speed.extend((1..=5).map(|j| from + (level - from) * j as f64 / 6.0));
+        let start = speed.len();
+        speed.extend((0..60).map(|i| level + 0.2 * [1.0, -1.0, 0.0][i % 3]));
+        holds.push((start, speed.len(), level));
+        from = level;
+    }
+    speed.extend((1..=5).map(|j| from * (1.0 - j as f64 / 5.0)));
+    let mut text = String::from("# stepped-speed run\ntime,speed,torque\ns,rpm,mN·m\n");
+    for (i, v) in speed.iter().enumerate() {
+        // Friction: 2 mN·m Coulomb and 0.01 mN·m per rpm, with a little ripple.
+        let torque = if *v == 0.0 {
+            0.0
+        } else {
+            v.signum() * 2.0 + 0.01 * v + 0.05 * [1.0, 0.0, -1.0, 0.0][i % 4]
+        };
+        text += &format!("{},{v},{torque}\n", i as f64 * 0.01);
+    }
+    // Sample i is on line i + 4.
+    let holds = holds
+        .into_iter()
+        .map(|(a, b, l)| (a + 4, b + 3, l))
+        .collect();
+    (text, holds)
+}
+
+#[test]
+fn one_stepped_speed_record_is_cut_into_its_plateaus() {
+    let dir = tempfile::tempdir().unwrap();
+    let (text, holds) = stepped_record();
+    std::fs::write(dir.path().join("steps.csv"), text).unwrap();
+    let out = rtid(
+        &[
+            "import",
+            "steps.csv",
+            "--kind",
+            "friction-map",
+            "--map",
+            "speed=speed",
+            "--map",
+            "effort=torque",
+            "--map",
+            "time=time",
+            "--out",
+            "map",
+        ],
+        dir.path(),
+    );
+    assert!(ok(&out).contains("(friction_map, 4 rows)"));
+    let e = experiment_file::read(&dir.path().join("map/friction_map.json")).unwrap();
+    let Data::FrictionMap(m) = &e.data else {
+        panic!("a friction map");
+    };
+    let rpm = std::f64::consts::PI / 30.0;
+    let mut expected: Vec<f64> = holds.iter().map(|h| h.2).collect();
+    expected.sort_by(f64::total_cmp);
+    for (row, level) in expected.iter().enumerate() {
+        assert!(
+            (m.speed[row] / rpm - level).abs() < 0.01,
+            "{row}: {}",
+            m.speed[row] / rpm
+        );
+        let effort = (level.signum() * 2.0 + 0.01 * level) * 1e-3;
+        assert!(
+            (m.effort[row] - effort).abs() < 3e-5,
+            "{row}: {}",
+            m.effort[row]
+        );
+        assert!(m.samples.as_ref().unwrap()[row] >= 50.0);
+    }
+    // Each run averaged lines of its hold only; the changes were left out.
+    let import = &e.manifest.extra["import"];
+    for run in import["runs"].as_array().unwrap() {
+        let span = run["averaged"].as_str().unwrap();
+        let (a, b) = span
+            .strip_prefix("lines ")
+            .and_then(|s| s.split_once('–'))
+            .unwrap_or_else(|| panic!("{span}"));
+        let (a, b): (usize, usize) = (a.parse().unwrap(), b.parse().unwrap());
+        assert!(
+            holds
+                .iter()
+                .any(|&(start, end, _)| a >= start && b <= end && b - a >= 49),
+            "{span} is not within a hold: {holds:?}"
+        );
+    }
+    let findings = import["findings"].to_string();
+    assert!(
+        findings.contains(
+            "steps.csv: a stepped-speed record, its plateaus taken as runs: lines 19–78, lines 84–143, "
+        ),
+        "{findings}"
+    );
+    // The changes between the holds are transitions; the drive at rest before the
+    // first is a plateau, but not one of the map.
+    assert!(
+        findings.contains("left out as transitions: lines 14–18, lines 79–83, "),
+        "{findings}"
+    );
+    assert!(
+        findings.contains("steps.csv, lines 4–13: a plateau not taken as a run: at rest"),
+        "{findings}"
+    );
+}

@@ -47,12 +47,19 @@ controller_output, controller_added
 phase
   frequency-response-time  time, motor_torque or motor_current, motor_angle, table_angle
   positioning              target, deviation, direction (> 0 up, < 0 down), run (from 1)
+  friction-map             speed (rad/s, rpm, m/s …), effort, time: one constant-speed run \
+per file, the maps applied to each file alike; one file whose speed steps through several \
+plateaus gives one run per plateau
 --condition NAME=VALUE sets a manifest condition (docs/experiment-files.md), e.g. \
 drive_gain=35.15, loop_period_s=0.001.
 
 Nothing is smoothed silently: a sample more than 10 robust deviations from its \
 neighbours is reported with file, line and value (and kept), a gap in the time base \
-names its line. The manifest records the source files with their SHA-256, their format, \
+names its line. A friction map's run is reduced to its mean speed and effort: its \
+glitches are dropped (each said with its line), the samples before the speed settles \
+within max(5 %, 2 quanta) of its median are left out as the transient, and a run that \
+has not settled (fewer than 10 samples left, more than 10 % outside that band, or halves \
+whose mean speeds differ by more than it) is refused, naming the file. The manifest records the source files with their SHA-256, their format, \
 the maps and conditions as given, and rtid's version.
 
 Examples:
@@ -62,13 +69,16 @@ Examples:
       --map controller_output=vir:V --map effort=vir*35.15065188248547:N \\
       --condition drive_gain=35.15065188248547 --condition loop_period_s=0.001 --out emps
   rtid import run.csv --kind torque-curve --map time=t:ms \\
-      --map 'effort=Torque actual value*-1:%(9.84 mN·m)' --out runs/torque";
+      --map 'effort=Torque actual value*-1:%(9.84 mN·m)' --out runs/torque
+  rtid import steady/10.csv steady/n10.csv steady/50.csv steady/n50.csv --kind friction-map \\
+      --map 'speed=Velocity actual value averaged*-1:rpm' \\
+      --map 'effort=Torque actual value averaged*-1:%(9.84 mN·m)' --out runs/map";
 
 /// Arguments of `rtid import`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The files to read (one experiment: several files are read together, their
-    /// channels named as in each).
+    /// channels named as in each; for friction-map each file is one run, mapped alike).
     #[arg(value_name = "FILE", required = true)]
     pub files: Vec<PathBuf>,
     /// List each file's channels (name, unit, samples, sample period, first, last,
@@ -79,7 +89,7 @@ pub struct Args {
     #[arg(long, value_name = "FORMAT", value_parser = parse_format)]
     pub format: Option<Format>,
     /// The experiment to write: servo-trace, torque-curve, frequency-response,
-    /// frequency-response-time, positioning.
+    /// frequency-response-time, positioning, friction-map.
     #[arg(long, value_name = "KIND", value_parser = parse_kind, requires = "out")]
     pub kind: Option<ImportKind>,
     /// ROLE=CHANNEL[*SCALE][:UNIT]; repeatable, one per role.

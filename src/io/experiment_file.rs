@@ -10,10 +10,13 @@
 
 mod conditions;
 mod data;
+mod friction_map;
 mod sampling;
 mod table;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_friction_map;
 #[cfg(test)]
 mod tests_units;
 mod units;
@@ -21,6 +24,7 @@ mod writer;
 
 pub use conditions::{Conditions, Excitation};
 pub use data::{Approaches, Data, ServoTrace, Signal, TimeRecord};
+pub use friction_map::FrictionMap;
 pub use sampling::{check_uniform, sample_period, NonUniform, SAMPLING_TOLERANCE};
 pub use units::{Axis, CommandUnit};
 pub use writer::write;
@@ -59,11 +63,14 @@ pub enum Kind {
     /// A recorded closed-loop run: position command, the loop's encoder, the drive's
     /// effort and the controller output over uniformly sampled time.
     ServoTrace,
+    /// Constant-speed runs: each run's mean speed and mean effort at the motor, one row
+    /// per run (the friction map).
+    FrictionMap,
 }
 
 impl Kind {
     /// Every kind, in the order of docs/experiment-files.md, then the kinds added since.
-    pub const ALL: [Kind; 8] = [
+    pub const ALL: [Kind; 9] = [
         Kind::FrequencyResponse,
         Kind::Resonance,
         Kind::TorqueCurve,
@@ -72,6 +79,7 @@ impl Kind {
         Kind::Unbalance,
         Kind::FrequencyResponseTime,
         Kind::ServoTrace,
+        Kind::FrictionMap,
     ];
 
     /// The name used in manifests (`frequency_response`, …).
@@ -85,6 +93,7 @@ impl Kind {
             Kind::Unbalance => "unbalance",
             Kind::FrequencyResponseTime => "frequency_response_time",
             Kind::ServoTrace => "servo_trace",
+            Kind::FrictionMap => "friction_map",
         }
     }
 

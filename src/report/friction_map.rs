@@ -29,8 +29,9 @@ pub fn map(e: &MapEvaluation, title: &str) -> Figure {
     let mut figure = Figure::new(title, x_label, effort_label(e.axis))
         .with(Series::new("runs (mean)", measured, Style::Markers));
     let selected = e.selected();
-    for (fit, style) in [(selected, Style::Line), (coulomb(e), Style::Dashed)] {
-        if let Some(fit) = fit.filter(|f| style == Style::Line || f.law != selected.law) {
+    let coulomb = coulomb(e).filter(|f| f.law != selected.law);
+    for (fit, style) in [(Some(selected), Style::Line), (coulomb, Style::Dashed)] {
+        if let Some(fit) = fit {
             for (direction, points) in curve(e, fit, to_unit) {
                 let name = format!("{} law, {direction}", fit.law.name());
                 figure = figure.with(Series::new(name, points, style));

@@ -159,7 +159,7 @@ impl Conditions {
                 c.torque_amplitude_nm.get_or_insert(5.0);
                 c.preload_nm.get_or_insert(0.0);
             }
-            Kind::Resonance | Kind::ServoTrace => {}
+            Kind::Resonance | Kind::ServoTrace | Kind::FrictionMap => {}
             Kind::TorqueCurve => {
                 c.amplitude_deg.get_or_insert(30.0);
                 c.period_s.get_or_insert(3.0);

@@ -8,7 +8,7 @@
 //! unit, and code written for the rotary variants cannot take metres for radians
 //! without noticing. [`Data::axis`] says which axis a variant belongs to.
 
-use super::{Axis, Columns, CommandUnit, Direction, Kind};
+use super::{Axis, Columns, CommandUnit, Direction, FrictionMap, Kind};
 
 /// The measured data of an experiment, in SI units (angles in rad, lengths in m). All
 /// series of one variant have the same length; `extra` columns too.
@@ -95,6 +95,8 @@ pub enum Data {
     },
     /// A recorded closed-loop run (`servo_trace`).
     ServoTrace(ServoTrace),
+    /// Constant-speed runs' mean speeds and efforts (`friction_map`), rotary or linear.
+    FrictionMap(FrictionMap),
 }
 
 /// A recorded closed-loop run, uniformly sampled: the position command, the loop's
@@ -253,6 +255,7 @@ impl Data {
                 Kind::FrequencyResponseTime
             }
             Data::ServoTrace(_) => Kind::ServoTrace,
+            Data::FrictionMap(_) => Kind::FrictionMap,
         }
     }
 
@@ -263,6 +266,7 @@ impl Data {
             Data::FrequencyResponse { .. } | Data::Resonance { .. } => None,
             Data::ForceCurve { .. } | Data::LinearPositioning { .. } => Some(Axis::Linear),
             Data::ServoTrace(t) => Some(t.axis),
+            Data::FrictionMap(m) => Some(m.axis),
             Data::TorqueCurve { .. }
             | Data::Positioning { .. }
             | Data::Fluctuation { .. }
@@ -272,7 +276,7 @@ impl Data {
         }
     }
 
-    /// Number of rows (of peaks, for resonance).
+    /// Number of rows (of peaks, for resonance; of runs, for a friction map).
     pub fn len(&self) -> usize {
         match self {
             Data::FrequencyResponse {
@@ -287,7 +291,8 @@ impl Data {
             | Data::Unbalance { time_s: v, .. }
             | Data::FrequencyResponseTime { time_s: v, .. }
             | Data::FrequencyResponseTimeCurrent { time_s: v, .. }
-            | Data::ServoTrace(ServoTrace { time_s: v, .. }) => v.len(),
+            | Data::ServoTrace(ServoTrace { time_s: v, .. })
+            | Data::FrictionMap(FrictionMap { speed: v, .. }) => v.len(),
         }
     }
 
@@ -309,7 +314,8 @@ impl Data {
             | Data::Unbalance { extra, .. }
             | Data::FrequencyResponseTime { extra, .. }
             | Data::FrequencyResponseTimeCurrent { extra, .. }
-            | Data::ServoTrace(ServoTrace { extra, .. }) => Some(extra),
+            | Data::ServoTrace(ServoTrace { extra, .. })
+            | Data::FrictionMap(FrictionMap { extra, .. }) => Some(extra),
         }
     }
 }

@@ -127,7 +127,25 @@ fn samples() -> Vec<Data> {
         },
         servo_trace(Axis::Linear, n),
         servo_trace(Axis::Rotary, n),
+        friction_map(Axis::Rotary, n),
+        friction_map(Axis::Linear, n),
     ]
+}
+
+/// A friction map, rows not in order of speed; rotary with every optional column,
+/// linear with none but an extra one.
+fn friction_map(axis: Axis, n: usize) -> Data {
+    let mut m = FrictionMap::new(axis, series(n, -0.5), series(n, 0.25));
+    if axis == Axis::Rotary {
+        m.speed_std = Some(series(n, 1.0));
+        m.effort_std = Some(series(n, 2.0));
+        m.samples = Some((0..n).map(|i| (100 + i) as f64).collect());
+        m.dropped = Some((0..n).map(|i| (i % 3) as f64).collect());
+        m.transient = Some((0..n).map(|i| (2 * i) as f64).collect());
+    } else {
+        m.extra = extra(n);
+    }
+    Data::FrictionMap(m)
 }
 
 /// A servo trace with every optional column.
@@ -254,6 +272,15 @@ fn numbers(data: &Data) -> Vec<Vec<f64>> {
                 signal(&t.controller_output),
                 signal(&t.controller_added),
             ]
+        }
+        Data::FrictionMap(m) => {
+            // The reader returns the rows in order of speed.
+            let m = m.sorted();
+            let mut v = vec![m.speed, m.effort];
+            let optional = [m.speed_std, m.effort_std, m.samples, m.dropped, m.transient];
+            v.extend(optional.into_iter().map(Option::unwrap_or_default));
+            v.extend(m.extra.into_values());
+            return v;
         }
     };
     v.extend(data.extra().into_iter().flat_map(|e| e.values().cloned()));

@@ -18,8 +18,8 @@ pub(super) const UM: f64 = 1e-6;
 
 pub use crate::model::Axis;
 
-/// A position suffix of a column name: the axis it implies and SI units (rad or m) per
-/// unit written.
+/// A position (or speed) suffix of a column name: the axis it implies and SI units
+/// (rad or m; rad/s or m/s) per unit written.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct PositionUnit {
     pub suffix: &'static str,
@@ -58,6 +58,39 @@ pub(super) const POSITION_UNITS: [PositionUnit; 6] = [
         suffix: "um",
         axis: Axis::Linear,
         si: UM,
+    },
+];
+
+/// Radians per second per revolution per minute.
+pub(super) const RPM: f64 = std::f64::consts::PI / 30.0;
+
+/// Every speed suffix the reader accepts (`speed_rad_s`, …), rotary first; the
+/// writer writes the first of each axis (`rad_s`, `m_s`).
+pub(super) const SPEED_UNITS: [PositionUnit; 5] = [
+    PositionUnit {
+        suffix: "rad_s",
+        axis: Axis::Rotary,
+        si: 1.0,
+    },
+    PositionUnit {
+        suffix: "rpm",
+        axis: Axis::Rotary,
+        si: RPM,
+    },
+    PositionUnit {
+        suffix: "deg_s",
+        axis: Axis::Rotary,
+        si: DEG,
+    },
+    PositionUnit {
+        suffix: "m_s",
+        axis: Axis::Linear,
+        si: 1.0,
+    },
+    PositionUnit {
+        suffix: "mm_s",
+        axis: Axis::Linear,
+        si: MM,
     },
 ];
 

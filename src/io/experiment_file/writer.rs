@@ -16,10 +16,11 @@ use super::{Conditions, Data, ExperimentFileError, Kind, Manifest};
 /// atomically. The written manifest has `data` set to the CSV's name and, for a
 /// resonance, `peaks_hz` and `peak_gain_db` from `data`. Angles are written in degrees
 /// (positioning deviations in arc-seconds), lengths in metres (positioning targets in
-/// mm, deviations in µm), numbers in Rust's shortest round-trip form.
+/// mm, deviations in µm), speeds in rad/s or m/s (a friction map's rows in order of
+/// increasing speed), numbers in Rust's shortest round-trip form.
 /// Data that would not read back (unequal lengths, non-finite values, times not
-/// increasing, run 0, extra columns named like a column the reader uses) is refused
-/// before anything is written.
+/// increasing, run 0, a friction map's speed of 0 or repeated, extra columns named like
+/// a column the reader uses) is refused before anything is written.
 pub fn write(
     manifest_path: &Path,
     manifest: &Manifest,
@@ -42,6 +43,9 @@ pub fn write(
     check_manifest(manifest).map_err(|m| invalid(manifest_path, m))?;
     if let Data::ServoTrace(trace) = data {
         check_signals(trace).map_err(|m| invalid(manifest_path, m))?;
+    }
+    if let Data::FrictionMap(map) = data {
+        map.check().map_err(|m| invalid(manifest_path, m))?;
     }
     let mut out = manifest.clone();
     if let Data::Resonance {
@@ -209,6 +213,15 @@ fn check_columns(data: &Data, columns: &[(Cow<'_, str>, Cells<'_>)]) -> Result<(
                     }
                 }
             }
+            Cells::Counts(v) => {
+                let whole = |x: &f64| super::friction_map::count(*x).is_ok();
+                if let Some((row, x)) = v.iter().enumerate().find(|(_, x)| !whole(x)) {
+                    return Err(format!(
+                        "column `{name}`, row {}: {x} is not a whole number ≥ 0",
+                        row + 1
+                    ));
+                }
+            }
             Cells::Runs(v) => {
                 if let Some(row) = v.iter().position(|&r| r == 0) {
                     return Err(format!(
@@ -242,6 +255,7 @@ fn write_csv(
             cell.clear();
             match cells {
                 Cells::Numbers(v) => write!(cell, "{:?}", v[row]),
+                Cells::Counts(v) => write!(cell, "{}", v[row]),
                 Cells::Directions(v) => write!(cell, "{}", v[row]),
                 Cells::Runs(v) => write!(cell, "{}", v[row]),
             }

@@ -70,8 +70,9 @@ pub fn glitches(values: &[f64]) -> Vec<Glitch> {
 /// The channel's step where it sits still for most of the record (the global scatter
 /// is then zero): the 10th percentile of its non-zero sample-to-sample changes — an
 /// encoder count, a recorder's resolution — so that one count is not a glitch and a
-/// jump of many is. Zero when the channel never changes.
-fn quantum(values: &[f64]) -> f64 {
+/// jump of many is. Zero when the channel never changes. (Also the step of a run's
+/// speed in [`super::runs`].)
+pub(crate) fn quantum(values: &[f64]) -> f64 {
     let mut steps: Vec<f64> = values
         .windows(2)
         .map(|w| (w[1] - w[0]).abs())
@@ -123,7 +124,9 @@ fn local(values: &[f64], i: usize) -> Local {
     }
 }
 
-fn median(v: &mut [f64]) -> f64 {
+/// The median of `v` (sorted in place; the mean of the middle two for an even count),
+/// NaN when empty.
+pub(crate) fn median(v: &mut [f64]) -> f64 {
     if v.is_empty() {
         return f64::NAN;
     }

@@ -12,6 +12,7 @@ pub enum ImportKind {
     FrequencyResponse,
     FrequencyResponseTime,
     Positioning,
+    FrictionMap,
 }
 
 /// A role of a kind.
@@ -174,13 +175,35 @@ const POSITIONING: &[Role] = &[
     role("run", &[Number], true, "the run (cycle) number, from 1"),
 ];
 
+const FRICTION_MAP: &[Role] = &[
+    role(
+        "time",
+        &[Time],
+        false,
+        "each run's time base (checked for gaps only)",
+    ),
+    role(
+        "speed",
+        &[AngularVelocity, Velocity],
+        true,
+        "the motor's speed (rotary) or the axis's (linear)",
+    ),
+    role(
+        "effort",
+        EFFORT,
+        true,
+        "the motor torque (rotary) or drive force (linear)",
+    ),
+];
+
 impl ImportKind {
-    pub const ALL: [ImportKind; 5] = [
+    pub const ALL: [ImportKind; 6] = [
         ImportKind::ServoTrace,
         ImportKind::TorqueCurve,
         ImportKind::FrequencyResponse,
         ImportKind::FrequencyResponseTime,
         ImportKind::Positioning,
+        ImportKind::FrictionMap,
     ];
 
     /// As the command line spells it.
@@ -191,6 +214,7 @@ impl ImportKind {
             ImportKind::FrequencyResponse => "frequency-response",
             ImportKind::FrequencyResponseTime => "frequency-response-time",
             ImportKind::Positioning => "positioning",
+            ImportKind::FrictionMap => "friction-map",
         }
     }
 
@@ -202,6 +226,7 @@ impl ImportKind {
             ImportKind::FrequencyResponse => Kind::FrequencyResponse,
             ImportKind::FrequencyResponseTime => Kind::FrequencyResponseTime,
             ImportKind::Positioning => Kind::Positioning,
+            ImportKind::FrictionMap => Kind::FrictionMap,
         }
     }
 
@@ -212,6 +237,7 @@ impl ImportKind {
             ImportKind::FrequencyResponse => FREQUENCY_RESPONSE,
             ImportKind::FrequencyResponseTime => FREQUENCY_RESPONSE_TIME,
             ImportKind::Positioning => POSITIONING,
+            ImportKind::FrictionMap => FRICTION_MAP,
         }
     }
 

@@ -2,11 +2,16 @@
 //! a [`Recording`] (read by [`crate::io::formats`]) named to the roles of a kind
 //! ([`kinds`]) by `--map ROLE=CHANNEL[*SCALE][:UNIT]` ([`mapping`]), converted to SI
 //! ([`crate::io::formats::units`]), checked for glitches and gaps ([`glitches`]), and returned as the
-//! experiment's [`Data`] with a manifest that records where they came from.
+//! experiment's [`Data`] with a manifest that records where they came from. A friction
+//! map is made of constant-speed runs instead, one per file or one per plateau of a
+//! stepped-speed record ([`runs`], [`plateaus`], `friction_map`).
 
+mod friction_map;
 pub mod glitches;
 pub mod kinds;
 pub mod mapping;
+pub mod plateaus;
+pub mod runs;
 
 use std::path::PathBuf;
 
@@ -66,6 +71,9 @@ struct Filled<'a> {
 
 /// Builds the experiment `request` asks for from `sources`.
 pub fn build(sources: &[Source], request: &Request) -> Result<Imported, ImportError> {
+    if request.kind == ImportKind::FrictionMap {
+        return friction_map::build(sources, request);
+    }
     let recordings: Vec<&Recording> = sources.iter().map(|s| &s.recording).collect();
     let filled = fill(&recordings, request)?;
     let data = if request.kind == ImportKind::Positioning {
@@ -284,18 +292,24 @@ fn assemble(kind: ImportKind, filled: &[Filled], base: Vec<f64>) -> Result<Data,
         ImportKind::FrequencyResponse => frequency_response(filled, base),
         ImportKind::FrequencyResponseTime => frequency_response_time(filled, base),
         ImportKind::Positioning => positioning(filled),
+        ImportKind::FrictionMap => Err(ImportError(
+            "a friction map is made of runs, not of one time base".into(),
+        )),
     }
 }
 
-/// The axis the positions say (all alike), and the effort agreeing with it.
+/// The axis the positions (or a friction map's speed) say (all alike), and the effort
+/// agreeing with it.
 fn axis(filled: &[Filled]) -> Result<Axis, ImportError> {
     let mut found: Option<(Axis, &str)> = None;
     for f in filled {
-        let positional = matches!(f.role.name, "effort" | "target" | "deviation")
+        let positional = matches!(f.role.name, "effort" | "target" | "deviation" | "speed")
             || f.role.name.ends_with("position");
         let this = match f.resolved.unit.quantity {
-            Quantity::Angle | Quantity::Torque if positional => Axis::Rotary,
-            Quantity::Length | Quantity::Force if positional => Axis::Linear,
+            Quantity::Angle | Quantity::AngularVelocity | Quantity::Torque if positional => {
+                Axis::Rotary
+            }
+            Quantity::Length | Quantity::Velocity | Quantity::Force if positional => Axis::Linear,
             _ => continue,
         };
         match found {

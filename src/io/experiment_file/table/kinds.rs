@@ -3,9 +3,12 @@
 //! refuses for an extra column).
 
 use super::super::data::{ServoTrace, Signal};
-use super::super::units::units_for;
-use super::{Col, Order, Table};
-use crate::io::experiment_file::{Axis, CommandUnit, Data, ExperimentFileError as Error, Kind};
+use super::super::friction_map::count;
+use super::super::units::{units_for, SPEED_UNITS};
+use super::{number, Col, Order, Table};
+use crate::io::experiment_file::{
+    Axis, CommandUnit, Data, ExperimentFileError as Error, FrictionMap, Kind,
+};
 
 use Order::{Any, Increasing};
 
@@ -28,6 +31,18 @@ const RECORD_LOAD: [&str; 2] = ["table_angle", "load_angle"];
 const SERVO_LOOP: [&str; 2] = ["position", "motor_position"];
 /// The drive's effort in a servo trace.
 const SERVO_EFFORT: [(&str, Axis); 2] = [("torque_nm", Axis::Rotary), ("force_n", Axis::Linear)];
+
+/// A friction map's mean effort per run: torque, or force on a linear axis.
+const MAP_EFFORT: [(&str, Axis); 2] = SERVO_EFFORT;
+/// The standard deviation of a friction map's effort per run.
+const MAP_EFFORT_STD: [(&str, Axis); 2] = [
+    ("torque_std_nm", Axis::Rotary),
+    ("force_std_n", Axis::Linear),
+];
+/// A friction map's speed columns, `{base}_{unit}` with a unit of [`SPEED_UNITS`].
+const MAP_SPEEDS: [&str; 2] = ["speed", "speed_std"];
+/// A friction map's counts of samples per run.
+const MAP_COUNTS: [&str; 3] = ["samples", "dropped", "transient"];
 
 /// What drives a frequency-response record.
 #[derive(Clone, Copy, PartialEq)]
@@ -59,6 +74,7 @@ impl Table {
             Kind::Fluctuation | Kind::Unbalance => self.fluctuation(kind),
             Kind::FrequencyResponseTime => self.record(),
             Kind::ServoTrace => self.servo_trace(),
+            Kind::FrictionMap => self.friction_map(),
         }
     }
 
@@ -263,6 +279,84 @@ impl Table {
         }))
     }
 
+    /// A friction map: each run's speed (non-zero, distinct) and effort, optionally
+    /// their standard deviations and the counts of samples averaged, dropped and left
+    /// out; all rotary or all linear. The rows come back in order of increasing speed.
+    fn friction_map(mut self) -> Result<Data, Error> {
+        let speed = self.speed(MAP_SPEEDS[0])?.ok_or_else(|| {
+            let mut names = SPEED_UNITS
+                .iter()
+                .map(|u| format!("{}_{}", MAP_SPEEDS[0], u.suffix));
+            let first = names.next().unwrap_or_default();
+            self.missing(&first, names.collect())
+        })?;
+        let effort = self.effort(&MAP_EFFORT)?;
+        let speed_std = self.speed(MAP_SPEEDS[1])?;
+        let effort_std = self
+            .one_of(&MAP_EFFORT_STD, "effort's deviation")?
+            .map(|(col, axis)| Col {
+                axis: Some(axis),
+                ..col
+            });
+        let axis = self.same_axis(&[Some(speed), Some(effort), speed_std, effort_std])?;
+        let counts = MAP_COUNTS.map(|name| {
+            let index = self.find(name)?;
+            self.used[index] = true;
+            Some(Col {
+                index,
+                scale: 1.0,
+                axis: None,
+            })
+        });
+        let optional = |c: Option<Col>| c.map(|c| self.numbers(c, Any)).transpose();
+        let whole = |c: Option<Col>| {
+            c.map(|c| self.parse(c, |t| number(t).and_then(count)))
+                .transpose()
+        };
+        let map = FrictionMap {
+            axis,
+            speed: self.map_speeds(speed)?,
+            effort: self.numbers(effort, Any)?,
+            speed_std: optional(speed_std)?,
+            effort_std: optional(effort_std)?,
+            samples: whole(counts[0])?,
+            dropped: whole(counts[1])?,
+            transient: whole(counts[2])?,
+            extra: self.extras(),
+        };
+        Ok(Data::FrictionMap(map.sorted()))
+    }
+
+    /// The speed column `{base}_{unit}` in any unit of [`SPEED_UNITS`], converted to
+    /// rad/s or m/s, if there is one; two spellings are an error.
+    fn speed(&mut self, base: &str) -> Result<Option<Col>, Error> {
+        let names = SPEED_UNITS.map(|u| (format!("{base}_{}", u.suffix), u));
+        let choices = names.each_ref().map(|(n, u)| (n.as_str(), *u));
+        Ok(self.one_of(&choices, "speed")?.map(|(col, u)| Col {
+            scale: u.si,
+            axis: Some(u.axis),
+            ..col
+        }))
+    }
+
+    /// A friction map's speeds: none 0 (a run at rest is not on the map), no two alike
+    /// (one row per run); the error names the line.
+    fn map_speeds(&self, col: Col) -> Result<Vec<f64>, Error> {
+        let speed = self.numbers(col, Any)?;
+        if let Some(row) = speed.iter().position(|&v| v == 0.0) {
+            let message = "a speed of 0: a run at rest is not on a friction map".to_string();
+            return Err(self.cell(self.rows[row].0, col.index, message));
+        }
+        let mut order: Vec<usize> = (0..speed.len()).collect();
+        order.sort_by(|&a, &b| speed[a].total_cmp(&speed[b]).then(a.cmp(&b)));
+        if let Some(w) = order.windows(2).find(|w| speed[w[0]] == speed[w[1]]) {
+            let (first, second) = (self.rows[w[0]].0, self.rows[w[1]].0);
+            let message = format!("the same speed as line {first}: one row per run");
+            return Err(self.cell(second, col.index, message));
+        }
+        Ok(speed)
+    }
+
     /// Strictly increasing, uniformly sampled time.
     fn uniform_time(&self, t: Col) -> Result<Vec<f64>, Error> {
         let time_s = self.numbers(t, Increasing)?;
@@ -294,6 +388,12 @@ pub(in crate::io::experiment_file) fn reserved(kind: Kind) -> Vec<String> {
             p.extend(SERVO_LOOP);
             (vec!["time_s", SERVO_EFFORT[0].0, SERVO_EFFORT[1].0], p)
         }
+        Kind::FrictionMap => {
+            let mut plain: Vec<&str> = MAP_EFFORT.iter().map(|(n, _)| *n).collect();
+            plain.extend(MAP_EFFORT_STD.iter().map(|(n, _)| *n));
+            plain.extend(MAP_COUNTS);
+            (plain, vec![])
+        }
     };
     let position_names = positions.into_iter().flat_map(|b| {
         units_for(b)
@@ -304,10 +404,15 @@ pub(in crate::io::experiment_file) fn reserved(kind: Kind) -> Vec<String> {
         .into_iter()
         .filter(|_| kind == Kind::ServoTrace)
         .flat_map(|b| CommandUnit::ALL.map(|u| format!("{b}_{}", u.suffix())));
+    let speeds = MAP_SPEEDS
+        .into_iter()
+        .filter(|_| kind == Kind::FrictionMap)
+        .flat_map(|b| SPEED_UNITS.map(|u| format!("{b}_{}", u.suffix)));
     plain
         .into_iter()
         .map(str::to_string)
         .chain(position_names)
         .chain(commands)
+        .chain(speeds)
         .collect()
 }

@@ -1,16 +1,18 @@
 //! The columns [`super::write`] writes for each [`Data`] variant, in the file's units:
 //! angles in degrees, positioning deviations in arc-seconds or µm (targets in mm),
-//! other lengths in metres.
+//! other lengths in metres, speeds in rad/s or m/s.
 
 use std::borrow::Cow;
 
 use crate::io::experiment_file::data::{ServoTrace, Signal};
 use crate::io::experiment_file::units::{ARCSEC, DEG, MM, UM};
-use crate::io::experiment_file::{Axis, Data, Direction};
+use crate::io::experiment_file::{Axis, Data, Direction, FrictionMap};
 
 /// The cells of one column to write, in the file's unit.
 pub(super) enum Cells<'a> {
     Numbers(Cow<'a, [f64]>),
+    /// Whole numbers (a friction map's counts), written without a decimal point.
+    Counts(Vec<f64>),
     Directions(&'a [Direction]),
     Runs(&'a [u32]),
 }
@@ -19,6 +21,7 @@ impl Cells<'_> {
     pub(super) fn len(&self) -> usize {
         match self {
             Cells::Numbers(v) => v.len(),
+            Cells::Counts(v) => v.len(),
             Cells::Directions(v) => v.len(),
             Cells::Runs(v) => v.len(),
         }
@@ -44,6 +47,9 @@ pub(super) fn out_columns(data: &Data) -> Vec<Column<'_>> {
     let Some(extra) = data.extra() else {
         return Vec::new();
     };
+    if let Data::FrictionMap(map) = data {
+        return friction_map(map);
+    }
     let mut columns = match data {
         Data::Resonance { .. } => Vec::new(),
         Data::FrequencyResponse {
@@ -105,6 +111,7 @@ pub(super) fn out_columns(data: &Data) -> Vec<Column<'_>> {
             record(data)
         }
         Data::ServoTrace(trace) => servo_trace(trace),
+        Data::FrictionMap(_) => Vec::new(),
     };
     for (name, v) in extra {
         columns.push(plain(name.as_str(), v));
@@ -209,5 +216,37 @@ fn servo_trace(t: &ServoTrace) -> Vec<Column<'_>> {
             .as_ref()
             .map(|s| signal("controller_added", s)),
     );
+    c
+}
+
+/// A friction map's columns in SI (`speed_rad_s` and `torque_nm`, or `speed_m_s` and
+/// `force_n`), the optional ones where given (counts as whole numbers), the extra
+/// columns last; every column's rows in order of increasing speed.
+fn friction_map(m: &FrictionMap) -> Vec<Column<'static>> {
+    let m = m.sorted();
+    let [speed, speed_std, effort, effort_std] = match m.axis {
+        Axis::Rotary => [
+            "speed_rad_s",
+            "speed_std_rad_s",
+            "torque_nm",
+            "torque_std_nm",
+        ],
+        Axis::Linear => ["speed_m_s", "speed_std_m_s", "force_n", "force_std_n"],
+    };
+    let numbers = |name: &str, v: Vec<f64>| -> Column<'static> {
+        (name.to_string().into(), Cells::Numbers(v.into()))
+    };
+    let mut c = vec![numbers(speed, m.speed), numbers(effort, m.effort)];
+    c.extend(m.speed_std.map(|v| numbers(speed_std, v)));
+    c.extend(m.effort_std.map(|v| numbers(effort_std, v)));
+    let counts = [
+        ("samples", m.samples),
+        ("dropped", m.dropped),
+        ("transient", m.transient),
+    ];
+    for (name, v) in counts {
+        c.extend(v.map(|v| (name.into(), Cells::Counts(v))));
+    }
+    c.extend(m.extra.into_iter().map(|(name, v)| numbers(&name, v)));
     c
 }
