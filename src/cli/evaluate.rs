@@ -6,7 +6,7 @@ use anyhow::bail;
 
 use crate::cli::common::model_args::ModelArgs;
 use crate::cli::experiment::{
-    fluctuation, friction_map, frequency_response, frequency_response_time, positioning,
+    fluctuation, frequency_response, frequency_response_time, friction_map, positioning,
     servo_trace, torque_curve,
 };
 use rtid::io::experiment_file::{self, Kind};

@@ -18,8 +18,8 @@
 
 pub mod compare;
 pub mod fluctuation;
-pub mod friction_map;
 pub mod frequency_response;
+pub mod friction_map;
 pub mod measurement_noise;
 pub mod positioning;
 pub mod servo_trace;

@@ -25,9 +25,16 @@ fn effort_label(axis: Axis) -> &'static str {
 /// Coulomb law dashed), drawn per direction so that no line crosses zero speed.
 pub fn map(e: &MapEvaluation, title: &str) -> Figure {
     let (to_unit, x_label) = speed_unit(e.axis);
-    let measured = e.runs.iter().map(|r| (r.speed * to_unit, r.effort)).collect();
-    let mut figure = Figure::new(title, x_label, effort_label(e.axis))
-        .with(Series::new("runs (mean)", measured, Style::Markers));
+    let measured = e
+        .runs
+        .iter()
+        .map(|r| (r.speed * to_unit, r.effort))
+        .collect();
+    let mut figure = Figure::new(title, x_label, effort_label(e.axis)).with(Series::new(
+        "runs (mean)",
+        measured,
+        Style::Markers,
+    ));
     let selected = e.selected();
     let coulomb = coulomb(e).filter(|f| f.law != selected.law);
     for (fit, style) in [(Some(selected), Style::Line), (coulomb, Style::Dashed)] {
@@ -42,8 +49,7 @@ pub fn map(e: &MapEvaluation, title: &str) -> Figure {
 }
 
 fn coulomb(e: &MapEvaluation) -> Option<&LawFit> {
-    e.laws
-        .fit(crate::estimation::friction_law::Law::Coulomb)
+    e.laws.fit(crate::estimation::friction_law::Law::Coulomb)
 }
 
 /// The law over each direction's measured speed range, 200 points spaced evenly in
@@ -77,7 +83,11 @@ fn curve(e: &MapEvaluation, fit: &LawFit, to_unit: f64) -> Vec<(&'static str, Ve
 /// The selected law's residuals (measured − law) over speed.
 pub fn residuals(e: &MapEvaluation, title: &str) -> Figure {
     let (to_unit, x_label) = speed_unit(e.axis);
-    let points = e.runs.iter().map(|r| (r.speed * to_unit, r.residual)).collect();
+    let points = e
+        .runs
+        .iter()
+        .map(|r| (r.speed * to_unit, r.residual))
+        .collect();
     let y = match e.axis {
         Axis::Rotary => "measured − law, N·m",
         Axis::Linear => "measured − law, N",

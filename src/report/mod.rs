@@ -3,9 +3,9 @@
 
 pub mod figure;
 pub mod fluctuation;
-pub mod friction_map;
 pub mod frequency_response;
 pub mod frequency_response_time;
+pub mod friction_map;
 pub mod html;
 pub mod identify;
 pub mod periodic;

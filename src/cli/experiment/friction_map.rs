@@ -5,7 +5,7 @@ use std::path::Path;
 use anyhow::Context;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use rtid::experiments::friction_map::{self, MapEvaluation, MapTest};
-use rtid::io::experiment_file::{Axis, Experiment, FrictionMap, Kind, Manifest};
+use rtid::io::experiment_file::{Axis, Data, Experiment, Kind, Manifest};
 use rtid::model::{Drive, Params};
 use rtid::report::friction_map as figures;
 
@@ -15,7 +15,7 @@ use crate::cli::common::progress;
 pub const LONG_ABOUT: &str = "\
 Friction map: the servo holds the axis at a series of constant motor speeds in both \
 directions, one run each, from rest; after --settle-s the motor speed and torque are \
-sampled every ms over --average-s (lengthened to whole revolutions of the driving shaft \
+averaged over every integration step of --average-s (lengthened to whole revolutions of the driving shaft \
 when the drive has a gear fluctuation, which averages out only over whole revolutions), \
 and each run's mean and scatter make a row of the map. The map shows the friction law at \
 the motor: the Coulomb level, a Stribeck rise at low speed (parameters fsm, vsm, \
@@ -31,7 +31,7 @@ stribeck_asymmetric — ranked by AICc, and the law the data support.
 Example:
   rtid experiment friction-map --preset worm-gear --out runs/worm
   rtid experiment friction-map --preset direct-drive --set fst=0.5 --set vst=0.2 \\
-      --speeds-rpm 1,2,5,10,20,50,100 --noise-percent 1 --out runs/dd
+      --speeds-rpm 1,2,5,10,20,50,100 --noise-percent 1 --scatter-percent 1 --out runs/dd
   rtid experiment friction-map --params fixtures/real/emps/axis.json --speeds-mm-s 2,5,10,20,50,100 --out runs/emps";
 
 /// Arguments of `rtid experiment friction-map`.
@@ -42,22 +42,58 @@ pub struct Args {
     /// Rotary axis: motor speeds, rpm, comma-separated; each is run in both directions
     /// (a negative value only in its own) [default: ±0.2 … ±50 % of the speed limit,
     /// eight per direction].
-    #[arg(long, value_name = "RPM,…", value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "RPM,…",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
     pub speeds_rpm: Vec<f64>,
     /// Linear axis: speeds, mm/s, as --speeds-rpm.
-    #[arg(long, value_name = "MM_S,…", value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "MM_S,…",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
     pub speeds_mm_s: Vec<f64>,
     /// Time from each run's start to its averaging window, s.
-    #[arg(long, value_name = "SECONDS", default_value_t = 0.5, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 0.5,
+        allow_negative_numbers = true
+    )]
     pub settle_s: f64,
     /// Averaging window of each run, s.
-    #[arg(long, value_name = "SECONDS", default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
     pub average_s: f64,
-    /// Scatter of the runs: each mean torque multiplied by (1 + ε), ε Gaussian with
-    /// this standard deviation in per cent.
-    #[arg(long, value_name = "PERCENT", default_value_t = 0.0, allow_negative_numbers = true)]
+    /// Measurement noise on the torque samples: Gaussian, this percentage of each run's
+    /// RMS torque, added to every sample before the run is averaged (as a recorder's
+    /// noise is).
+    #[arg(
+        long,
+        value_name = "PERCENT",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
     pub noise_percent: f64,
-    /// Seed of the scatter.
+    /// Scatter from run to run (what a real map shows beyond the recorder's noise:
+    /// temperature, lubrication, position along the axis): each run's mean torque
+    /// multiplied by (1 + ε), ε Gaussian with this standard deviation in per cent.
+    #[arg(
+        long,
+        value_name = "PERCENT",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub scatter_percent: f64,
+    /// Seed of the noise and the scatter.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
 }
@@ -75,19 +111,32 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let bar = progress::bar(test.speeds.len() as u64, "friction map", a.common.quiet);
     let mut map = friction_map::run(&p, &test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
-    rtid::experiments::measurement_noise::perturb_relative(&mut map.effort, a.noise_percent, a.seed);
-    a.common
-        .write_and_report("friction_map", manifest(&p, &test, &a), &rtid::io::experiment_file::Data::FrictionMap(map), report)
+    rtid::experiments::measurement_noise::perturb_relative(
+        &mut map.effort,
+        a.scatter_percent,
+        a.seed.wrapping_add(test.speeds.len() as u64),
+    );
+    a.common.write_and_report(
+        "friction_map",
+        manifest(&p, &test, &a),
+        &Data::FrictionMap(map),
+        report,
+    )
 }
 
 /// The test the flags describe, or why they do not describe one.
 fn test(a: &Args, p: &Params) -> anyhow::Result<MapTest> {
     check::non_negative(a.noise_percent, "--noise-percent")?;
+    check::non_negative(a.scatter_percent, "--scatter-percent")?;
     let (given, option, si) = match (p.axis, a.speeds_rpm.is_empty(), a.speeds_mm_s.is_empty()) {
         (Axis::Rotary, _, true) => (&a.speeds_rpm, "--speeds-rpm", std::f64::consts::TAU / 60.0),
         (Axis::Linear, true, _) => (&a.speeds_mm_s, "--speeds-mm-s", 1e-3),
-        (Axis::Rotary, _, false) => anyhow::bail!("--speeds-mm-s is for a linear axis; this axis is rotary (--speeds-rpm)"),
-        (Axis::Linear, false, _) => anyhow::bail!("--speeds-rpm is for a rotary axis; this axis is linear (--speeds-mm-s)"),
+        (Axis::Rotary, _, false) => {
+            anyhow::bail!("--speeds-mm-s is for a linear axis; this axis is rotary (--speeds-rpm)")
+        }
+        (Axis::Linear, false, _) => {
+            anyhow::bail!("--speeds-rpm is for a rotary axis; this axis is linear (--speeds-mm-s)")
+        }
     };
     let speeds = if given.is_empty() {
         MapTest::default_speeds(p)
@@ -98,7 +147,9 @@ fn test(a: &Args, p: &Params) -> anyhow::Result<MapTest> {
         speeds,
         settle: check::positive(a.settle_s, "--settle-s")?,
         average: check::positive(a.average_s, "--average-s")?,
-        sample: 1e-3,
+        sample: 0.0,
+        noise_percent: a.noise_percent,
+        seed: a.seed,
     };
     let d = Drive::new(p)?;
     for &v in &test.speeds {
@@ -147,8 +198,14 @@ fn manifest(p: &Params, test: &MapTest, a: &Args) -> Manifest {
     );
     if a.noise_percent > 0.0 {
         notes += &format!(
-            "; each mean torque scattered by {} % (Gaussian, seed {})",
+            "; {} % (of each run's RMS) Gaussian noise on the torque samples (seed {})",
             a.noise_percent, a.seed
+        );
+    }
+    if a.scatter_percent > 0.0 {
+        notes += &format!(
+            "; each run's mean torque scattered by {} % (Gaussian)",
+            a.scatter_percent
         );
     }
     m.notes = Some(notes);
@@ -158,10 +215,11 @@ fn manifest(p: &Params, test: &MapTest, a: &Args) -> Manifest {
 /// Evaluates a friction-map experiment: runs and laws printed (table or JSON), the map
 /// with its laws written to `plot` and the residuals beside it (`STEM-residuals.svg`).
 pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
-    let rtid::io::experiment_file::Data::FrictionMap(map) = &exp.data else {
+    let Data::FrictionMap(map) = &exp.data else {
         anyhow::bail!("{}: not a friction map", exp.path.display());
     };
-    let e = friction_map::evaluate(map).map_err(|m| anyhow::anyhow!("{}: {m}", exp.path.display()))?;
+    let e =
+        friction_map::evaluate(map).map_err(|m| anyhow::anyhow!("{}: {m}", exp.path.display()))?;
     let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("axis");
     figures::map(&e, &format!("{mechanism}: friction map")).write(plot)?;
     let stem = plot.file_stem().unwrap_or_default().to_string_lossy();
@@ -216,7 +274,13 @@ fn runs_table(e: &MapEvaluation) -> Table {
 fn laws_table(e: &MapEvaluation) -> Table {
     let mut t = Table::new();
     t.load_preset(UTF8_FULL_CONDENSED);
-    t.set_header(["law", "parameters (SI) ± standard error", "RMS residual", "ΔAICc", "weight"]);
+    t.set_header([
+        "law",
+        "parameters (SI) ± standard error",
+        "RMS residual",
+        "ΔAICc",
+        "weight",
+    ]);
     for c in &e.laws.selection.candidates {
         let Some(fit) = e.laws.fits.iter().find(|f| f.law.name() == c.label) else {
             continue;
@@ -238,7 +302,13 @@ fn laws_table(e: &MapEvaluation) -> Table {
         ]);
     }
     for r in &e.laws.refused {
-        t.add_row([r.law.name().to_string(), format!("not fitted: {}", r.reason), "".into(), "".into(), "".into()]);
+        t.add_row([
+            r.law.name().to_string(),
+            format!("not fitted: {}", r.reason),
+            "".into(),
+            "".into(),
+            "".into(),
+        ]);
     }
     t
 }

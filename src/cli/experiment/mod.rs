@@ -4,9 +4,9 @@
 
 pub mod check;
 pub mod fluctuation;
-pub mod friction_map;
 pub mod frequency_response;
 pub mod frequency_response_time;
+pub mod friction_map;
 pub mod periodic_summary;
 pub mod positioning;
 pub mod servo_trace;

@@ -43,10 +43,8 @@ mod tests {
         let p = presets::load("worm-gear").unwrap();
         let (rg, rw) = (p.rg.unwrap(), p.rw);
         let w = 10.0;
-        let expected = p.cm * w
-            + p.fm
-            + rg * (p.cw * rg * w + p.fw)
-            + rg * rw * (p.ct * rg * rw * w + p.ft);
+        let expected =
+            p.cm * w + p.fm + rg * (p.cw * rg * w + p.fw) + rg * rw * (p.ct * rg * rw * w + p.ft);
         let got = model_map(&p, &[w, -w]).unwrap();
         assert!((got[0] - expected).abs() < 1e-12 * expected, "{got:?}");
         assert!((got[1] + expected).abs() < 1e-12 * expected, "{got:?}");

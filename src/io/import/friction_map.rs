@@ -153,7 +153,7 @@ fn statistics(r: &Record, range: Range<usize>) -> Result<Run, String> {
     let effort = &r.role("effort").values[range];
     let unit = speed_unit(r.axis);
     let run = runs::statistics(speed, effort).map_err(|e| match e {
-        RunError::Scattered { .. } | RunError::Drifting { .. } => format!("{e} (speeds in {unit})"),
+        RunError::Drifting { .. } => format!("{e} (speeds in {unit})"),
         _ => e.to_string(),
     })?;
     if run.reference == 0.0 || run.speed == 0.0 {

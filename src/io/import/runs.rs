@@ -16,8 +16,12 @@
 //! 6. Over the samples left: the mean speed and effort, their sample standard
 //!    deviations (n − 1 denominator), n.
 //! 7. The run has not settled — an error — when fewer than [`MIN_SAMPLES`] samples are
-//!    left, when more than 10 % of them lie outside the band, or when the mean speeds of
-//!    their first and second halves differ by more than `b`.
+//!    left, or when the mean speeds of their first and second halves differ by more
+//!    than `b`. Samples outside the band after the transient are counted, not refused:
+//!    at a creep speed a recorder's speed reading scatters far around its mean (the
+//!    shared lead-screw drive at −2 rpm reads 0 … 15 rpm, a fifth of its samples
+//!    outside the band) while the run itself holds its speed, and its mean is what the
+//!    map needs.
 
 use std::ops::Range;
 
@@ -31,9 +35,6 @@ pub const BAND_FRACTION: f64 = 0.05;
 
 /// The settle band's width in quanta of the speed, at least.
 pub const BAND_QUANTA: f64 = 2.0;
-
-/// The largest share of the averaged samples that may lie outside the settle band.
-pub const OUTSIDE_FRACTION: f64 = 0.10;
 
 /// The settle band around `reference` for a speed of quantum `quantum`:
 /// `max(0.05·|reference|, 2·quantum)`.
@@ -71,7 +72,7 @@ pub struct Run {
     /// From the first averaged sample to the end: every index in it but the dropped
     /// ones was averaged.
     pub averaged: Range<usize>,
-    /// How many averaged samples lie outside the settle band (at most 10 %).
+    /// How many averaged samples lie outside the settle band (counted, not refused).
     pub outside: usize,
 }
 
@@ -91,19 +92,6 @@ pub enum RunError {
         left: usize,
         dropped: usize,
         transient: usize,
-    },
-    /// More than 10 % of the averaged samples outside the settle band.
-    #[error(
-        "not settled: {outside} of {samples} samples lie outside the settle band {} ± {}, \
-         more than 10 %",
-        short(*reference),
-        short(*band)
-    )]
-    Scattered {
-        outside: usize,
-        samples: usize,
-        reference: f64,
-        band: f64,
     },
     /// The mean speed drifts across the run.
     #[error(
@@ -150,14 +138,6 @@ pub fn statistics(speed: &[f64], effort: &[f64]) -> Result<Run, RunError> {
         });
     }
     let outside = used.iter().filter(|&&i| !within(i)).count();
-    if outside as f64 > OUTSIDE_FRACTION * used.len() as f64 {
-        return Err(RunError::Scattered {
-            outside,
-            samples: used.len(),
-            reference,
-            band,
-        });
-    }
     let half = used.len() / 2;
     let (first, second) = (
         mean(used[..half].iter().map(|&i| speed[i])),
@@ -292,7 +272,7 @@ mod tests {
         let v: Vec<f64> = (0..100).map(|i| 10.0 + 0.1 * i as f64).collect();
         let e = vec![1.0; 100];
         let err = statistics(&v, &e).unwrap_err();
-        assert!(matches!(err, RunError::Scattered { .. }), "{err}");
+        assert!(matches!(err, RunError::Drifting { .. }), "{err}");
         assert!(err.to_string().starts_with("not settled"), "{err}");
         // A speed that changes halfway by less than the band on either side of the
         // median, but by more than the band between the halves.
