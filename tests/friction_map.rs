@@ -79,7 +79,10 @@ fn a_virtual_map_gives_its_stribeck_law_back_directly_and_through_the_model() {
         let dir = tempfile::tempdir().unwrap();
         let map = virtual_map(dir.path(), seed);
         // The direct fit: the symmetric Stribeck law is selected, each value within 2 %.
-        let out = ok(&rtid(&["evaluate", map.to_str().unwrap(), "--json"], dir.path()));
+        let out = ok(&rtid(
+            &["evaluate", map.to_str().unwrap(), "--json"],
+            dir.path(),
+        ));
         let e: Value = serde_json::from_str(&out).unwrap();
         assert_eq!(e["laws"]["selected"], "stribeck", "seed {seed}");
         let fit = e["laws"]["fits"]
@@ -147,11 +150,12 @@ fn a_virtual_map_gives_its_stribeck_law_back_directly_and_through_the_model() {
 
 /// A map file of the given rows (rad/s, N·m) in `dir`.
 fn map_file(dir: &Path, name: &str, rows: &[(f64, f64)]) -> PathBuf {
-    let csv: String = rows
-        .iter()
-        .map(|(v, t)| format!("{v},{t}\n"))
-        .collect();
-    std::fs::write(dir.join(format!("{name}.csv")), format!("speed_rad_s,torque_nm\n{csv}")).unwrap();
+    let csv: String = rows.iter().map(|(v, t)| format!("{v},{t}\n")).collect();
+    std::fs::write(
+        dir.join(format!("{name}.csv")),
+        format!("speed_rad_s,torque_nm\n{csv}"),
+    )
+    .unwrap();
     let manifest = dir.join(format!("{name}.json"));
     std::fs::write(&manifest, r#"{"kind": "friction_map"}"#).unwrap();
     manifest
@@ -169,7 +173,16 @@ fn maps_no_law_can_be_fitted_to_are_refused_naming_the_file() {
     for (name, speeds, says) in cases {
         let rows: Vec<(f64, f64)> = speeds
             .iter()
-            .map(|&v| (v, if name == "one_sign" { law(v).abs() } else { law(v) }))
+            .map(|&v| {
+                (
+                    v,
+                    if name == "one_sign" {
+                        law(v).abs()
+                    } else {
+                        law(v)
+                    },
+                )
+            })
             .collect();
         let file = map_file(dir.path(), name, &rows);
         for command in [

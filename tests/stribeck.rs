@@ -153,3 +153,46 @@ fn a_rise_without_a_speed_is_refused_naming_both() {
         "fsw applies to the spur gear only"
     );
 }
+
+#[test]
+fn a_stribeck_rise_on_the_table_widens_the_worms_reversal_value() {
+    // The sweep output `reversal` (ISO 230-2 mean reversal B̄ of the positioning test)
+    // against the table's Stribeck rise: a higher static level holds the table longer
+    // at each reversal, so the lost motion grows (measured 35.5 → 37.6 arc-sec from
+    // fst = 0 to 0.3 N·m at vst = 0.02 rad/s).
+    let dir = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rtid"))
+        .args([
+            "sweep",
+            "--preset",
+            "worm-gear",
+            "--set",
+            "vst=0.02",
+            "--vary",
+            "fst=0..0.3:3",
+            "--outputs",
+            "reversal",
+            "--out",
+            "rev.csv",
+            "--quiet",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(dir.path().join("rev.csv")).unwrap();
+    let reversal: Vec<f64> = text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("index"))
+        .map(|l| l.split(',').nth(2).unwrap().parse::<f64>().unwrap().abs())
+        .collect();
+    assert_eq!(reversal.len(), 3);
+    assert!(
+        reversal[0] < reversal[1] && reversal[1] < reversal[2] && reversal[2] - reversal[0] > 1.0,
+        "{reversal:?} arc-sec"
+    );
+}
