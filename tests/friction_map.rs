@@ -4,31 +4,11 @@
 //! fitted to are refused naming the file.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use serde_json::Value;
 
-fn rtid(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtid"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the rtid binary runs")
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "rtid failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout.clone()).unwrap()
-}
-
-fn err(out: &Output) -> String {
-    assert!(!out.status.success(), "rtid succeeded where it should not");
-    String::from_utf8(out.stderr.clone()).unwrap()
-}
+mod cli_support;
+use cli_support::{err, ok, rtid};
 
 /// The direct drive's table with a Stribeck law and a load: Coulomb 1.5 N·m, static
 /// 2.0 N·m, Stribeck speed 0.2 rad/s, δ = 1, viscous 0.3 N·m·s/rad, Tload 0.3 N·m.

@@ -15,31 +15,12 @@
 //! than the reference's best, and the law selected (rtid: coulomb; the step would tip
 //! AICc to stribeck by 1.0) is not compared there.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
 use serde_json::Value;
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn rtid(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtid"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the rtid binary runs")
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "rtid failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout.clone()).unwrap()
-}
+mod cli_support;
+use cli_support::{ok, root, rtid};
 
 /// `rtid evaluate --json` of the map of one drive's steady-state runs.
 fn evaluated(drive: &str, dir: &Path) -> Value {
