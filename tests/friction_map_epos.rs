@@ -9,11 +9,12 @@
 //! median of 1): rtid averages them (docs/import.md §2), so its map has 32 runs, the
 //! reference's `including_not_settled` fits. Drive 2 shows no Stribeck rise: rtid's
 //! local Levenberg–Marquardt stops where Fs = Fc and says the rise is not shown, while
-//! the reference's global multi-start finds a step (δ in the thousands) between its two
+//! the reference's multi-start finds a step (δ in the thousands) between its two
 //! 200 rpm runs with a lower cost — not a friction law, and not a number either fit
-//! determines. So on drive 2 the Stribeck laws' cost is only checked to be no lower
-//! than the reference's best, and the law selected (rtid: coulomb; the step would tip
-//! AICc to stribeck by 1.0) is not compared there.
+//! determines (a wider random search finds lower steps still). So on drive 2 the
+//! Stribeck laws' cost is only checked to be no lower than the reference's, with the
+//! rise said not to show, and the law selected (rtid: coulomb; the step would tip AICc
+//! to stribeck by 1.0) is not compared there.
 
 use std::path::Path;
 
