@@ -12,7 +12,7 @@
 
 use super::registry::{Definition, Estimated, SetupError, Source};
 use super::{Fidelity, Objective, ObjectiveError, Properties, Smoothness};
-use crate::estimation::friction_law::LawFit;
+use crate::estimation::friction_law::{check_map, LawFit};
 use crate::experiments::friction_map::{evaluate, model_effort};
 use crate::io::experiment_file::{Data, FrictionMap, Kind};
 use crate::model::{Drive, Params, Topology};
@@ -54,10 +54,11 @@ fn map_of<'a>(source: &Source<'a>) -> Result<&'a FrictionMap, SetupError> {
 
 fn build(source: &Source<'_>, _: Fidelity) -> Result<Box<dyn Objective>, SetupError> {
     let map = map_of(source)?;
-    // A map no law can be fitted to is refused here, naming the file.
-    evaluate(map).map_err(|reason| SetupError::Data {
+    // A map no law can be fitted to is refused here, naming the file (the checks
+    // alone: the laws are fitted once, by the first estimate).
+    check_map(&map.speed, &map.effort).map_err(|e| SetupError::Data {
         file: source.file.into(),
-        reason,
+        reason: e.to_string(),
     })?;
     Ok(Box::new(MapResidual::new(map)))
 }

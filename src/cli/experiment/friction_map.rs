@@ -6,7 +6,7 @@ use anyhow::Context;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use rtid::experiments::friction_map::{self, MapEvaluation, MapTest};
 use rtid::io::experiment_file::{Axis, Data, Experiment, Kind, Manifest};
-use rtid::model::{Drive, Params};
+use rtid::model::Params;
 use rtid::report::friction_map as figures;
 
 use super::{check, Common};
@@ -102,7 +102,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
     let test = test(&a, &p)?;
     check::work(
-        test.duration(&p)?,
+        test.duration(&p),
         check::MAX_SIMULATED_S,
         "simulated seconds",
         "--speeds-rpm (--speeds-mm-s), --settle-s, --average-s",
@@ -151,9 +151,8 @@ fn test(a: &Args, p: &Params) -> anyhow::Result<MapTest> {
         noise_percent: a.noise_percent,
         seed: a.seed,
     };
-    let d = Drive::new(p)?;
     for &v in &test.speeds {
-        let window = test.window(&d, p, v);
+        let window = test.window(p, v);
         if window > friction_map::run::MAX_WINDOW_S {
             anyhow::bail!(
                 "{option}: at {} the averaging window would be {window:.0} s (whole revolutions of the driving shaft, whose gear fluctuation averages out only over them), beyond {} s: give faster speeds",

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use crate::experiments::measurement_noise::perturb_by_rms;
 use crate::io::experiment_file::FrictionMap;
 use crate::model::idx::OMEGA_M;
-use crate::model::{Drive, Params, Topology, NSTATE};
+use crate::model::{Params, NSTATE};
 use crate::recorder::{NullRecorder, Recorder};
 use crate::sim::{SimError, Simulation};
 
@@ -53,27 +53,24 @@ impl MapTest {
         ups.iter().rev().map(|v| -v).chain(ups.clone()).collect()
     }
 
-    /// The averaging window at motor speed `speed` on drive `d`.
-    pub fn window(&self, d: &Drive, p: &Params, speed: f64) -> f64 {
+    /// The averaging window at motor speed `speed` of drive `p`.
+    pub fn window(&self, p: &Params, speed: f64) -> f64 {
         if p.w == 0.0 || p.axis == crate::model::Axis::Linear {
             return self.average;
         }
-        let shaft_speed = match p.topology {
-            Topology::SpurGear => d.ratio() / p.rw * speed,
-            _ => speed,
-        };
+        // The driving shaft turns Rg times the motor (the motor itself without a spur
+        // stage, where Rg is absent).
+        let shaft_speed = p.rg.unwrap_or(1.0) * speed;
         let revolution = std::f64::consts::TAU / shaft_speed.abs();
         (self.average / revolution).ceil().max(1.0) * revolution
     }
 
     /// Simulated seconds of the whole map.
-    pub fn duration(&self, p: &Params) -> Result<f64, SimError> {
-        let d = Drive::new(p).map_err(SimError::from)?;
-        Ok(self
-            .speeds
+    pub fn duration(&self, p: &Params) -> f64 {
+        self.speeds
             .iter()
-            .map(|&v| self.settle + self.window(&d, p, v))
-            .sum())
+            .map(|&v| self.settle + self.window(p, v))
+            .sum()
     }
 }
 
@@ -104,14 +101,13 @@ pub fn run(
     test: &MapTest,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<FrictionMap, SimError> {
-    let d = Drive::new(p).map_err(SimError::from)?;
     let done = std::sync::atomic::AtomicUsize::new(0);
     let runs: Vec<Samples> = test
         .speeds
         .par_iter()
         .enumerate()
         .map(|(k, &v)| {
-            let run = one_speed(p, test, v, test.window(&d, p, v)).map(|mut r| {
+            let run = one_speed(p, test, v, test.window(p, v)).map(|mut r| {
                 let seed = test.seed.wrapping_add(k as u64);
                 perturb_by_rms(&mut r.effort, test.noise_percent, seed);
                 r
@@ -191,7 +187,6 @@ mod tests {
     fn the_window_is_whole_shaft_revolutions_with_a_fluctuation() {
         let p = presets::load("worm-gear").unwrap();
         assert!(p.w > 0.0);
-        let d = Drive::new(&p).unwrap();
         let test = MapTest {
             speeds: vec![1.0],
             settle: 0.5,
@@ -201,7 +196,7 @@ mod tests {
             seed: 1,
         };
         let shaft = p.rg.unwrap();
-        let window = test.window(&d, &p, 1.0);
+        let window = test.window(&p, 1.0);
         let turns = window * shaft / std::f64::consts::TAU;
         assert!(
             (turns - turns.round()).abs() < 1e-9 && window >= 1.0,
