@@ -19,6 +19,22 @@ pub fn perturb_gain_db(gain_db: &mut [f64], percent: f64, seed: u64) {
     }
 }
 
+/// Multiplies each complex ratio (gain dB, phase rad) by 1 + ε_r + i·ε_i, ε_r and
+/// ε_i ~ N(0, (percent/100)²) each: an analyser's complex noise, which moves ln|H|
+/// and the phase alike.
+pub fn perturb_complex(gain_db: &mut [f64], phase_rad: &mut [f64], percent: f64, seed: u64) {
+    if percent <= 0.0 {
+        return;
+    }
+    let normal = Normal::new(0.0, percent / 100.0).expect("finite σ");
+    let mut rng = StdRng::seed_from_u64(seed);
+    for (g, ph) in gain_db.iter_mut().zip(phase_rad.iter_mut()) {
+        let (re, im): (f64, f64) = (1.0 + normal.sample(&mut rng), normal.sample(&mut rng));
+        *g += 20.0 * re.hypot(im).max(1e-3).log10();
+        *ph += im.atan2(re);
+    }
+}
+
 /// Adds N(0, σ²) with σ = percent/100 of the record's RMS to every sample.
 pub fn perturb_by_rms(values: &mut [f64], percent: f64, seed: u64) {
     if percent <= 0.0 || values.is_empty() {

@@ -29,7 +29,7 @@ use crate::identify::config::ExperimentSpec;
 use crate::identify::intervals::uncertainty::{self, jacobian};
 use crate::identify::setup;
 use crate::identify::space::ParamSpace;
-use crate::io::experiment_file::Experiment;
+use crate::io::experiment_file::{Experiment, Response};
 use crate::model::Params;
 use crate::objectives::{Fidelity, Stage};
 
@@ -146,8 +146,8 @@ fn experiment(p: &Params, c: &Candidate) -> Result<Experiment, DesignError> {
         Test::FrequencyResponse(t) => {
             let points = fr::sweep(p, t, &|| {}).map_err(|e| failed(&e))?;
             (
-                fr::manifest(p, t, false),
-                fr::to_data(p, &points).map_err(|e| failed(&e))?,
+                fr::manifest(p, t, false, Response::TableOverMotor),
+                fr::to_data(p, &points, Response::TableOverMotor).map_err(|e| failed(&e))?,
             )
         }
         Test::TorqueCurve(t) => {

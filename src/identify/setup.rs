@@ -36,7 +36,7 @@ pub(crate) fn selection(
             }
             chosen
         }
-        None => ObjectiveKind::defaults(kind, stage),
+        None => ObjectiveKind::defaults(&spec.experiment, stage),
     };
     if chosen.is_empty() {
         return Err(SetupError::Unsupported {
@@ -75,19 +75,21 @@ pub fn build(
 /// search (those at full relative weight, not tie-breakers) determine, in registry
 /// order, each once.
 pub(crate) fn default_fit(specs: &[ExperimentSpec], p: &Params) -> Result<Vec<String>, SetupError> {
-    let mut primary: Vec<ObjectiveKind> = Vec::new();
+    let mut primary: Vec<(ObjectiveKind, &ExperimentSpec)> = Vec::new();
     for spec in specs {
         for (kind, weight) in selection(spec, Stage::Search)? {
-            if weight >= spec.weight && !primary.contains(&kind) {
-                primary.push(kind);
+            if weight >= spec.weight {
+                primary.push((kind, spec));
             }
         }
     }
     let mut fit: Vec<String> = Vec::new();
-    for kind in ObjectiveKind::all().filter(|k| primary.contains(k)) {
-        for name in (kind.definition().determines)(p) {
-            if !fit.iter().any(|f| f == name) {
-                fit.push(name.to_string());
+    for kind in ObjectiveKind::all() {
+        for (_, spec) in primary.iter().filter(|(k, _)| *k == kind) {
+            for name in (kind.definition().determines)(&spec.experiment, p) {
+                if !fit.iter().any(|f| f == name) {
+                    fit.push(name.to_string());
+                }
             }
         }
     }

@@ -11,6 +11,7 @@
 mod conditions;
 mod data;
 mod friction_map;
+mod response;
 mod sampling;
 mod table;
 #[cfg(test)]
@@ -25,6 +26,7 @@ mod writer;
 pub use conditions::{Conditions, Excitation};
 pub use data::{Approaches, Data, ServoTrace, Signal, TimeRecord};
 pub use friction_map::FrictionMap;
+pub use response::{Delay, Reference, Response, ResponseForm};
 pub use sampling::{check_uniform, sample_period, NonUniform, SAMPLING_TOLERANCE};
 pub use units::{Axis, CommandUnit};
 pub use writer::write;

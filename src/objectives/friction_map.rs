@@ -27,8 +27,8 @@ pub static DEFINITION: Definition = Definition {
         smoothness: Smoothness::Smooth,
         frequency_response: false,
     },
-    determines,
-    default_weight: |kind, _| (kind == Kind::FrictionMap).then_some(1.0),
+    determines: |_, p| determines(p),
+    default_weight: |exp, _| (exp.manifest.kind == Kind::FrictionMap).then_some(1.0),
     build,
     first_estimate: Some(direct_fit_start),
 };

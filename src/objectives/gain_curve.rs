@@ -7,14 +7,18 @@
 //! Points a measurement marks as meaningless (`below_resolution` = 1: the table did
 //! not move more than the encoder resolves) are left out.
 
-use super::model_peaks::{nonlinear_gains, GRID_BAND};
+use std::f64::consts::TAU;
+
+use super::complex_response::{fit_delay, rms_errors, sigmas, wrap};
+use super::measured::DB_PER_NEPER;
+use super::model_peaks::{nonlinear_responses, GRID_BAND};
 use super::registry::{Definition, SetupError, Source, Stage};
 use super::resonance::drive_stiffnesses;
-use super::{measured, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
+use super::{measured, Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::frequency_response::FrequencyTest;
-use crate::io::experiment_file::Kind;
+use crate::io::experiment_file::{Delay, Experiment, Kind, Response};
 use crate::model::linear_response::{Channel, LinearResponse};
-use crate::model::Params;
+use crate::model::{Params, Topology};
 
 const PROPERTIES: Properties = Properties {
     smoothness: Smoothness::Smooth,
@@ -24,13 +28,14 @@ const PROPERTIES: Properties = Properties {
 /// The whole measured gain curve.
 pub static DEFINITION: Definition = Definition {
     name: "gain_curve",
-    summary: "dB error of the gain at every measured frequency",
+    summary:
+        "dB error of the gain at every measured frequency, and of the phase where the file has one",
     reads: &[Kind::FrequencyResponse],
     needs: "a frequency_response experiment",
     properties: PROPERTIES,
-    determines: drive_stiffnesses,
-    default_weight: |_, _| None,
-    build: |source, fidelity| Ok(Box::new(GainCurve::of(source, fidelity, |_| true))),
+    determines: curve_determines,
+    default_weight: |exp, stage| (stage == Stage::Search && fits_whole_curve(exp)).then_some(1.0),
+    build: |source, fidelity| Ok(Box::new(GainCurve::of(source, fidelity, |_| true)?)),
     first_estimate: None,
 };
 
@@ -46,9 +51,9 @@ pub static NEAR_PEAKS: Definition = Definition {
     reads: &[Kind::FrequencyResponse],
     needs: "a frequency_response experiment",
     properties: PROPERTIES,
-    determines: drive_stiffnesses,
-    default_weight: |kind, stage| {
-        (kind == Kind::FrequencyResponse && stage == Stage::Correction).then_some(1.0)
+    determines: |_, p| drive_stiffnesses(p),
+    default_weight: |exp, stage| {
+        (exp.manifest.kind == Kind::FrequencyResponse && stage == Stage::Correction).then_some(1.0)
     },
     build: near_peaks,
     first_estimate: None,
@@ -61,44 +66,196 @@ fn near_peaks(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objecti
             .iter()
             .any(|pk| (f - pk.frequency_hz).abs() <= GRID_BAND * pk.frequency_hz)
     };
-    Ok(Box::new(GainCurve::of(source, fidelity, near)))
+    Ok(Box::new(GainCurve::of(source, fidelity, near)?))
 }
 
-/// One scaled residual is this error, dB.
+/// Whether a frequency response is fitted by its whole curve by default rather than
+/// by its resonances: where it has phase (the complex curve says the dampings too),
+/// and where it is not table over motor (a compliance's peaks are not the motor-held
+/// modes the resonance objectives compare).
+pub fn fits_whole_curve(exp: &Experiment) -> bool {
+    let phase = matches!(
+        exp.data,
+        crate::io::experiment_file::Data::FrequencyResponse {
+            phase_rad: Some(_),
+            ..
+        }
+    );
+    exp.manifest.kind == Kind::FrequencyResponse
+        && (phase || measured::form(exp).response != Response::TableOverMotor)
+}
+
+/// What a whole curve determines: table over motor, the drive stiffnesses and, with
+/// phase, the meshes' (or the coupling's) dampings; a compliance, the motor's inertia
+/// too — a direct drive's, its inertia and damping.
+fn curve_determines(exp: &Experiment, p: &Params) -> Vec<&'static str> {
+    let response = measured::form(exp).response;
+    let mut out = match (response, p.topology) {
+        (Response::MotorCompliance, Topology::DirectDrive) => return vec!["Jt", "Ct"],
+        (Response::TableOverMotor, Topology::DirectDrive) => return Vec::new(),
+        (Response::MotorCompliance, _) => vec!["Jm"],
+        (Response::TableOverMotor, _) => Vec::new(),
+    };
+    out.extend(drive_stiffnesses(p));
+    let phase = matches!(
+        exp.data,
+        crate::io::experiment_file::Data::FrequencyResponse {
+            phase_rad: Some(_),
+            ..
+        }
+    );
+    if phase {
+        out.push("Ciw");
+        if p.cig.is_some() {
+            out.push("Cig");
+        }
+    }
+    out
+}
+
+/// One scaled residual is this error, dB (and, on a complex response, the same
+/// relative error in phase: 0.1 dB ↔ 0.66°), where the file states no noise.
 pub const SCALE_DB: f64 = 0.1;
 
-/// A measured gain curve.
+/// A measured gain curve, and its phase where the file has one.
 #[derive(Clone, Debug)]
 pub struct GainCurve {
     pub frequency_hz: Vec<f64>,
+    /// The drive's ratio, dB.
     pub gain_db: Vec<f64>,
+    /// σ of each gain, dB.
+    pub sigma_db: Vec<f64>,
+    /// The complex response: the residual is then complex ([`super::complex_response`]).
+    pub complex: Option<Complex>,
+    pub response: Response,
     pub fidelity: Fidelity,
     pub test: FrequencyTest,
 }
 
+/// The phase of a measured response, its noise and its delay.
+#[derive(Clone, Debug)]
+pub struct Complex {
+    /// Drive's phase, rad (given delay taken out).
+    pub phase_rad: Vec<f64>,
+    /// σ of ln|H| and of the phase, per line.
+    pub sigma_ln: Vec<f64>,
+    pub sigma_phase: Vec<f64>,
+    /// The delay is fitted; the file's ratio is inverted (sign of its delay term).
+    pub fit_delay: bool,
+    pub sign: f64,
+}
+
 impl GainCurve {
     /// The valid measured points of `source` at frequencies where `keep` holds.
-    fn of(source: &Source<'_>, fidelity: Fidelity, keep: impl Fn(f64) -> bool) -> GainCurve {
-        let (frequency_hz, gain_db) = measured::valid_points(source.experiment)
+    fn of(
+        source: &Source<'_>,
+        fidelity: Fidelity,
+        keep: impl Fn(f64) -> bool + Copy,
+    ) -> Result<GainCurve, SetupError> {
+        let exp = source.experiment;
+        let form = measured::form(exp);
+        if fidelity == Fidelity::Nonlinear && form.response != Response::TableOverMotor {
+            return Err(SetupError::Data {
+                file: source.file.into(),
+                reason: format!(
+                    "a {} response is fitted with the linear model only (the nonlinear \
+                     virtual test measures the table over the motor): --model linear",
+                    form.response.name()
+                ),
+            });
+        }
+        let default = SCALE_DB / DB_PER_NEPER;
+        let (frequency_hz, gain_db): (Vec<f64>, Vec<f64>) = measured::valid_points(exp)
             .filter(|(f, _)| keep(*f))
             .unzip();
-        GainCurve {
+        let complex = measured::complex_points(exp, keep).map(|m| {
+            let (sigma_ln, sigma_phase) = sigmas(&m, default);
+            Complex {
+                phase_rad: m.phase_rad,
+                sigma_ln,
+                sigma_phase,
+                fit_delay: form.delay == Delay::Unknown,
+                sign: if form.inverted { -1.0 } else { 1.0 },
+            }
+        });
+        let sigma_db = match &complex {
+            Some(c) => c.sigma_ln.iter().map(|s| s * DB_PER_NEPER).collect(),
+            None => vec![SCALE_DB; frequency_hz.len()],
+        };
+        Ok(GainCurve {
             frequency_hz,
             gain_db,
+            sigma_db,
+            complex,
+            response: form.response,
             fidelity,
-            test: measured::frequency_test(source.experiment),
+            test: measured::frequency_test(exp),
+        })
+    }
+
+    fn channel(&self) -> Channel {
+        match self.response {
+            Response::TableOverMotor => Channel::TableOverMotor,
+            Response::MotorCompliance => Channel::MotorOverTorque,
         }
     }
 
-    /// The model's gain at the measured frequencies, dB.
-    pub(crate) fn model_db(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+    /// The model's gain (dB) and phase (rad) at the measured frequencies.
+    pub(crate) fn model(&self, p: &Params) -> Result<Vec<(f64, f64)>, ObjectiveError> {
         match self.fidelity {
             Fidelity::Linear => {
-                let lin = LinearResponse::new(p, Channel::TableOverMotor)?;
-                Ok(self.frequency_hz.iter().map(|&f| lin.gain_db(f)).collect())
+                let lin = LinearResponse::new(p, self.channel())?;
+                Ok(self
+                    .frequency_hz
+                    .iter()
+                    .map(|&f| {
+                        lin.at(f).map_or((f64::NEG_INFINITY, f64::NAN), |h| {
+                            (20.0 * h.norm().log10(), h.arg())
+                        })
+                    })
+                    .collect())
             }
-            Fidelity::Nonlinear => Ok(nonlinear_gains(p, &self.test, &self.frequency_hz)?),
+            Fidelity::Nonlinear => Ok(nonlinear_responses(p, &self.test, &self.frequency_hz)?
+                .into_iter()
+                .map(|(g, ph)| (g, ph.to_radians()))
+                .collect()),
         }
+    }
+
+    /// The phase errors (model − measured, rad, wrapped) and the delay fitted into
+    /// them (0 unless the delay is unknown).
+    fn phase_errors(&self, c: &Complex, model: &[(f64, f64)]) -> (Vec<f64>, f64) {
+        let raw: Vec<f64> = model
+            .iter()
+            .zip(&c.phase_rad)
+            .map(|((_, m), d)| wrap(m - d))
+            .collect();
+        if !c.fit_delay {
+            return (raw, 0.0);
+        }
+        let omega: Vec<f64> = self.frequency_hz.iter().map(|f| TAU * f).collect();
+        let w: Vec<f64> = c.sigma_phase.iter().map(|s| 1.0 / (s * s)).collect();
+        let finite = raw.iter().all(|e| e.is_finite());
+        let tau = if finite {
+            fit_delay(&raw, &omega, &w, c.sign)
+        } else {
+            0.0
+        };
+        let errors = raw
+            .iter()
+            .zip(&omega)
+            .map(|(e, o)| wrap(e - c.sign * o * tau))
+            .collect();
+        (errors, tau)
+    }
+}
+
+/// A scaled residual, or a large finite one where the model is singular.
+fn finite_or_large(r: f64) -> f64 {
+    if r.is_finite() {
+        r
+    } else {
+        1e3
     }
 }
 
@@ -108,27 +265,55 @@ impl Objective for GainCurve {
     }
 
     fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
-        Ok(self
-            .model_db(p)?
+        let model = self.model(p)?;
+        let gains = model
             .iter()
             .zip(&self.gain_db)
-            .map(|(m, g)| {
-                let r = (m - g) / SCALE_DB;
-                // A singular frequency of the model: a large, finite residual.
-                if r.is_finite() {
-                    r
-                } else {
-                    1e3
-                }
-            })
-            .collect())
+            .zip(&self.sigma_db)
+            .map(|(((m, _), g), s)| finite_or_large((m - g) / s));
+        let Some(c) = &self.complex else {
+            return Ok(gains.collect());
+        };
+        let (errors, _) = self.phase_errors(c, &model);
+        let phases = errors
+            .iter()
+            .zip(&c.sigma_phase)
+            .map(|(e, s)| finite_or_large(e / s));
+        Ok(gains.chain(phases).collect())
     }
 
     fn len(&self) -> usize {
-        self.frequency_hz.len()
+        self.frequency_hz.len() * if self.complex.is_some() { 2 } else { 1 }
     }
 
     fn scale(&self) -> String {
-        format!("{SCALE_DB} dB of gain at each measured frequency")
+        let stated = self.sigma_db.iter().any(|s| *s != SCALE_DB);
+        match (&self.complex, stated) {
+            (None, false) => format!("{SCALE_DB} dB of gain at each measured frequency"),
+            (None, true) => "the stated σ of the gain at each measured frequency".into(),
+            (Some(_), false) => format!(
+                "{SCALE_DB} dB of gain and {:.2}° of phase at each measured frequency",
+                (SCALE_DB / DB_PER_NEPER).to_degrees()
+            ),
+            (Some(_), true) => {
+                "the stated σ of the gain and of the phase at each measured frequency".into()
+            }
+        }
+    }
+
+    fn detail(&self, p: &Params, r: &[f64]) -> Option<Detail> {
+        let c = self.complex.as_ref()?;
+        let (gain_rms_db, phase_rms_deg) = rms_errors(r, &c.sigma_ln, &c.sigma_phase);
+        let delay_s = if c.fit_delay {
+            let model = self.model(p).ok()?;
+            Some(self.phase_errors(c, &model).1)
+        } else {
+            None
+        };
+        Some(Detail::ComplexResponse {
+            gain_rms_db,
+            phase_rms_deg,
+            fitted_delay_s: delay_s,
+        })
     }
 }

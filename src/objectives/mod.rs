@@ -22,6 +22,7 @@
 //! Adding an objective is one new file (the struct, its `Objective` impl and its
 //! `DEFINITION`) and one line in [`registry::REGISTRY`].
 
+pub mod complex_response;
 pub mod friction_map;
 pub mod gain_curve;
 pub mod joint;
@@ -124,6 +125,13 @@ pub enum Detail {
         position_rms: f64,
         position_max: f64,
     },
+    /// A complex frequency response: the RMS errors of gain (dB) and phase (deg), and
+    /// the delay fitted with the model where the file's delay is unknown, s.
+    ComplexResponse {
+        gain_rms_db: f64,
+        phase_rms_deg: f64,
+        fitted_delay_s: Option<f64>,
+    },
     /// The unbalance steps: direction, measured and model table angle (deg; `None`
     /// where the model shows no step).
     UnbalanceSteps {
@@ -147,9 +155,10 @@ pub trait Objective: Sync + Send {
     }
     /// What one unit of scaled residual means, for reports, e.g. `0.1 % of frequency`.
     fn scale(&self) -> String;
-    /// The residuals `r` in the measurement's own units, for reports.
-    fn detail(&self, r: &[f64]) -> Option<Detail> {
-        let _ = r;
+    /// The residuals `r` (at the parameter set `p`) in the measurement's own units,
+    /// for reports.
+    fn detail(&self, p: &Params, r: &[f64]) -> Option<Detail> {
+        let _ = (p, r);
         None
     }
 }

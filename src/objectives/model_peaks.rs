@@ -33,6 +33,18 @@ pub(crate) fn nonlinear_gains(
         .collect()
 }
 
+/// The nonlinear gain (dB) and phase (deg) at each frequency, in parallel.
+pub(crate) fn nonlinear_responses(
+    p: &Params,
+    test: &FrequencyTest,
+    freqs: &[f64],
+) -> Result<Vec<(f64, f64)>, SimError> {
+    freqs
+        .par_iter()
+        .map(|&f| simulate_point(p, f, test).map(|pt| (pt.gain_db, pt.phase_deg)))
+        .collect()
+}
+
 /// The peak of the nonlinear virtual test nearest above/below the linear prediction
 /// `guess_hz`: a scan in 2 % steps (extended while the maximum is on its edge), a
 /// parabola through the best scan point and its neighbours, then a parabola of

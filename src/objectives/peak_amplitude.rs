@@ -8,6 +8,7 @@
 //! has ζ ≈ 7.5e-5 (0.025 Hz half-power width): a measurement on a 1 Hz grid
 //! under-estimates such a peak by tens of dB, so compare like with like.
 
+use super::gain_curve::fits_whole_curve;
 use super::model_peaks::ModelPeaks;
 use super::registry::{Definition, SetupError, Source, Stage};
 use super::{measured, Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
@@ -33,15 +34,18 @@ pub static DEFINITION: Definition = Definition {
         smoothness: Smoothness::Smooth,
         frequency_response: true,
     },
-    determines: |p| {
+    determines: |_, p| {
         if p.cig.is_some() {
             vec!["Ciw", "Cig"]
         } else {
             vec!["Ciw"]
         }
     },
-    default_weight: |kind, stage| {
-        (kind == Kind::FrequencyResponse && stage == Stage::Search).then_some(DEFAULT_HEIGHT_WEIGHT)
+    default_weight: |exp, stage| {
+        (exp.manifest.kind == Kind::FrequencyResponse
+            && stage == Stage::Search
+            && !fits_whole_curve(exp))
+        .then_some(DEFAULT_HEIGHT_WEIGHT)
     },
     build,
     first_estimate: None,
@@ -127,7 +131,7 @@ impl Objective for PeakAmplitude {
         format!("{SCALE_DB} dB of each peak height")
     }
 
-    fn detail(&self, r: &[f64]) -> Option<Detail> {
+    fn detail(&self, _: &Params, r: &[f64]) -> Option<Detail> {
         Some(Detail::PeakHeights {
             measured_db: self.measured.iter().map(|p| p.gain_db).collect(),
             error_db: r.iter().map(|x| x * SCALE_DB).collect(),

@@ -72,10 +72,10 @@ pub struct Definition {
     pub needs: &'static str,
     pub properties: Properties,
     /// The parameters a user who names none wants fitted from it.
-    pub determines: fn(&Params) -> Vec<&'static str>,
-    /// Its weight (relative to the experiment's) among the objectives an experiment of
-    /// `kind` feeds by default at `stage`; `None`: not a default there.
-    pub default_weight: fn(kind: Kind, stage: Stage) -> Option<f64>,
+    pub determines: fn(&Experiment, &Params) -> Vec<&'static str>,
+    /// Its weight (relative to the experiment's) among the objectives an experiment
+    /// feeds by default at `stage`; `None`: not a default there.
+    pub default_weight: fn(&Experiment, Stage) -> Option<f64>,
     /// The objective of one experiment at a fidelity.
     pub build: Build,
     /// Its direct estimate of where to start, if it has one.
@@ -152,11 +152,11 @@ impl ObjectiveKind {
         }
     }
 
-    /// The objectives an experiment of `kind` feeds by default at `stage`, with their
-    /// relative weights, in registry order.
-    pub fn defaults(kind: Kind, stage: Stage) -> Vec<(ObjectiveKind, f64)> {
+    /// The objectives `experiment` feeds by default at `stage`, with their relative
+    /// weights, in registry order.
+    pub fn defaults(experiment: &Experiment, stage: Stage) -> Vec<(ObjectiveKind, f64)> {
         Self::all()
-            .filter_map(|k| (k.0.default_weight)(kind, stage).map(|w| (k, w)))
+            .filter_map(|k| (k.0.default_weight)(experiment, stage).map(|w| (k, w)))
             .collect()
     }
 }

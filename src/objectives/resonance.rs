@@ -12,6 +12,7 @@
 //! ascending frequency, against the measured ones in ascending frequency. A measured
 //! peak the model does not have costs a residual of 100 % of its frequency.
 
+use super::gain_curve::fits_whole_curve;
 use super::model_peaks::ModelPeaks;
 use super::registry::{Definition, SetupError, Source, Stage};
 use super::{measured, Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
@@ -30,9 +31,10 @@ pub static DEFINITION: Definition = Definition {
         smoothness: Smoothness::Smooth,
         frequency_response: true,
     },
-    determines: drive_stiffnesses,
-    default_weight: |kind, stage| match (kind, stage) {
-        (Kind::FrequencyResponse, Stage::Search) | (Kind::Resonance, _) => Some(1.0),
+    determines: |_, p| drive_stiffnesses(p),
+    default_weight: |exp, stage| match (exp.manifest.kind, stage) {
+        (Kind::FrequencyResponse, Stage::Search) if !fits_whole_curve(exp) => Some(1.0),
+        (Kind::Resonance, _) => Some(1.0),
         _ => None,
     },
     build,
@@ -128,7 +130,7 @@ impl Objective for ResonanceMatch {
         format!("{} % of each resonance frequency", SCALE * 100.0)
     }
 
-    fn detail(&self, r: &[f64]) -> Option<Detail> {
+    fn detail(&self, _: &Params, r: &[f64]) -> Option<Detail> {
         let miss: Vec<f64> = r
             .iter()
             .zip(&self.measured_hz)

@@ -33,8 +33,8 @@ pub static DEFINITION: Definition = Definition {
         smoothness: Smoothness::Rough,
         frequency_response: false,
     },
-    determines,
-    default_weight: |kind, _| (kind == Kind::ServoTrace).then_some(1.0),
+    determines: |_, p| determines(p),
+    default_weight: |exp, _| (exp.manifest.kind == Kind::ServoTrace).then_some(1.0),
     build,
     first_estimate: Some(inverse_dynamics_start),
 };
@@ -168,7 +168,7 @@ impl Objective for TraceResidual {
         )
     }
 
-    fn detail(&self, r: &[f64]) -> Option<Detail> {
+    fn detail(&self, _: &Params, r: &[f64]) -> Option<Detail> {
         let (force, position) = r.split_at(r.len() / 2);
         Some(Detail::Trace {
             force_rms: rms(force) * self.force_scale,

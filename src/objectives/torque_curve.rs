@@ -31,8 +31,8 @@ pub static DEFINITION: Definition = Definition {
         smoothness: Smoothness::Rough,
         frequency_response: false,
     },
-    determines: |_| vec!["fm", "Cm"],
-    default_weight: |kind, _| (kind == Kind::TorqueCurve).then_some(1.0),
+    determines: |_, _| vec!["fm", "Cm"],
+    default_weight: |exp, _| (exp.manifest.kind == Kind::TorqueCurve).then_some(1.0),
     build,
     first_estimate: None,
 };
@@ -145,7 +145,7 @@ impl Objective for TorqueResidual {
         )
     }
 
-    fn detail(&self, r: &[f64]) -> Option<Detail> {
+    fn detail(&self, _: &Params, r: &[f64]) -> Option<Detail> {
         let n = r.len().max(1) as f64;
         let rms = (r.iter().map(|x| x * x).sum::<f64>() / n).sqrt() * self.scale_nm;
         Some(Detail::Torque { rms_error_nm: rms })

@@ -42,8 +42,8 @@ pub static DEFINITION: Definition = Definition {
         smoothness: Smoothness::Rough,
         frequency_response: false,
     },
-    determines: |_| vec!["ft"],
-    default_weight: |kind, _| (kind == Kind::Unbalance).then_some(1.0),
+    determines: |_, _| vec!["ft"],
+    default_weight: |exp, _| (exp.manifest.kind == Kind::Unbalance).then_some(1.0),
     build,
     first_estimate: None,
 };
@@ -211,7 +211,7 @@ impl Objective for UnbalanceStep {
         format!("{SCALE_DEG}° of table angle per step (model − measured step angle)")
     }
 
-    fn detail(&self, r: &[f64]) -> Option<Detail> {
+    fn detail(&self, _: &Params, r: &[f64]) -> Option<Detail> {
         let model: Vec<Option<f64>> = r
             .iter()
             .zip(&self.steps)

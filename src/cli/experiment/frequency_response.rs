@@ -9,7 +9,8 @@ use super::Common;
 use crate::cli::common::progress;
 use rtid::experiments::frequency_response::{self as fr, FrequencyTest, Point};
 use rtid::experiments::measurement_noise;
-use rtid::io::experiment_file::{Data, Experiment};
+use rtid::io::experiment_file::{Data, Delay, Experiment, Manifest, Response};
+use rtid::objectives::complex_response::wrap;
 
 pub const LONG_ABOUT: &str = "\
 Frequency response (paper §4.1): open loop, the motor driven by a sinusoidal torque \
@@ -69,9 +70,39 @@ pub struct Args {
     /// standard deviation in percent (0: none).
     #[arg(long, value_name = "PERCENT", default_value_t = 0.0)]
     pub noise_percent: f64,
+    /// Complex measurement noise, as an analyser's: each complex ratio × (1 + ε_r +
+    /// i·ε_i), ε_r and ε_i Gaussian with this standard deviation in percent each — it
+    /// moves the gain and the phase alike (0: none).
+    #[arg(long, value_name = "PERCENT", default_value_t = 0.0)]
+    pub complex_noise_percent: f64,
     /// Seed of the measurement noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// The ratio measured: `table-over-motor` (the paper's gain) or `motor-compliance`
+    /// (motor angle over motor torque, rad/(N·m): a direct drive's only informative
+    /// ratio; with --linear).
+    #[arg(long, value_enum, default_value = "table-over-motor")]
+    pub response: ResponseArg,
+    /// A delay of the measurement chain, s: the phase written lags by 2π·f·delay, and
+    /// the manifest states it as "unknown" (for a test of the delay's fit).
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    pub unstated_delay_s: f64,
+}
+
+/// `--response`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ResponseArg {
+    TableOverMotor,
+    MotorCompliance,
+}
+
+impl From<ResponseArg> for Response {
+    fn from(r: ResponseArg) -> Response {
+        match r {
+            ResponseArg::TableOverMotor => Response::TableOverMotor,
+            ResponseArg::MotorCompliance => Response::MotorCompliance,
+        }
+    }
 }
 
 impl Args {
@@ -104,6 +135,14 @@ impl Args {
         }
         check::finite(self.preload_nm, "--preload-nm")?;
         check::non_negative(self.noise_percent, "--noise-percent")?;
+        check::non_negative(self.complex_noise_percent, "--complex-noise-percent")?;
+        check::non_negative(self.unstated_delay_s, "--unstated-delay-s")?;
+        if self.response == ResponseArg::MotorCompliance && !self.linear {
+            bail!(
+                "--response motor-compliance needs --linear: the nonlinear test measures \
+                 the table over the motor"
+            );
+        }
         Ok(FrequencyTest {
             frequencies_hz: check::frequency_grid(from, to, step)?,
             amplitude_nm: check::positive(self.amplitude_nm, "--amplitude-nm")?,
@@ -118,8 +157,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.model.load()?;
     let test = a.test()?;
     a.common.create_out()?;
+    let response = Response::from(a.response);
     let points = if a.linear {
-        fr::linear_points(&p, &test)?
+        fr::linear_points(&p, &test, response)?
     } else {
         let expected = test.frequencies_hz.len() as u64
             + 6 * (1 + (test.refine_half_width_hz / test.refine_step_hz.max(1e-9)) as u64);
@@ -135,21 +175,53 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         points
     };
     warn_about_backlash(&points);
-    let mut data = fr::to_data(&p, &points)?;
-    let mut manifest = fr::manifest(&p, &test, a.linear);
-    if a.noise_percent > 0.0 {
-        if let Data::FrequencyResponse { gain_db, .. } = &mut data {
-            measurement_noise::perturb_gain_db(gain_db, a.noise_percent, a.seed);
+    let mut data = fr::to_data(&p, &points, response)?;
+    let mut manifest = fr::manifest(&p, &test, a.linear, response);
+    add_noise(&a, &mut data, &mut manifest);
+    if a.unstated_delay_s > 0.0 {
+        if let Data::FrequencyResponse {
+            phase_rad: Some(phase),
+            frequency_hz,
+            ..
+        } = &mut data
+        {
+            for (ph, f) in phase.iter_mut().zip(frequency_hz.iter()) {
+                *ph = wrap(*ph - std::f64::consts::TAU * f * a.unstated_delay_s);
+            }
         }
-        manifest.notes = Some(format!(
-            "{}; {} % Gaussian noise on the amplitude ratio (seed {})",
-            manifest.notes.unwrap_or_default(),
-            a.noise_percent,
-            a.seed
-        ));
+        manifest.conditions.delay_s = Some(Delay::Unknown);
     }
     a.common
         .write_and_report("frequency_response", manifest, &data, report)
+}
+
+/// The measurement noise of the flags, added to `data` and said in the notes.
+fn add_noise(a: &Args, data: &mut Data, manifest: &mut Manifest) {
+    let Data::FrequencyResponse {
+        gain_db,
+        phase_rad: Some(phase),
+        ..
+    } = data
+    else {
+        return;
+    };
+    let mut notes = manifest.notes.take().unwrap_or_default();
+    if a.noise_percent > 0.0 {
+        measurement_noise::perturb_gain_db(gain_db, a.noise_percent, a.seed);
+        notes += &format!(
+            "; {} % Gaussian noise on the amplitude ratio (seed {})",
+            a.noise_percent, a.seed
+        );
+    }
+    if a.complex_noise_percent > 0.0 {
+        let seed = a.seed.wrapping_add(0x9e37_79b9);
+        measurement_noise::perturb_complex(gain_db, phase, a.complex_noise_percent, seed);
+        notes += &format!(
+            "; {} % complex Gaussian noise on the ratio (seed {})",
+            a.complex_noise_percent, a.seed
+        );
+    }
+    manifest.notes = Some(notes);
 }
 
 /// Warns on stderr where a mesh lost contact, and where the table did not move.

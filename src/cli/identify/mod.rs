@@ -677,6 +677,17 @@ fn detail(d: &Detail) -> String {
             )
         }
         Detail::Torque { rms_error_nm } => format!("  RMS error {rms_error_nm:.4} N·m"),
+        Detail::ComplexResponse {
+            gain_rms_db,
+            phase_rms_deg,
+            fitted_delay_s,
+        } => format!(
+            "  RMS error {gain_rms_db:.3} dB, {phase_rms_deg:.2}°{}",
+            fitted_delay_s.map_or(String::new(), |d| format!(
+                "; delay fitted {:.1} µs",
+                1e6 * d
+            ))
+        ),
         Detail::Trace {
             force_rms,
             position_rms,

@@ -39,6 +39,7 @@ pub(crate) use run::initial_state;
 pub use run::simulate_point;
 
 use crate::estimation::peaks::Peak;
+use crate::io::experiment_file::Response;
 use crate::model::Params;
 use crate::sim::SimError;
 
@@ -171,9 +172,22 @@ pub fn evaluate(frequency_hz: &[f64], gain_db: &[f64]) -> Evaluation {
     }
 }
 
-/// The gain (dB) and phase (deg) of the linearised model at `freqs_hz`, solved in the
-/// frequency domain (no backlash, no friction).
+/// The gain (dB) and phase (deg) of the linearised model's table over motor at
+/// `freqs_hz`, solved in the frequency domain (no backlash, no friction).
 pub fn linear(p: &Params, freqs_hz: &[f64]) -> Result<Vec<(f64, f64)>, crate::model::ParamError> {
+    linear_of(p, Response::TableOverMotor, freqs_hz)
+}
+
+/// The gain (dB) and phase (deg) of the linearised model's `response` at `freqs_hz`.
+pub fn linear_of(
+    p: &Params,
+    response: Response,
+    freqs_hz: &[f64],
+) -> Result<Vec<(f64, f64)>, crate::model::ParamError> {
     use crate::model::linear_response::{Channel, LinearResponse};
-    Ok(LinearResponse::new(p, Channel::TableOverMotor)?.gain_phase(freqs_hz))
+    let channel = match response {
+        Response::TableOverMotor => Channel::TableOverMotor,
+        Response::MotorCompliance => Channel::MotorOverTorque,
+    };
+    Ok(LinearResponse::new(p, channel)?.gain_phase(freqs_hz))
 }

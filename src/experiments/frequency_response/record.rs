@@ -3,15 +3,19 @@
 //! exact linear gain beside them, the manifest, and the test solved on the linear
 //! model alone (`--linear`).
 
-use super::{linear, refinement, FrequencyTest, Point};
-use crate::io::experiment_file::{Columns, Data, Kind, Manifest};
+use super::{linear_of, refinement, FrequencyTest, Point};
+use crate::io::experiment_file::{Columns, Data, Kind, Manifest, Response};
 use crate::model::{ParamError, Params};
 
 /// The test on the linear model, solved in the frequency domain: the coarse grid,
 /// then the refinement around each peak, sorted by frequency.
-pub fn linear_points(p: &Params, test: &FrequencyTest) -> Result<Vec<Point>, ParamError> {
+pub fn linear_points(
+    p: &Params,
+    test: &FrequencyTest,
+    response: Response,
+) -> Result<Vec<Point>, ParamError> {
     let solve = |freqs: &[f64]| -> Result<Vec<Point>, ParamError> {
-        Ok(linear(p, freqs)?
+        Ok(linear_of(p, response, freqs)?
             .into_iter()
             .zip(freqs)
             .map(|((gain_db, phase_deg), &frequency_hz)| Point {
@@ -38,7 +42,7 @@ pub fn linear_points(p: &Params, test: &FrequencyTest) -> Result<Vec<Point>, Par
 
 /// The experiment-file form of the points of `p`'s test: gain and phase, the
 /// diagnostics as extra columns, and `linear_gain_db`, the exact linear response.
-pub fn to_data(p: &Params, points: &[Point]) -> Result<Data, ParamError> {
+pub fn to_data(p: &Params, points: &[Point], response: Response) -> Result<Data, ParamError> {
     let frequency_hz: Vec<f64> = points.iter().map(|q| q.frequency_hz).collect();
     let flag = |f: fn(&Point) -> bool| -> Vec<f64> {
         points.iter().map(|q| f64::from(u8::from(f(q)))).collect()
@@ -56,7 +60,10 @@ pub fn to_data(p: &Params, points: &[Point]) -> Result<Data, ParamError> {
     extra.insert("below_resolution".into(), flag(|q| q.below_resolution));
     extra.insert(
         "linear_gain_db".into(),
-        linear(p, &frequency_hz)?.into_iter().map(|g| g.0).collect(),
+        linear_of(p, response, &frequency_hz)?
+            .into_iter()
+            .map(|g| g.0)
+            .collect(),
     );
     Ok(Data::FrequencyResponse {
         gain_db: points.iter().map(|q| q.gain_db).collect(),
@@ -68,8 +75,11 @@ pub fn to_data(p: &Params, points: &[Point]) -> Result<Data, ParamError> {
 
 /// The manifest of a virtual frequency-response test (`linear`: solved on the
 /// linear model).
-pub fn manifest(p: &Params, test: &FrequencyTest, linear: bool) -> Manifest {
+pub fn manifest(p: &Params, test: &FrequencyTest, linear: bool, response: Response) -> Manifest {
     let mut m = Manifest::new(Kind::FrequencyResponse);
+    if response != Response::TableOverMotor {
+        m.conditions.response = Some(response);
+    }
     m.mechanism = Some(p.name.clone());
     m.conditions.torque_amplitude_nm = Some(test.amplitude_nm);
     m.conditions.preload_nm = Some(test.preload_nm);

@@ -41,7 +41,7 @@ pub fn assess(
     let mut warnings = search_warnings(space, &ran.starts, best, monitor);
     let parts = joint.part_residuals(params)?;
     let stacked = joint.stack(&parts);
-    let residuals = residual_report(joint, parts);
+    let residuals = residual_report(joint, params, parts);
     warnings.extend(resonance_misses(&residuals));
     let uncertainty = if interrupted {
         None
@@ -108,7 +108,7 @@ fn search_warnings(
 }
 
 /// Each part's residuals at the result, with their details in the measurement's units.
-fn residual_report(joint: &Joint, parts: Vec<Vec<f64>>) -> Vec<ExperimentResidual> {
+fn residual_report(joint: &Joint, p: &Params, parts: Vec<Vec<f64>>) -> Vec<ExperimentResidual> {
     joint
         .parts
         .iter()
@@ -119,7 +119,7 @@ fn residual_report(joint: &Joint, parts: Vec<Vec<f64>>) -> Vec<ExperimentResidua
             weight: part.weight,
             scale: part.objective.scale(),
             rms: (sum_of_squares(&r) / r.len().max(1) as f64).sqrt(),
-            detail: part.objective.detail(&r),
+            detail: part.objective.detail(p, &r),
             residuals: r,
         })
         .collect()

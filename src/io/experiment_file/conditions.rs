@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
+use super::response::{self, Delay, Reference, Response};
 use super::{sample_period, Kind};
 use crate::model::params::LoopMode;
 
@@ -115,6 +116,22 @@ pub struct Conditions {
     /// model's peaks; `rtid identify --band` sets it). Absent: the whole curve.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub band_hz: Option<[f64; 2]>,
+    /// Frequency response: the ratio the file holds, `table_over_motor` (default) or
+    /// `motor_compliance` ([`Response`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub response: Option<Response>,
+    /// Frequency response: the channel the analyser divided by ([`Reference`]; default
+    /// the ratio's own: the motor angle, or the motor torque for a compliance).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<Reference>,
+    /// Frequency response: the measurement chain's delay in the phase, s, or
+    /// `"unknown"` to fit it ([`Delay`]; default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub delay_s: Option<Delay>,
+    /// Frequency response with a `coherence` column: the segments averaged per line,
+    /// which with the coherence gives each line's noise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub averages: Option<u32>,
     /// Condition keys this version does not know, kept as written.
     #[serde(flatten)]
     pub extra: Map<String, Value>,
@@ -122,7 +139,7 @@ pub struct Conditions {
 
 impl Conditions {
     /// The JSON keys of the typed fields.
-    pub(super) const KEYS: [&'static str; 20] = [
+    pub(super) const KEYS: [&'static str; 24] = [
         "torque_amplitude_nm",
         "preload_nm",
         "amplitude_deg",
@@ -143,6 +160,10 @@ impl Conditions {
         "drive_gain",
         "loop_period_s",
         "band_hz",
+        "response",
+        "reference",
+        "delay_s",
+        "averages",
     ];
 
     /// True when no condition is given.
@@ -233,6 +254,7 @@ pub(super) fn check(kind: Kind, c: &Conditions) -> Result<(), String> {
         }
     }
     match kind {
+        Kind::FrequencyResponse => response::check(c),
         Kind::FrequencyResponseTime => check_record(c),
         Kind::ServoTrace => check_servo(c),
         _ => Ok(()),
