@@ -178,6 +178,7 @@ impl GainCurve {
                 sign: if form.inverted { -1.0 } else { 1.0 },
             }
         });
+        check_orientation(source.file, form.response, &frequency_hz, &gain_db, complex.as_ref())?;
         let sigma_db = match &complex {
             Some(c) => c.sigma_ln.iter().map(|s| s * DB_PER_NEPER).collect(),
             None => vec![SCALE_DB; frequency_hz.len()],
@@ -250,6 +251,80 @@ impl GainCurve {
     }
 }
 
+/// A driven table lags its motor: the phase of table over motor, unwrapped from the
+/// lowest line, falls (0 → −180° past each motor-held mode). A compliance falls with
+/// frequency like a free mass's (−40 dB per decade, first line to last, whatever
+/// modes lie between). A ratio that leads, or rises, is the inverse of the one the
+/// manifest names.
+fn check_orientation(
+    file: &str,
+    response: Response,
+    frequency_hz: &[f64],
+    gain_db: &[f64],
+    complex: Option<&Complex>,
+) -> Result<(), SetupError> {
+    let refuse = |what: String| {
+        Err(SetupError::Data {
+            file: file.into(),
+            reason: format!(
+                "{what}: the file holds the inverse ratio? State its reference channel \
+                 (conditions.reference: \"{}\") — or its phase has the opposite sign \
+                 convention (negate phase_deg)",
+                response.output().name()
+            ),
+        })
+    };
+    match (response, complex) {
+        (Response::TableOverMotor, Some(c)) if c.phase_rad.len() >= 3 => {
+            let mut phase = super::complex_response::unwrap(&c.phase_rad);
+            let shift = TAU * (phase[0] / TAU).round();
+            phase.iter_mut().for_each(|p| *p -= shift);
+            phase.sort_by(f64::total_cmp);
+            let median = phase[phase.len() / 2];
+            if median > 10f64.to_radians() {
+                return refuse(format!(
+                    "the table's phase leads the motor's (median {:+.0}° over the lines), \
+                     where a driven table lags its motor",
+                    median.to_degrees()
+                ));
+            }
+            Ok(())
+        }
+        (Response::MotorCompliance, _) if frequency_hz.len() >= 2 => {
+            let n = frequency_hz.len();
+            let (f0, f1) = (frequency_hz[0], frequency_hz[n - 1]);
+            let slope = (gain_db[n - 1] - gain_db[0]) / (f1 / f0).log10();
+            if slope > 20.0 {
+                return refuse(format!(
+                    "the compliance rises with frequency ({slope:+.0} dB per decade over \
+                     {f0}–{f1} Hz), where a driven mass's falls"
+                ));
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
+
+impl GainCurve {
+    /// The delay the phase errors `errors` show when the manifest states none to fit:
+    /// `Some` where taking it out would halve their RMS.
+    fn unstated_delay(&self, c: &Complex, errors: &[f64]) -> Option<f64> {
+        let omega: Vec<f64> = self.frequency_hz.iter().map(|f| TAU * f).collect();
+        let w: Vec<f64> = c.sigma_phase.iter().map(|s| 1.0 / (s * s)).collect();
+        let tau = fit_delay(errors, &omega, &w, c.sign);
+        let rms = |e: &mut dyn Iterator<Item = f64>| {
+            (e.zip(&w).map(|(x, w)| w * x * x).sum::<f64>() / w.len().max(1) as f64).sqrt()
+        };
+        let before = rms(&mut errors.iter().copied());
+        let after = rms(&mut errors
+            .iter()
+            .zip(&omega)
+            .map(|(e, o)| wrap(e - c.sign * o * tau)));
+        (after < 0.5 * before && tau != 0.0).then_some(tau)
+    }
+}
+
 /// A scaled residual, or a large finite one where the model is singular.
 fn finite_or_large(r: f64) -> f64 {
     if r.is_finite() {
@@ -304,16 +379,15 @@ impl Objective for GainCurve {
     fn detail(&self, p: &Params, r: &[f64]) -> Option<Detail> {
         let c = self.complex.as_ref()?;
         let (gain_rms_db, phase_rms_deg) = rms_errors(r, &c.sigma_ln, &c.sigma_phase);
-        let delay_s = if c.fit_delay {
-            let model = self.model(p).ok()?;
-            Some(self.phase_errors(c, &model).1)
-        } else {
-            None
-        };
+        let model = self.model(p).ok()?;
+        let (errors, fitted) = self.phase_errors(c, &model);
         Some(Detail::ComplexResponse {
             gain_rms_db,
             phase_rms_deg,
-            fitted_delay_s: delay_s,
+            fitted_delay_s: c.fit_delay.then_some(fitted),
+            unstated_delay_s: (!c.fit_delay)
+                .then(|| self.unstated_delay(c, &errors))
+                .flatten(),
         })
     }
 }

@@ -125,12 +125,15 @@ pub enum Detail {
         position_rms: f64,
         position_max: f64,
     },
-    /// A complex frequency response: the RMS errors of gain (dB) and phase (deg), and
-    /// the delay fitted with the model where the file's delay is unknown, s.
+    /// A complex frequency response: the RMS errors of gain (dB) and phase (deg), the
+    /// delay fitted with the model where the file's delay is unknown, s, and where it
+    /// is not, a delay its phase errors show all the same (it would halve them).
     ComplexResponse {
         gain_rms_db: f64,
         phase_rms_deg: f64,
         fitted_delay_s: Option<f64>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        unstated_delay_s: Option<f64>,
     },
     /// The unbalance steps: direction, measured and model table angle (deg; `None`
     /// where the model shows no step).

@@ -248,19 +248,65 @@ mod tests {
         assert!(err.contains("torque_curve"), "{err}");
     }
 
+    /// An experiment of `kind` with `data`, for the defaults.
+    fn experiment(kind: Kind, data: crate::io::experiment_file::Data) -> Experiment {
+        Experiment {
+            manifest: crate::io::experiment_file::Manifest::new(kind),
+            data,
+            path: "e.json".into(),
+            data_path: None,
+        }
+    }
+
+    fn gain_curve(phase: bool) -> Experiment {
+        experiment(
+            Kind::FrequencyResponse,
+            crate::io::experiment_file::Data::FrequencyResponse {
+                frequency_hz: vec![10.0, 20.0],
+                gain_db: vec![0.0, 0.1],
+                phase_rad: phase.then(|| vec![0.0, -0.1]),
+                extra: Default::default(),
+            },
+        )
+    }
+
+    fn names(e: &Experiment, stage: Stage) -> Vec<(&'static str, f64)> {
+        ObjectiveKind::defaults(e, stage)
+            .into_iter()
+            .map(|(k, w)| (k.name(), w))
+            .collect()
+    }
+
     #[test]
-    fn a_frequency_response_feeds_resonances_and_heights_by_default() {
-        let names = |stage| {
-            ObjectiveKind::defaults(Kind::FrequencyResponse, stage)
-                .into_iter()
-                .map(|(k, w)| (k.name(), w))
-                .collect::<Vec<_>>()
-        };
+    fn a_gain_curve_feeds_resonances_and_heights_by_default() {
+        let e = gain_curve(false);
         assert_eq!(
-            names(Stage::Search),
+            names(&e, Stage::Search),
             [("resonance", 1.0), ("peak_amplitude", 0.01)]
         );
-        assert_eq!(names(Stage::Correction), [("gain_near_peaks", 1.0)]);
-        assert!(ObjectiveKind::defaults(Kind::Positioning, Stage::Search).is_empty());
+        assert_eq!(names(&e, Stage::Correction), [("gain_near_peaks", 1.0)]);
+        let positioning = experiment(
+            Kind::Positioning,
+            crate::io::experiment_file::Data::Resonance {
+                peaks_hz: vec![],
+                peak_gain_db: None,
+            },
+        );
+        assert!(ObjectiveKind::defaults(&positioning, Stage::Search).is_empty());
+    }
+
+    #[test]
+    fn a_response_with_phase_feeds_its_whole_complex_curve_by_default() {
+        let e = gain_curve(true);
+        assert_eq!(names(&e, Stage::Search), [("gain_curve", 1.0)]);
+        assert_eq!(names(&e, Stage::Correction), [("gain_near_peaks", 1.0)]);
+        let p = crate::model::presets::load("worm-gear").unwrap();
+        let fit = (ObjectiveKind::named("gain_curve").unwrap().definition().determines)(&e, &p);
+        assert_eq!(fit, ["Kw", "Kg", "Ciw", "Cig"]);
+        let without = (ObjectiveKind::named("gain_curve").unwrap().definition().determines)(
+            &gain_curve(false),
+            &p,
+        );
+        assert_eq!(without, ["Kw", "Kg"]);
     }
 }

@@ -217,7 +217,7 @@ mod tests {
             force_rms,
             position_rms,
             position_max,
-        }) = o.detail(&r)
+        }) = o.detail(&crate::model::presets::load("direct-drive").unwrap(), &r)
         else {
             panic!("a trace detail")
         };

@@ -681,6 +681,7 @@ fn detail(d: &Detail) -> String {
             gain_rms_db,
             phase_rms_deg,
             fitted_delay_s,
+            ..
         } => format!(
             "  RMS error {gain_rms_db:.3} dB, {phase_rms_deg:.2}°{}",
             fitted_delay_s.map_or(String::new(), |d| format!(

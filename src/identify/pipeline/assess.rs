@@ -43,6 +43,7 @@ pub fn assess(
     let stacked = joint.stack(&parts);
     let residuals = residual_report(joint, params, parts);
     warnings.extend(resonance_misses(&residuals));
+    warnings.extend(phase_delays(&residuals));
     let uncertainty = if interrupted {
         None
     } else {
@@ -121,6 +122,23 @@ fn residual_report(joint: &Joint, p: &Params, parts: Vec<Vec<f64>>) -> Vec<Exper
             rms: (sum_of_squares(&r) / r.len().max(1) as f64).sqrt(),
             detail: part.objective.detail(p, &r),
             residuals: r,
+        })
+        .collect()
+}
+
+/// Complex responses whose phase errors show a delay the manifest does not state.
+fn phase_delays(residuals: &[ExperimentResidual]) -> Vec<Warning> {
+    residuals
+        .iter()
+        .filter_map(|r| match &r.detail {
+            Some(Detail::ComplexResponse {
+                unstated_delay_s: Some(d),
+                ..
+            }) => Some(Warning::PhaseDelay {
+                source: r.source.clone(),
+                delay_s: *d,
+            }),
+            _ => None,
         })
         .collect()
 }

@@ -20,6 +20,12 @@ pub(super) fn text(w: &Warning) -> String {
         }
         Warning::DistinctSolution { start, solution } => distinct_solution(*start, solution),
         Warning::AtBound { name, side } => at_bound(name, *side),
+        Warning::PhaseDelay { source, delay_s } => format!(
+            "{source}: the phase error grows with frequency like a delay of {:.1} µs that the \
+             manifest does not state — a measurement chain's delay (filters, a recorder)? \
+             State it as conditions.delay_s (seconds), or \"unknown\" to fit it",
+            1e6 * delay_s
+        ),
         Warning::ResonanceMiss {
             source,
             max_miss_hz,

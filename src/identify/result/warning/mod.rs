@@ -44,6 +44,9 @@ pub enum Warning {
     AtBound { name: String, side: Side },
     /// The fitted model misses measured resonances by more than 1 Hz.
     ResonanceMiss { source: String, max_miss_hz: f64 },
+    /// The phase errors of a complex frequency response grow with frequency like a
+    /// delay the manifest does not state (`delay_s`): removing it would halve them.
+    PhaseDelay { source: String, delay_s: f64 },
     /// A parameter has no effect on the residuals.
     NoEffect { name: String },
     /// Fewer residuals than parameters: they cannot all be determined.
@@ -107,6 +110,7 @@ impl Warning {
             Warning::DistinctSolution { .. } => "distinct_solution",
             Warning::AtBound { .. } => "at_bound",
             Warning::ResonanceMiss { .. } => "resonance_miss",
+            Warning::PhaseDelay { .. } => "phase_delay",
             Warning::NoEffect { .. } => "no_effect",
             Warning::TooFewResiduals { .. } => "too_few_residuals",
             Warning::Singular { .. } => "singular",
