@@ -73,7 +73,7 @@ pub fn fit_delay(error: &[f64], omega: &[f64], w: &[f64], sign: f64) -> f64 {
 }
 
 /// The phases made continuous along the lines (jumps of more than π taken out).
-fn unwrap(phase: &[f64]) -> Vec<f64> {
+pub fn unwrap(phase: &[f64]) -> Vec<f64> {
     let mut out = Vec::with_capacity(phase.len());
     let mut offset = 0.0;
     for (k, &p) in phase.iter().enumerate() {
