@@ -34,3 +34,61 @@ pub fn gain(
         Style::Markers,
     ))
 }
+
+/// The phase (rad, any wrapping) over frequency (ascending), drawn in degrees and
+/// unwrapped along frequency: a jump of more than 180° between neighbouring lines is
+/// taken as a whole turn.
+pub fn phase(frequency_hz: &[f64], phase_rad: &[f64], title: &str) -> Figure {
+    let unwrapped = crate::objectives::complex_response::unwrap(phase_rad);
+    Figure::new(title, "frequency, Hz", "phase, degrees (unwrapped)").with(Series::new(
+        "phase (unwrapped along frequency)",
+        frequency_hz
+            .iter()
+            .zip(&unwrapped)
+            .map(|(&f, p)| (f, p.to_degrees()))
+            .collect(),
+        Style::Line,
+    ))
+}
+
+/// The Nyquist plot: Im H against Re H, lines joined in frequency order (`ln_gain`:
+/// natural log of |H|, `phase_rad`), each line marked; the axes are not to equal
+/// scale.
+pub fn nyquist(ln_gain: &[f64], phase_rad: &[f64], title: &str, unit: &str) -> Figure {
+    let h: Vec<(f64, f64)> = ln_gain
+        .iter()
+        .zip(phase_rad)
+        .map(|(l, p)| {
+            let m = l.exp();
+            (m * p.cos(), m * p.sin())
+        })
+        .collect();
+    let x = format!("Re H, {unit}");
+    let y = format!("Im H, {unit}");
+    Figure::new(title, &x, &y)
+        .with(Series::new(
+            "H (lines in frequency order)",
+            h.clone(),
+            Style::Line,
+        ))
+        .with(Series::new("", h, Style::Markers))
+}
+
+/// The phase plot and the Nyquist plot of a complex response (lines ascending in
+/// frequency), titled `what`, H in `unit`.
+pub fn phase_and_nyquist(
+    frequency_hz: &[f64],
+    ln_gain: &[f64],
+    phase_rad: &[f64],
+    what: &str,
+    unit: &str,
+) -> [Figure; 2] {
+    [
+        phase(
+            frequency_hz,
+            phase_rad,
+            &format!("{what}: phase (unwrapped along frequency)"),
+        ),
+        nyquist(ln_gain, phase_rad, &format!("{what}: Nyquist plot"), unit),
+    ]
+}

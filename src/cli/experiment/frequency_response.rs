@@ -1,16 +1,17 @@
 //! `rtid experiment frequency-response` and the evaluation of frequency-response files.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 
 use super::check;
 use super::Common;
 use crate::cli::common::progress;
-use rtid::experiments::frequency_response::{self as fr, FrequencyTest, Point};
+use rtid::experiments::frequency_response::{self as fr, modal, FrequencyTest, Point};
 use rtid::experiments::measurement_noise;
-use rtid::io::experiment_file::{Data, Delay, Experiment, Manifest, Response};
+use rtid::io::experiment_file::{Data, Delay, Experiment, Manifest, Response, ResponseForm};
 use rtid::objectives::complex_response::wrap;
+use rtid::objectives::measured;
 
 pub const LONG_ABOUT: &str = "\
 Frequency response (paper §4.1): open loop, the motor driven by a sinusoidal torque \
@@ -262,7 +263,9 @@ fn warn_about_backlash(points: &[Point]) {
 }
 
 /// Evaluates a frequency-response experiment: resonances printed (table or JSON),
-/// gain plot written to `plot` (with the linear curve when the file has one).
+/// gain plot written to `plot` (with the linear curve when the file has one). With a
+/// phase, also each resonance's modal parameters ([`modal::modes`]) and the phase and
+/// Nyquist plots beside `plot` (`STEM_phase.svg`, `STEM_nyquist.svg`).
 pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
     let Data::FrequencyResponse {
         frequency_hz,
@@ -277,20 +280,26 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
         );
     };
     let peaks = fr::evaluate(frequency_hz, gain_db).peaks;
-    let title = format!(
-        "{}: frequency response (table / motor × ratio)",
-        exp.manifest.mechanism.as_deref().unwrap_or("table")
-    );
+    let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
+    let title = format!("{mechanism}: frequency response (table / motor × ratio)");
     let linear = extra.get("linear_gain_db").map(Vec::as_slice);
     rtid::report::frequency_response::gain(frequency_hz, gain_db, linear, &peaks, &title)
         .write(plot)?;
+    let complex = complex_evaluation(exp, plot)?;
     if json {
-        let value = serde_json::json!({
+        let mut value = serde_json::json!({
             "kind": "frequency_response",
             "source": exp.path,
             "peaks": peaks,
             "points": frequency_hz.len(),
         });
+        if let Some(c) = &complex {
+            value["modes"] = serde_json::to_value(&c.modes)?;
+            value["response"] = c.form.response.name().into();
+            value["noise_stated"] = c.noise_stated.into();
+            value["phase_plot"] = serde_json::to_value(&c.plots[0])?;
+            value["nyquist_plot"] = serde_json::to_value(&c.plots[1])?;
+        }
         println!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         println!(
@@ -307,6 +316,127 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
                 frequency_hz[frequency_hz.len() - 1]
             );
         }
+        match &complex {
+            Some(c) => print_modes(c),
+            None => println!("modal damping needs the phase: this file has none (gain peaks only)"),
+        }
     }
     Ok(())
+}
+
+/// What the complex response of a file with phase gives: its modes, and the plots
+/// written.
+struct ComplexEvaluation {
+    form: ResponseForm,
+    modes: Vec<modal::Mode>,
+    noise_stated: bool,
+    plots: [PathBuf; 2],
+}
+
+/// The modes of the file's complex response (the drive's ratio, as
+/// [`measured::complex_points`] gives it) and its phase and Nyquist plots beside
+/// `plot`; `None` without a phase.
+fn complex_evaluation(exp: &Experiment, plot: &Path) -> anyhow::Result<Option<ComplexEvaluation>> {
+    let Some(mut c) = measured::complex_points(exp, |_| true) else {
+        return Ok(None);
+    };
+    let form = measured::form(exp);
+    let (integrators, ratio, unit) = match form.response {
+        Response::TableOverMotor => (0, "table / motor × ratio", "1"),
+        Response::MotorCompliance => (2, "motor angle / motor torque", "rad/(N·m)"),
+    };
+    let modes = modal::modes(&c, integrators);
+    // The plots along ascending frequency.
+    let mut order: Vec<usize> = (0..c.frequency_hz.len()).collect();
+    order.sort_by(|&a, &b| c.frequency_hz[a].total_cmp(&c.frequency_hz[b]));
+    for v in [&mut c.frequency_hz, &mut c.ln_gain, &mut c.phase_rad] {
+        *v = order.iter().map(|&k| v[k]).collect();
+    }
+    let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
+    let plots = [sibling(plot, "phase"), sibling(plot, "nyquist")];
+    let mut inputs: Vec<&Path> = vec![&exp.path];
+    inputs.extend(exp.data_path.as_deref());
+    for p in &plots {
+        crate::cli::common::inputs::refuse_overwrite("the plot", p, &inputs)?;
+    }
+    let figures = &rtid::report::frequency_response::phase_and_nyquist(
+        &c.frequency_hz,
+        &c.ln_gain,
+        &c.phase_rad,
+        &format!("{mechanism}: {ratio}"),
+        unit,
+    );
+    for (figure, path) in figures.iter().zip(&plots) {
+        figure.write(path)?;
+    }
+    Ok(Some(ComplexEvaluation {
+        form,
+        modes,
+        noise_stated: c.sigma_ln.is_some() || c.sigma_phase.is_some(),
+        plots,
+    }))
+}
+
+/// `plot` with `_SUFFIX` added to its stem.
+fn sibling(plot: &Path, suffix: &str) -> PathBuf {
+    let stem = plot.file_stem().map_or_else(
+        || "frequency_response".into(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    let ext = plot
+        .extension()
+        .map_or_else(|| "svg".into(), |e| e.to_string_lossy().into_owned());
+    plot.with_file_name(format!("{stem}_{suffix}.{ext}"))
+}
+
+/// The modes as a table.
+fn print_modes(c: &ComplexEvaluation) {
+    println!(
+        "modes ({}: rational fit of the complex response over a band around each \
+         resonance, ± one standard error)",
+        c.form.response.name()
+    );
+    if let Delay::Unknown = c.form.delay {
+        println!(
+            "  the manifest's delay is unknown: it is not taken out of the phase, and a \
+             delay's phase lag biases the damping ratios"
+        );
+    }
+    if c.modes.is_empty() {
+        println!("  no resonance stands out of the gain");
+    }
+    for m in &c.modes {
+        let head = format!(
+            "  peak {:7.2} Hz  band {:.1}–{:.1} Hz ({} lines)",
+            m.peak.frequency_hz, m.band_hz.0, m.band_hz.1, m.lines
+        );
+        let Some(p) = m.pole else {
+            println!("{head}: {}", m.note.as_deref().unwrap_or("no pole pair"));
+            continue;
+        };
+        println!(
+            "{head}: f = {:.3} ± {:.3} Hz, ζ = {:.5} ± {:.5}, residual {:.3}",
+            p.frequency_hz, p.frequency_se_hz, p.damping_ratio, p.damping_se, m.residual_rms
+        );
+        if let Some(z) = m.zero {
+            println!(
+                "    antiresonance (zero pair): f = {:.3} ± {:.3} Hz, ζ = {:.5} ± {:.5}",
+                z.frequency_hz, z.frequency_se_hz, z.damping_ratio, z.damping_se
+            );
+        }
+    }
+    println!(
+        "  residual: {}",
+        if c.noise_stated {
+            "RMS misfit over the stated noise (≈ 1 when the model explains the band)"
+        } else {
+            "RMS relative misfit per component (no noise stated: ≈ the complex noise's σ \
+             when the model explains the band)"
+        }
+    );
+    println!(
+        "  plots: {}, {}",
+        c.plots[0].display(),
+        c.plots[1].display()
+    );
 }
