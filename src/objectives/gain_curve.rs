@@ -178,7 +178,13 @@ impl GainCurve {
                 sign: if form.inverted { -1.0 } else { 1.0 },
             }
         });
-        check_orientation(source.file, form.response, &frequency_hz, &gain_db, complex.as_ref())?;
+        check_orientation(
+            source.file,
+            form.response,
+            &frequency_hz,
+            &gain_db,
+            complex.as_ref(),
+        )?;
         let sigma_db = match &complex {
             Some(c) => c.sigma_ln.iter().map(|s| s * DB_PER_NEPER).collect(),
             None => vec![SCALE_DB; frequency_hz.len()],

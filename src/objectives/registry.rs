@@ -301,12 +301,15 @@ mod tests {
         assert_eq!(names(&e, Stage::Search), [("gain_curve", 1.0)]);
         assert_eq!(names(&e, Stage::Correction), [("gain_near_peaks", 1.0)]);
         let p = crate::model::presets::load("worm-gear").unwrap();
-        let fit = (ObjectiveKind::named("gain_curve").unwrap().definition().determines)(&e, &p);
+        let fit = (ObjectiveKind::named("gain_curve")
+            .unwrap()
+            .definition()
+            .determines)(&e, &p);
         assert_eq!(fit, ["Kw", "Kg", "Ciw", "Cig"]);
-        let without = (ObjectiveKind::named("gain_curve").unwrap().definition().determines)(
-            &gain_curve(false),
-            &p,
-        );
+        let without = (ObjectiveKind::named("gain_curve")
+            .unwrap()
+            .definition()
+            .determines)(&gain_curve(false), &p);
         assert_eq!(without, ["Kw", "Kg"]);
     }
 }

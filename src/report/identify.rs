@@ -13,7 +13,8 @@ pub fn comparison(c: &Comparison) -> Figure {
         &c.x_label,
         &c.y_label,
     );
-    let sampled = c.x_label.starts_with("frequency");
+    // Measured lines (a frequency response, its Nyquist plot) are points, not a trace.
+    let sampled = c.x_label.starts_with("frequency") || c.x_label == "real part";
     for curve in &c.curves {
         let style = match curve.role {
             Role::Measured if sampled => Style::Markers,

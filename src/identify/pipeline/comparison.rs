@@ -5,12 +5,13 @@
 
 use crate::identify::result::comparison::{Comparison, Curve, Role};
 
+mod frequency_response;
+
 use crate::experiments::fluctuation::{self, FluctuationTest};
 use crate::experiments::servo_trace::{self, ServoTrace, TraceError};
 use crate::experiments::torque_curve::{simulate_torque, TorqueTest};
 use crate::identify::config::ExperimentSpec;
 use crate::io::experiment_file::{Data, Experiment};
-use crate::model::linear_response::{Channel, LinearResponse};
 use crate::model::params::Axis;
 use crate::model::Params;
 use crate::sim::SimError;
@@ -36,8 +37,6 @@ pub enum ComparisonError {
     },
 }
 
-/// Points of the model's curve over the measured frequency range.
-const CURVE_POINTS: usize = 600;
 /// Points per curve kept for the deviation of an unbalance test.
 const MAX_DEVIATION_POINTS: usize = 3000;
 
@@ -63,11 +62,7 @@ pub fn compare(
     fitted: &Params,
 ) -> Result<Vec<Comparison>, ComparisonError> {
     Ok(match &exp.data {
-        Data::FrequencyResponse {
-            frequency_hz,
-            gain_db,
-            ..
-        } => vec![gain(source, frequency_hz, gain_db, start, fitted)],
+        Data::FrequencyResponse { .. } => frequency_response::compare(source, exp, start, fitted),
         Data::TorqueCurve {
             time_s,
             motor_torque_nm,
@@ -101,51 +96,11 @@ pub fn compare(
     })
 }
 
-fn curve(label: &str, role: Role, x: &[f64], y: &[f64]) -> Curve {
+pub(super) fn curve(label: &str, role: Role, x: &[f64], y: &[f64]) -> Curve {
     Curve {
         label: label.into(),
         role,
         points: x.iter().copied().zip(y.iter().copied()).collect(),
-    }
-}
-
-/// The measured gain and the linear model's at the start and identified values.
-fn gain(
-    source: &str,
-    frequency_hz: &[f64],
-    gain_db: &[f64],
-    start: &Params,
-    fitted: &Params,
-) -> Comparison {
-    let (lo, hi) = (frequency_hz[0], frequency_hz[frequency_hz.len() - 1]);
-    let model = |p: &Params| -> Vec<(f64, f64)> {
-        let Ok(lin) = LinearResponse::new(p, Channel::TableOverMotor) else {
-            return Vec::new();
-        };
-        (0..=CURVE_POINTS)
-            .map(|i| lo + (hi - lo) * i as f64 / CURVE_POINTS as f64)
-            .map(|f| (f, lin.gain_db(f)))
-            .collect()
-    };
-    let mut measured = curve("measured", Role::Measured, frequency_hz, gain_db);
-    measured.points.retain(|(_, g)| g.is_finite());
-    Comparison {
-        source: source.into(),
-        x_label: "frequency, Hz".into(),
-        y_label: "gain θt/(θm·Rg·Rw), dB".into(),
-        curves: vec![
-            measured,
-            Curve {
-                label: "linear model, start".into(),
-                role: Role::Start,
-                points: model(start),
-            },
-            Curve {
-                label: "linear model, identified".into(),
-                role: Role::Fitted,
-                points: model(fitted),
-            },
-        ],
     }
 }
 

@@ -26,13 +26,13 @@ use crate::identify::config::Config;
 use crate::identify::error::IdentifyError;
 use crate::identify::result::warning::Warning;
 use crate::identify::result::NonlinearCheck;
+use crate::io::experiment_file::Experiment;
 use crate::model::linear_response::{Channel, LinearResponse};
 use crate::model::Params;
 use crate::objectives::gain_curve::fits_whole_curve;
-use crate::objectives::gain_curve::{self, SCALE_DB};
 use crate::objectives::model_peaks::nonlinear_peak_on_grid;
 use crate::objectives::model_peaks::GRID_BAND;
-use crate::objectives::{measured, sum_of_squares, Fidelity, ObjectiveError, Source};
+use crate::objectives::{measured, sum_of_squares, ObjectiveError, Source};
 
 /// The relative miss of a resonance (nonlinear test at the linear fit against the
 /// measurement) beyond which `auto` goes on to the nonlinear fit.
@@ -66,9 +66,7 @@ pub fn check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, Identif
             .map(|&f| nonlinear_peak_on_grid(p, &test, &grid, f).map(|pk| pk.frequency_hz))
             .collect::<Result<Vec<f64>, _>>()
             .map_err(ObjectiveError::from)?;
-        let linear = (gain_curve::DEFINITION.build)(&source, Fidelity::Linear)?.residuals(p)?;
-        let linear_misfit_db =
-            SCALE_DB * (sum_of_squares(&linear) / linear.len().max(1) as f64).sqrt();
+        let linear_misfit_db = gain_misfit_db(&spec.experiment, p)?;
         let max_miss_hz = model
             .iter()
             .zip(&measured)
@@ -84,6 +82,17 @@ pub fn check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, Identif
         });
     }
     Ok(out)
+}
+
+/// The RMS of the linear model's gain against the measured one, dB, over the valid
+/// lines: the gain alone, in dB whatever the file's stated noise — a phase error (a
+/// delay, say) is not one the nonlinear test could explain.
+fn gain_misfit_db(exp: &Experiment, p: &Params) -> Result<f64, IdentifyError> {
+    let lin = LinearResponse::new(p, Channel::TableOverMotor).map_err(ObjectiveError::from)?;
+    let errors: Vec<f64> = measured::valid_points(exp)
+        .map(|(f, g)| lin.gain_db(f) - g)
+        .collect();
+    Ok((sum_of_squares(&errors) / errors.len().max(1) as f64).sqrt())
 }
 
 /// The measured resonances at which the nonlinear test at `p` resolves the table's
