@@ -7,12 +7,18 @@
 //! fixture from +40 % starts, defaults (4 starts, lsq, linear search + nonlinear
 //! check). `identify/fit/worm-gear-nonlinear`: the same with `--model nonlinear`
 //! (issue 4's goal: < 3 s on 2 cores).
+//!
+//! `identify/complex/…`: the complex residual against the gain alone on the same
+//! data (fixtures/frf/worm_frf: the worm's linear response with 2 % complex noise,
+//! 5–2000 Hz, 1996 lines), `gain_curve` with the linear model — `cost/*` one
+//! evaluation, `fit/*` Kw, Kg, Ciw, Cig from +40 % starts (`--model linear`).
 
 #[path = "../tests/support/mod.rs"]
 mod support;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use rtid::identify::{identify, Config, FidelityChoice, Monitor};
+use rtid::identify::{identify, Config, ExperimentSpec, FidelityChoice, Monitor};
+use rtid::io::experiment_file::Data;
 use rtid::objectives::{Fidelity, ObjectiveKind, Source};
 
 fn bench(c: &mut Criterion) {
@@ -45,6 +51,44 @@ fn bench(c: &mut Criterion) {
             identify(&config, &Monitor::default()).unwrap()
         })
     });
+    group.finish();
+    complex(c);
+}
+
+/// The complex residual against the gain alone (module docs).
+fn complex(c: &mut Criterion) {
+    let with_phase = support::experiment("frf/worm_frf.json");
+    let mut gain_only = with_phase.clone();
+    if let Data::FrequencyResponse { phase_rad, .. } = &mut gain_only.experiment.data {
+        *phase_rad = None;
+    }
+    let truth = rtid::model::presets::load("worm-gear").unwrap();
+    let curve = ObjectiveKind::named("gain_curve").unwrap();
+    let names = ["Kw", "Kg", "Ciw", "Cig"];
+    let factors: Vec<(&str, f64)> = names.iter().map(|n| (*n, 1.4)).collect();
+    let start = support::off(&truth, &factors);
+    let mut group = c.benchmark_group("identify/complex");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(1));
+    for (label, spec) in [("phase", &with_phase), ("gain", &gain_only)] {
+        let source = Source {
+            file: &spec.source,
+            experiment: &spec.experiment,
+        };
+        let obj = curve.build(&source, Fidelity::Linear).unwrap();
+        group.bench_function(format!("cost/{label}"), |b| {
+            b.iter(|| obj.residuals(&truth).unwrap())
+        });
+        let mut spec: ExperimentSpec = spec.clone();
+        spec.objectives = Some(vec![curve]);
+        group.bench_function(format!("fit/{label}"), |b| {
+            b.iter(|| {
+                let mut config = Config::new(vec![spec.clone()], start.clone(), &names);
+                config.fidelity = FidelityChoice::Linear;
+                identify(&config, &Monitor::default()).unwrap()
+            })
+        });
+    }
     group.finish();
 }
 

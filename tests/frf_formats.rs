@@ -5,10 +5,10 @@
 //! of the UFF gives the CSV's frequencies, gains and phases, and `rtid identify` the
 //! same parameters and cost from either. No objective is named: the two
 //! identifications are compared with each other, whichever objective rtid uses for a
-//! frequency response. The peak-based ones agree bit for bit (the measured peaks come
-//! out the same from both files); one using every point starts from gains and phases
-//! that differ in their last bits (numpy's rounding against rtid's), and a search that
-//! stops along a flat direction may stop elsewhere (docs/import.md, UFF section).
+//! frequency response. The generator computes the CSV's gains and phases with the C
+//! library's functions, as an importer does, so the two files hold the same numbers;
+//! from gains and phases that differed in their last bits (a first draft's numpy
+//! rounding) the complex fit stopped 3e-7 apart in Ciw (docs/import.md, UFF section).
 
 use std::path::{Path, PathBuf};
 

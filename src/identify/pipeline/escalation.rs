@@ -56,11 +56,12 @@ pub fn check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, Identif
             experiment: &spec.experiment,
         };
         let test = measured::frequency_test(&spec.experiment);
-        let reference_is_fit = fits_whole_curve(&spec.experiment);
-        let mut measured = resolved_peaks(&source, p, &test)?;
-        if reference_is_fit {
-            measured = linear_peaks_on_grid(p, &grid, &measured)?;
-        }
+        let measured = resolved_peaks(&source, p, &test)?;
+        let linear_hz = if fits_whole_curve(&spec.experiment) {
+            linear_peaks_on_grid(p, &grid, &measured)?
+        } else {
+            Vec::new()
+        };
         let model = measured
             .iter()
             .map(|&f| nonlinear_peak_on_grid(p, &test, &grid, f).map(|pk| pk.frequency_hz))
@@ -75,7 +76,7 @@ pub fn check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, Identif
         out.push(NonlinearCheck {
             source: spec.source.clone(),
             measured_hz: measured,
-            reference_is_fit,
+            linear_hz,
             model_hz: model,
             max_miss_hz,
             linear_misfit_db,
@@ -162,7 +163,7 @@ pub fn verdict(checks: &[NonlinearCheck]) -> Option<Warning> {
             source: c.source.clone(),
             model_hz: c.model_hz.clone(),
             measured_hz: c.measured_hz.clone(),
-            reference_is_fit: c.reference_is_fit,
+            linear_hz: c.linear_hz.clone(),
             max_miss_hz: c.max_miss_hz,
             max_miss_percent: 100.0 * miss,
             linear_misfit_db: c.linear_misfit_db,
@@ -175,6 +176,10 @@ fn misfit_fails(db: f64) -> bool {
 }
 
 /// The largest |model − measured| / measured of a check (a NaN counts as infinite).
+/// The linear fit's own miss (`linear_hz`, where it fitted the whole curve) is
+/// reported, not subtracted: a whole-curve linear fit that misses a clean peak by
+/// 1 % is itself the sign of what the test shows (the worm fixture: its own 0.95 %,
+/// the test's 1.43 %), and subtracting it would pass a 1 % bias.
 fn worst_relative_miss(c: &NonlinearCheck) -> f64 {
     c.model_hz
         .iter()
@@ -194,7 +199,7 @@ mod tests {
         NonlinearCheck {
             source: "fr.json".into(),
             measured_hz: vec![200.0, 250.0],
-            reference_is_fit: false,
+            linear_hz: Vec::new(),
             model_hz,
             max_miss_hz: 0.0,
             linear_misfit_db: 0.2,

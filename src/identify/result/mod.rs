@@ -53,11 +53,11 @@ pub struct NonlinearCheck {
     /// parameters, every valid measured frequency).
     #[serde(default)]
     pub linear_misfit_db: f64,
-    /// `measured_hz` are the linear fit's own peaks located on the measured
-    /// frequencies, not the measured ones: where the fit used the whole (complex)
-    /// curve, the measured peaks carry the noise the fit averaged out.
+    /// Where the fit used the whole (complex) curve: the linear fit's own peaks,
+    /// located on the measured frequencies as the measured ones were, for the reader
+    /// (empty otherwise).
     #[serde(default)]
-    pub reference_is_fit: bool,
+    pub linear_hz: Vec<f64>,
 }
 
 /// The result of `rtid identify`.

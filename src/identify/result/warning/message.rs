@@ -50,13 +50,13 @@ pub(super) fn text(w: &Warning) -> String {
             source,
             model_hz,
             measured_hz,
-            reference_is_fit,
+            linear_hz,
             max_miss_hz,
             max_miss_percent,
             linear_misfit_db,
         } => escalated(
             source,
-            (model_hz, measured_hz, *reference_is_fit),
+            (model_hz, measured_hz, linear_hz),
             (*max_miss_hz, *max_miss_percent),
             *linear_misfit_db,
         ),
@@ -130,19 +130,19 @@ fn estimate_unused(source: &str, values: &str) -> String {
 /// largest miss in Hz and %, and the linear gain's misfit.
 fn escalated(
     source: &str,
-    (model_hz, measured_hz, reference_is_fit): (&[f64], &[f64], bool),
+    (model_hz, measured_hz, linear_hz): (&[f64], &[f64], &[f64]),
     (max_miss_hz, max_miss_percent): (f64, f64),
     linear_misfit_db: f64,
 ) -> String {
     format!(
-        "{source}: the linear fit does not explain the data — the nonlinear virtual test at its parameters puts the resonances at {} Hz ({} {} Hz), up to {max_miss_hz:.2} Hz ({max_miss_percent:.2} %) off, and the linear model's gain misses the measured curve by {linear_misfit_db:.2} dB RMS — beyond 0.5 % (a stiffness biased twice as much) or 1 dB (a flattened or misplaced peak): backlash or friction at the test's amplitude. So the result is the nonlinear fit, the linear one corrected by the nonlinear test",
+        "{source}: the linear fit does not explain the data — the nonlinear virtual test at its parameters puts the resonances at {} Hz (measured {} Hz{}), up to {max_miss_hz:.2} Hz ({max_miss_percent:.2} %) off, and the linear model's gain misses the measured curve by {linear_misfit_db:.2} dB RMS — beyond 0.5 % (a stiffness biased twice as much) or 1 dB (a flattened or misplaced peak): backlash or friction at the test's amplitude. So the result is the nonlinear fit, the linear one corrected by the nonlinear test",
         hz(model_hz),
-        if reference_is_fit {
-            "the linear fit's own peaks on the measured frequencies"
+        hz(measured_hz),
+        if linear_hz.is_empty() {
+            String::new()
         } else {
-            "measured"
-        },
-        hz(measured_hz)
+            format!("; the linear fit's own {} Hz", hz(linear_hz))
+        }
     )
 }
 

@@ -73,9 +73,9 @@ pub enum Warning {
         source: String,
         model_hz: Vec<f64>,
         measured_hz: Vec<f64>,
-        /// `measured_hz` are the linear fit's own peaks ([`crate::identify::result::NonlinearCheck`]).
+        /// The linear fit's own peaks ([`crate::identify::result::NonlinearCheck`]).
         #[serde(default)]
-        reference_is_fit: bool,
+        linear_hz: Vec<f64>,
         max_miss_hz: f64,
         max_miss_percent: f64,
         linear_misfit_db: f64,
