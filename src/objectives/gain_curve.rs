@@ -70,19 +70,15 @@ fn near_peaks(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objecti
 }
 
 /// Whether a frequency response is fitted by its whole curve by default rather than
-/// by its resonances: where it has phase (the complex curve says the dampings too),
-/// and where it is not table over motor (a compliance's peaks are not the motor-held
-/// modes the resonance objectives compare).
+/// by its resonances: where it is not table over motor (a compliance's peaks are not
+/// the motor-held modes the resonance objectives compare). A table over motor with
+/// phase still feeds its resonances by default; `--objective gain-curve` fits its
+/// complex curve (and then the dampings by default). Making the complex curve the
+/// default there changes the shipped worm fixtures' fits (they have phase) and nine
+/// tests written for the resonance fit: the next step of this work.
 pub fn fits_whole_curve(exp: &Experiment) -> bool {
-    let phase = matches!(
-        exp.data,
-        crate::io::experiment_file::Data::FrequencyResponse {
-            phase_rad: Some(_),
-            ..
-        }
-    );
     exp.manifest.kind == Kind::FrequencyResponse
-        && (phase || measured::form(exp).response != Response::TableOverMotor)
+        && measured::form(exp).response != Response::TableOverMotor
 }
 
 /// What a whole curve determines: table over motor, the drive stiffnesses and, with
