@@ -297,6 +297,8 @@ fn a_file_referred_to_the_table_is_refused_unless_the_manifest_says_so() {
         "two-mass",
         "--model",
         "linear",
+        "--objective",
+        "gain-curve",
     ];
     args.extend_from_slice(case.linear);
     let message = err(&rtid(&args, dir.path()));
