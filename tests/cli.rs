@@ -1059,7 +1059,8 @@ fn the_virtual_tests_run_on_a_linear_axis_in_its_units() {
 
 /// `identify --band`: a spurious maximum outside the band (here a 4 dB ripple written
 /// into the worm fixture at 400 Hz) is a "resonance" the model cannot match without
-/// it, and is not matched with it — the band gives the clean fixture's fit.
+/// it, and is not matched with it — the band gives the clean fixture's fit. (The
+/// resonance fit, named: the fixture has phase, whose default is the whole curve.)
 #[test]
 fn identify_in_a_band_ignores_a_ripple_outside_it() {
     let dir = tempdir();
@@ -1090,6 +1091,8 @@ fn identify_in_a_band_ignores_a_ripple_outside_it() {
             "worm-gear",
             "--model",
             "linear",
+            "--objective",
+            "resonance",
             "--json",
         ];
         if let Some(b) = band {
@@ -1653,7 +1656,7 @@ fn a_negative_value_names_its_option() {
 fn an_identification_stopped_by_sigint_resumes_to_the_uninterrupted_result() {
     let dir = tempdir();
     // The fixture without its phase: the resonance fit of Kw and Kg, which stops at
-    // the same point from any path. Its complex fit (--objective gain-curve: Kw, Kg,
+    // the same point from any path. Its complex fit (the default with phase: Kw, Kg,
     // Ciw, Cig; Ciw at its bound on this 10–600 Hz record) resumed to 2e-5 of Kg, not
     // 1e-9: its search stops on the cost's relative change along a flat direction.
     let source =
@@ -1920,7 +1923,7 @@ fn identify_profile_writes_intervals_points_and_plots() {
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("--profile Kx: not a fitted parameter (fitted: Kg, Kw)"),
+        err.contains("--profile Kx: not a fitted parameter (fitted: Cig, Ciw, Kg, Kw)"),
         "{err}"
     );
 }

@@ -6,9 +6,9 @@
 //! the band of its modes: the worm table and the roller gear cam as table over motor,
 //! the two-mass drive likewise, the direct drive (whose table over motor is 1) as the
 //! motor's compliance. The command states that the drive is linear (`--model linear`,
-//! and no backlash, friction or gear fluctuation) and asks for the whole curve
-//! (`--objective gain-curve`: with phase, the complex curve), the search starts 20–40 %
-//! away from the truth, no parameter or bound is named, and
+//! and no backlash, friction or gear fluctuation), the search starts 20–40 % away from
+//! the truth, no objective, parameter or bound is named (a file with phase feeds its
+//! whole complex curve by default), and
 //! every fitted value must lie within 3 of its standard errors of the truth, over two
 //! seeds (a 95 % interval would, by design, miss one value in twenty; measured: all
 //! within 2 standard errors).
@@ -135,8 +135,7 @@ fn identify(dir: &Path, case: &Case, name: &str, extra: &[&str]) -> Value {
         args.extend_from_slice(&["--set", s]);
     }
     args.extend_from_slice(extra);
-    args.extend_from_slice(&["--model", "linear", "--objective", "gain-curve"]);
-    args.extend_from_slice(&["--quiet", "--json"]);
+    args.extend_from_slice(&["--model", "linear", "--quiet", "--json"]);
     serde_json::from_str(&ok(&rtid(&args, dir))).unwrap()
 }
 
@@ -297,8 +296,6 @@ fn a_file_referred_to_the_table_is_refused_unless_the_manifest_says_so() {
         "two-mass",
         "--model",
         "linear",
-        "--objective",
-        "gain-curve",
     ];
     args.extend_from_slice(case.linear);
     let message = err(&rtid(&args, dir.path()));

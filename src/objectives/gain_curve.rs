@@ -70,15 +70,24 @@ fn near_peaks(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objecti
 }
 
 /// Whether a frequency response is fitted by its whole curve by default rather than
-/// by its resonances: where it is not table over motor (a compliance's peaks are not
-/// the motor-held modes the resonance objectives compare). A table over motor with
-/// phase still feeds its resonances by default; `--objective gain-curve` fits its
-/// complex curve (and then the dampings by default). Making the complex curve the
-/// default there changes the shipped worm fixtures' fits (they have phase) and nine
-/// tests written for the resonance fit: the next step of this work.
+/// by its resonances: where it has phase (the complex curve says which damping belongs
+/// to which mesh; the peaks alone fix the stiffnesses only roughly when the damping is
+/// unknown), or where it is not table over motor (a compliance's peaks are not the
+/// motor-held modes the resonance objectives compare). A gain-only table over motor
+/// feeds its resonances; `--objective gain-curve` fits its whole curve.
 pub fn fits_whole_curve(exp: &Experiment) -> bool {
     exp.manifest.kind == Kind::FrequencyResponse
-        && measured::form(exp).response != Response::TableOverMotor
+        && (has_phase(exp) || measured::form(exp).response != Response::TableOverMotor)
+}
+
+fn has_phase(exp: &Experiment) -> bool {
+    matches!(
+        exp.data,
+        crate::io::experiment_file::Data::FrequencyResponse {
+            phase_rad: Some(_),
+            ..
+        }
+    )
 }
 
 /// What a whole curve determines: table over motor, the drive stiffnesses and, with
@@ -93,14 +102,7 @@ fn curve_determines(exp: &Experiment, p: &Params) -> Vec<&'static str> {
         (Response::TableOverMotor, _) => Vec::new(),
     };
     out.extend(drive_stiffnesses(p));
-    let phase = matches!(
-        exp.data,
-        crate::io::experiment_file::Data::FrequencyResponse {
-            phase_rad: Some(_),
-            ..
-        }
-    );
-    if phase {
+    if has_phase(exp) {
         out.push("Ciw");
         if p.cig.is_some() {
             out.push("Cig");

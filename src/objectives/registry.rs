@@ -296,12 +296,10 @@ mod tests {
     }
 
     #[test]
-    fn a_response_with_phase_fitted_by_its_curve_determines_the_dampings_too() {
+    fn a_response_with_phase_feeds_its_whole_complex_curve_by_default() {
         let e = gain_curve(true);
-        assert_eq!(
-            names(&e, Stage::Search),
-            [("resonance", 1.0), ("peak_amplitude", 0.01)]
-        );
+        assert_eq!(names(&e, Stage::Search), [("gain_curve", 1.0)]);
+        assert_eq!(names(&e, Stage::Correction), [("gain_near_peaks", 1.0)]);
         let p = crate::model::presets::load("worm-gear").unwrap();
         let fit = (ObjectiveKind::named("gain_curve")
             .unwrap()

@@ -44,6 +44,16 @@ pub fn worm_frequency_response() -> Fixture {
     fixture("worm-gear/frequency_response.json", "worm-gear")
 }
 
+/// The fixture's gain alone, its phase column dropped: the resonance fit (with phase
+/// a frequency response feeds its whole complex curve by default).
+pub fn gain_only(mut f: Fixture) -> Fixture {
+    if let experiment_file::Data::FrequencyResponse { phase_rad, .. } = &mut f.spec.experiment.data
+    {
+        *phase_rad = None;
+    }
+    f
+}
+
 /// As [`worm_frequency_response`] with 1 % Gaussian noise on the amplitude ratio.
 pub fn worm_frequency_response_noisy() -> Fixture {
     fixture("worm-gear-noisy/frequency_response.json", "worm-gear")

@@ -335,11 +335,15 @@ struct ComplexEvaluation {
 
 /// The modes of the file's complex response (the drive's ratio, as
 /// [`measured::complex_points`] gives it) and its phase and Nyquist plots beside
-/// `plot`; `None` without a phase.
+/// `plot`; `None` without a phase, or where no line is resolved (every line flagged
+/// below the table encoder's resolution: the warnings say so).
 fn complex_evaluation(exp: &Experiment, plot: &Path) -> anyhow::Result<Option<ComplexEvaluation>> {
     let Some(mut c) = measured::complex_points(exp, |_| true) else {
         return Ok(None);
     };
+    if c.frequency_hz.is_empty() {
+        return Ok(None);
+    }
     let form = measured::form(exp);
     let (integrators, ratio, unit) = match form.response {
         Response::TableOverMotor => (0, "table / motor × ratio", "1"),

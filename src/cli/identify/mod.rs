@@ -38,13 +38,14 @@ rig or written by `rtid experiment`. The other parameters stay at the --preset /
 values.
 
 What each experiment feeds (--objective to choose):
-  frequency_response  resonance: the measured resonance frequencies (peaks of the gain curve) \
-against the model's; also peak-amplitude (peak heights, dB: for Ciw, Cig), gain-curve (the \
-whole curve: with phase the complex response — ln|H| and phase errors, each over its noise \
-(the file's gain_sigma_db / coherence, else 0.1 dB and 0.66°), phase compared modulo 360°, a \
-delay_s in the manifest taken out or fitted (\"unknown\"), --fit then defaulting to Kw, Kg, \
-Ciw, Cig; a compliance's default, Jt and Ct on a direct drive) and gain-near-peaks (the gain \
-within ±3 % of each resonance).
+  frequency_response  with phase (or a compliance): gain-curve, the whole complex response — \
+ln|H| and phase errors, each over its noise (the file's gain_sigma_db / coherence, else 0.1 dB \
+and 0.66°), phase compared modulo 360°, a delay_s in the manifest taken out or fitted \
+(\"unknown\") — and --fit defaults to the stiffnesses and the meshes' dampings (Kw, Kg, Ciw, \
+Cig; a direct drive's compliance: Jt, Ct). Gain only: resonance, the measured resonance \
+frequencies (peaks of the gain curve) against the model's; also peak-amplitude (peak heights, \
+dB: for Ciw, Cig), gain-curve (the whole gain curve, dB) and gain-near-peaks (the gain within \
+±3 % of each resonance).
   resonance           resonance (and peak-amplitude when the manifest has peak_gain_db).
   torque_curve        torque-curve: the motor torque of the closed-loop torque test, sample by \
 sample. A torque curve determines one Coulomb and one viscous sum (fm + fw·Rg + ft·Rg·Rw, and \
@@ -58,7 +59,8 @@ fm and Cm.
   unbalance           unbalance-step: the table angles where the deviation θt − θm·Rg·Rw steps \
 across the backlash (where the unbalance moment overcomes the table friction), model against \
 measured, 0.05° per unit. It determines ft (the manifest must give mass_kg and radius_m).
-Default --fit: Kw (and Kg with a spur stage) from resonances; fm and Cm from a torque curve \
+Default --fit: Kw, Kg, Ciw, Cig from a response with phase; Kw (and Kg with a spur stage) \
+from resonances; fm and Cm from a torque curve \
 (the table's friction reaches the motor divided by the ratio — 1/90 for the worm — and \
 hardly shows in its torque); ft from an unbalance test; Jt, Ct, ft, Tload from a servo trace \
 of a direct-drive axis. fm and ft together: give both files \
