@@ -612,3 +612,162 @@ fn negative_values_reach_the_options_own_check() {
         check(&args, &run, culprit);
     }
 }
+
+/// Issue 28's classes met at their root: torque curves out of any physical range
+/// (angles or torques of ±1e308, a time step of 1e-300 s or 1e300 s) are evaluated at
+/// once with no null among the friction law's numbers (the law's least squares hung on
+/// them, or wrote null); a resonance file's non-positive or absurd peak, a parameter
+/// file's null and a weight of 1e308 are refused naming the field or option.
+#[test]
+fn records_and_values_out_of_range_are_met_at_their_root() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let manifest = std::fs::read_to_string(fixture("worm-gear/torque_curve.json")).unwrap();
+    let csv = std::fs::read_to_string(fixture("worm-gear/torque_curve.csv")).unwrap();
+    let rows: Vec<Vec<String>> = csv
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    let alternate = |k: usize| if k % 2 == 0 { "1e308" } else { "-1e308" }.to_string();
+    type Edit = fn(usize, &mut Vec<String>, &dyn Fn(usize) -> String);
+    // Each with what a refusal names: the value's column (beyond ±1e15 SI).
+    let edits: [(&str, Edit, &str); 4] = [
+        (
+            "angles",
+            |k, r, alt| r[2] = alt(k),
+            "`table_angle_deg`: 1e308",
+        ),
+        (
+            "torques",
+            |k, r, alt| r[1] = alt(k),
+            "`motor_torque_nm`: 1e308",
+        ),
+        (
+            "tiny-step",
+            |k, r, _| r[0] = format!("{:e}", k as f64 * 1e-300),
+            "time_s",
+        ),
+        (
+            "huge-step",
+            |k, r, _| r[0] = format!("{:e}", k as f64 * 1e300),
+            "`time_s`: 1e300",
+        ),
+    ];
+    for (name, edit, culprit) in edits {
+        let mut text = String::from("time_s,motor_torque_nm,table_angle_deg\n");
+        for (k, row) in rows.iter().enumerate() {
+            let mut row = row.clone();
+            edit(k, &mut row, &alternate);
+            text += &(row.join(",") + "\n");
+        }
+        std::fs::write(d.join(format!("{name}.csv")), text).unwrap();
+        let m = manifest.replace("torque_curve.csv", &format!("{name}.csv"));
+        std::fs::write(d.join(format!("{name}.json")), m).unwrap();
+        let args = strings(&["evaluate", &format!("{name}.json"), "--json"]);
+        let run = rtid(&args, d);
+        check(&args, &run, culprit);
+        if run.code == Some(0) {
+            let v: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+            let law = &v["inverse_dynamics"];
+            assert!(
+                law.is_null() || !law.to_string().contains("null"),
+                "{name}: {law}"
+            );
+        }
+    }
+    let worm = fixture("worm-gear/frequency_response.json");
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            strings(&["identify", "peaks.json", "--preset", "worm-gear"]),
+            "peaks_hz",
+        ),
+        (strings(&["modes", "--params", "null.json"]), "`Cw` is null"),
+        (
+            strings(&[
+                "identify",
+                worm.to_str().unwrap(),
+                "--preset",
+                "worm-gear",
+                "--weight",
+                "1e308",
+            ]),
+            "--weight 1e308",
+        ),
+    ];
+    let mut params: serde_json::Value = serde_json::from_str(&rtid_ok_json(d)).unwrap();
+    params["Cw"] = serde_json::Value::Null;
+    std::fs::write(d.join("null.json"), params.to_string()).unwrap();
+    for peaks in ["[-100]", "[0, 200]", "[100, 1e308]"] {
+        let m = format!("{{\"kind\": \"resonance\", \"peaks_hz\": {peaks}}}");
+        std::fs::write(d.join("peaks.json"), m).unwrap();
+        let (args, culprit) = &cases[0];
+        let run = rtid(args, d);
+        assert_eq!(run.code, Some(1), "{peaks}: {}", run.stderr);
+        check(args, &run, culprit);
+    }
+    for (args, culprit) in &cases[1..] {
+        let run = rtid(args, d);
+        assert_eq!(run.code, Some(1), "{args:?}: {}", run.stderr);
+        check(args, &run, culprit);
+    }
+    // A checkpoint resumed with another parameter held, or with a corrupted stage.
+    let fit = |extra: &[&str]| {
+        let mut args = strings(&[
+            "identify",
+            worm.to_str().unwrap(),
+            "--preset",
+            "worm-gear",
+            "--fit",
+            "Kw,Kg",
+            "--model",
+            "linear",
+            "--starts",
+            "1",
+            "--max-iters",
+            "3",
+            "--checkpoint",
+            "c.json",
+            "--quiet",
+        ]);
+        args.extend(strings(extra));
+        (rtid(&args, d), args)
+    };
+    assert_eq!(fit(&[]).0.code, Some(0));
+    let (run, args) = fit(&["--resume", "--set", "Jt=0.2"]);
+    assert_eq!(run.code, Some(1), "{}", run.stderr);
+    check(&args, &run, "another problem (the parameters held differ)");
+    let text = std::fs::read_to_string(d.join("c.json")).unwrap();
+    let mut c: serde_json::Value = serde_json::from_str(&text).unwrap();
+    c["stage"] = 7.into();
+    std::fs::write(d.join("c.json"), c.to_string()).unwrap();
+    let (run, args) = fit(&["--resume"]);
+    assert_eq!(run.code, Some(1), "{}", run.stderr);
+    check(&args, &run, "stage is 7");
+    // A field the checkpoint does not have, nested thousands deep.
+    c["stage"] = 0.into();
+    let deep = "[".repeat(5000) + &"]".repeat(5000);
+    let text = c
+        .to_string()
+        .replacen('{', &format!("{{\"extra\": {deep}, "), 1);
+    std::fs::write(d.join("c.json"), text).unwrap();
+    let (run, args) = fit(&["--resume"]);
+    assert_eq!(run.code, Some(1), "{}", run.stderr);
+    check(&args, &run, "not an rtid checkpoint");
+}
+
+/// The worm preset's parameter file, as `rtid params --out` writes it.
+fn rtid_ok_json(dir: &Path) -> String {
+    let args = strings(&[
+        "params",
+        "--preset",
+        "worm-gear",
+        "--out",
+        "p.json",
+        "--quiet",
+    ]);
+    let run = rtid(&args, dir);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    std::fs::read_to_string(dir.join("p.json")).unwrap()
+}

@@ -10,13 +10,18 @@ use crate::io::experiment_file::Experiment;
 use crate::model::Params;
 use crate::objectives::ObjectiveKind;
 
+/// The weights an experiment may have: relative, 1 by default. Beyond, the weighted
+/// residuals of the others vanish beside it, or its own overflow (a weight of 1e308
+/// made every cost infinite and the search never stop).
+pub const WEIGHTS: std::ops::RangeInclusive<f64> = 1e-6..=1e6;
+
 /// One experiment of an identification.
 #[derive(Clone, Debug)]
 pub struct ExperimentSpec {
     /// Where it came from (its file), for reports.
     pub source: String,
     pub experiment: Experiment,
-    /// Its weight in the joint cost (default 1).
+    /// Its weight in the joint cost (default 1; within [`WEIGHTS`]).
     pub weight: f64,
     /// The objectives it feeds (`None`: the defaults of its kind).
     pub objectives: Option<Vec<ObjectiveKind>>,

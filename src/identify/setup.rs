@@ -13,7 +13,7 @@ pub(crate) fn selection(
     stage: Stage,
 ) -> Result<Vec<(ObjectiveKind, f64)>, SetupError> {
     let w = spec.weight;
-    if !(w.is_finite() && w > 0.0) {
+    if !crate::identify::config::WEIGHTS.contains(&w) {
         return Err(SetupError::BadWeight {
             file: spec.source.clone(),
             weight: w,

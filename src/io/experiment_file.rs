@@ -309,6 +309,10 @@ fn either(column: &str, alternatives: &[String]) -> String {
     s
 }
 
+/// The highest resonance frequency a resonance file may give, Hz: a drive's
+/// mechanical modes lie far below (the model's response at 1e308 Hz is not a number).
+const MAX_PEAK_HZ: f64 = 1e6;
+
 /// Reads an experiment: the manifest at `path` and, unless it is a resonance, its CSV.
 pub fn read(path: &Path) -> Result<Experiment, ExperimentFileError> {
     let manifest = read_manifest(path)?;
@@ -321,6 +325,25 @@ pub fn read(path: &Path) -> Result<Experiment, ExperimentFileError> {
         })?;
         if peaks_hz.is_empty() {
             return Err(manifest_error(path, "`peaks_hz` is empty"));
+        }
+        if let Some((i, f)) = peaks_hz
+            .iter()
+            .enumerate()
+            .find(|(_, f)| f.is_nan() || **f <= 0.0)
+        {
+            return Err(manifest_error(
+                path,
+                &format!("`peaks_hz`[{i}] = {f}: a resonance frequency is positive (Hz)"),
+            ));
+        }
+        if let Some((i, f)) = peaks_hz.iter().enumerate().find(|(_, f)| **f > MAX_PEAK_HZ) {
+            return Err(manifest_error(
+                path,
+                &format!(
+                    "`peaks_hz`[{i}] = {f:e} Hz: above 1 MHz, not a drive's mechanical resonance \
+                     (the unit is Hz)"
+                ),
+            ));
         }
         let data = Data::Resonance {
             peaks_hz,

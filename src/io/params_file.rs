@@ -23,6 +23,11 @@ pub enum ParamsFileError {
     },
     #[error("parameter file {path}: {source}")]
     Invalid { path: PathBuf, source: ParamError },
+    #[error(
+        "parameter file {path}: `{field}` is null: give a number, or leave the field out \
+         (for its default, where it has one)"
+    )]
+    Null { path: PathBuf, field: String },
     #[error("cannot write parameter file {path}: {source}")]
     Write {
         path: PathBuf,
@@ -41,18 +46,26 @@ pub fn read(path: &Path) -> Result<Params, ParamsFileError> {
 
 /// Parses and validates parameter JSON; `path` is only used in error messages.
 pub fn parse(text: &str, path: &Path) -> Result<Params, ParamsFileError> {
-    let params: Params =
-        serde_json::from_str(super::without_bom(text)).map_err(|e| ParamsFileError::Syntax {
+    let syntax = |e: serde_json::Error| ParamsFileError::Syntax {
+        path: path.to_path_buf(),
+        line: e.line(),
+        column: e.column(),
+        message: e
+            .to_string()
+            .split(" at line ")
+            .next()
+            .unwrap_or("")
+            .to_string(),
+    };
+    let value: serde_json::Value =
+        serde_json::from_str(super::without_bom(text)).map_err(syntax)?;
+    if let Some(field) = null_field(&value, "") {
+        return Err(ParamsFileError::Null {
             path: path.to_path_buf(),
-            line: e.line(),
-            column: e.column(),
-            message: e
-                .to_string()
-                .split(" at line ")
-                .next()
-                .unwrap_or("")
-                .to_string(),
-        })?;
+            field,
+        });
+    }
+    let params: Params = serde_json::from_str(super::without_bom(text)).map_err(syntax)?;
     params
         .validate()
         .map_err(|source| ParamsFileError::Invalid {
@@ -60,6 +73,21 @@ pub fn parse(text: &str, path: &Path) -> Result<Params, ParamsFileError> {
             source,
         })?;
     Ok(params)
+}
+
+/// The first field whose value is null (a parameter's `Option` would read it as
+/// absent: the default taken silently), dotted below the top level.
+fn null_field(v: &serde_json::Value, prefix: &str) -> Option<String> {
+    let serde_json::Value::Object(map) = v else {
+        return None;
+    };
+    map.iter().find_map(|(k, v)| {
+        let name = format!("{prefix}{k}");
+        match v {
+            serde_json::Value::Null => Some(name),
+            _ => null_field(v, &format!("{name}.")),
+        }
+    })
 }
 
 /// Writes a parameter file atomically (temporary file in the same folder, then rename).
@@ -94,6 +122,24 @@ mod tests {
         let p = presets::load("roller-gear-cam").unwrap();
         write(&path, &p).unwrap();
         assert_eq!(read(&path).unwrap(), p);
+    }
+
+    #[test]
+    fn a_null_parameter_is_refused_naming_it_not_read_as_absent() {
+        for (path, field) in [
+            (&["Cw"][..], "Cw"),
+            (&["theta_bw"], "theta_bw"),
+            (&["controller", "Kpp"], "controller.Kpp"),
+        ] {
+            let mut v = worm_json();
+            let mut at = &mut v;
+            for k in path {
+                at = &mut at[*k];
+            }
+            *at = serde_json::Value::Null;
+            let e = parse_value(&v).unwrap_err().to_string();
+            assert!(e.contains(&format!("p.json: `{field}` is null")), "{e}");
+        }
     }
 
     #[test]

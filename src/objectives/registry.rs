@@ -220,7 +220,10 @@ pub enum SetupError {
     Data { file: String, reason: String },
     #[error("{file}: no resonance peak found in the gain curve")]
     NoPeaks { file: String },
-    #[error("{file}: weight {weight}: weights must be positive and finite")]
+    #[error(
+        "{file}: weight {}: a weight is relative (default 1): give one within 1e-6..1e6",
+        crate::names::Num(*weight)
+    )]
     BadWeight { file: String, weight: f64 },
     #[error(transparent)]
     Param(#[from] ParamError),

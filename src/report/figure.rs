@@ -55,6 +55,13 @@ pub struct Figure {
 pub enum FigureError {
     #[error("{title}: nothing to plot (no finite points)")]
     Empty { title: String },
+    #[error("{title}: the {axis} values span {lo:e} … {hi:e}, beyond what an axis can scale")]
+    Range {
+        title: String,
+        axis: &'static str,
+        lo: f64,
+        hi: f64,
+    },
     #[error("{title}: drawing failed: {message}")]
     Draw { title: String, message: String },
     #[error("cannot write {path}: {source}")]
@@ -134,6 +141,17 @@ fn render(figure: &Figure) -> Result<String, FigureError> {
         (a - m, b + m)
     };
     let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
+    for (axis, lo, hi) in [("x", x0, x1), ("y", y0, y1)] {
+        // The axis' tick search never ends on a span that overflows.
+        if !(hi - lo).is_finite() {
+            return Err(FigureError::Range {
+                title: figure.title.clone(),
+                axis,
+                lo,
+                hi,
+            });
+        }
+    }
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (900, 560)).into_drawing_area();
@@ -219,5 +237,13 @@ mod tests {
         let figure =
             Figure::new("", "", "").with(Series::new("x", vec![(f64::NAN, 1.0)], Style::Line));
         assert!(matches!(figure.render(), Err(FigureError::Empty { .. })));
+    }
+
+    #[test]
+    fn a_span_that_overflows_is_an_error_not_a_hang() {
+        let points = vec![(0.0, -1e308), (1.0, 1e308)];
+        let figure = Figure::new("t", "", "").with(Series::new("x", points, Style::Line));
+        let e = figure.render().unwrap_err();
+        assert!(matches!(e, FigureError::Range { axis: "y", .. }), "{e}");
     }
 }

@@ -22,6 +22,17 @@ pub fn non_negative(v: f64, option: &str) -> anyhow::Result<f64> {
     }
 }
 
+/// A noise or scatter level, %: from 0 to 100 (beyond, the noise is not a
+/// measurement's; 1e308 % made infinite samples that the writer then named as a cell
+/// rather than as the option).
+pub fn percent(v: f64, option: &str) -> anyhow::Result<f64> {
+    if (0.0..=100.0).contains(&v) {
+        Ok(v)
+    } else {
+        bail!("{option} {}: must lie in 0..100 (%)", Num(v))
+    }
+}
+
 /// A finite value.
 pub fn finite(v: f64, option: &str) -> anyhow::Result<f64> {
     if v.is_finite() {

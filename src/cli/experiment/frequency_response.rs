@@ -135,8 +135,8 @@ impl Args {
             )?;
         }
         check::finite(self.preload_nm, "--preload-nm")?;
-        check::non_negative(self.noise_percent, "--noise-percent")?;
-        check::non_negative(self.complex_noise_percent, "--complex-noise-percent")?;
+        check::percent(self.noise_percent, "--noise-percent")?;
+        check::percent(self.complex_noise_percent, "--complex-noise-percent")?;
         check::non_negative(self.unstated_delay_s, "--unstated-delay-s")?;
         if self.response == ResponseArg::MotorCompliance && !self.linear {
             bail!(

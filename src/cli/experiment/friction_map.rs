@@ -126,8 +126,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 
 /// The test the flags describe, or why they do not describe one.
 fn test(a: &Args, p: &Params) -> anyhow::Result<MapTest> {
-    check::non_negative(a.noise_percent, "--noise-percent")?;
-    check::non_negative(a.scatter_percent, "--scatter-percent")?;
+    check::percent(a.noise_percent, "--noise-percent")?;
+    check::percent(a.scatter_percent, "--scatter-percent")?;
     let (given, option, si) = match (p.axis, a.speeds_rpm.is_empty(), a.speeds_mm_s.is_empty()) {
         (Axis::Rotary, _, true) => (&a.speeds_rpm, "--speeds-rpm", std::f64::consts::TAU / 60.0),
         (Axis::Linear, true, _) => (&a.speeds_mm_s, "--speeds-mm-s", 1e-3),

@@ -87,7 +87,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 /// The test the flags describe, or why they do not describe one (checked before
 /// anything runs).
 fn test(a: &Args, axis: Axis) -> anyhow::Result<TorqueTest> {
-    check::non_negative(a.noise_percent, "--noise-percent")?;
+    check::percent(a.noise_percent, "--noise-percent")?;
     let amplitude = match (axis, a.amplitude_deg, a.amplitude_mm) {
         (Axis::Rotary, deg, None) => {
             check::positive(deg.unwrap_or(30.0), "--amplitude-deg")?.to_radians()

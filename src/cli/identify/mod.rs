@@ -137,7 +137,8 @@ pub struct Args {
     /// feeds those of them it can.
     #[arg(long, value_delimiter = ',', value_parser = objective_names())]
     pub objective: Option<Vec<String>>,
-    /// Weight of each experiment in the joint cost, in the order given (default 1 each).
+    /// Weight of each experiment in the joint cost, in the order given (default 1 each;
+    /// relative, within 1e-6..1e6).
     #[arg(long = "weight", value_delimiter = ',', allow_negative_numbers = true)]
     pub weights: Vec<f64>,
     /// Solver [default: lsq; nelder-mead when a torque curve or an unbalance test is
@@ -397,8 +398,9 @@ impl Args {
             }
             if let Some(&w) = self.weights.get(i) {
                 anyhow::ensure!(
-                    w.is_finite() && w > 0.0,
-                    "--weight {w}: weights must be positive and finite"
+                    rtid::identify::config::WEIGHTS.contains(&w),
+                    "--weight {}: a weight is relative (default 1): give one within 1e-6..1e6",
+                    rtid::names::Num(w)
                 );
                 spec.weight = w;
             }

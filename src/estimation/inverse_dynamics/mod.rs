@@ -187,6 +187,11 @@ pub enum IdimError {
          not excite every parameter (it needs motion both ways at changing speed)"
     )]
     Singular { condition: f64 },
+    #[error(
+        "the {what} is not a finite number: the record's positions, efforts or sample \
+         period are out of any physical range"
+    )]
+    Overflow { what: &'static str },
 }
 
 /// Identifies M, Fv, Fc and OF from a uniformly sampled `position` (m or rad) and the
@@ -207,6 +212,12 @@ pub fn identify(
     let mut columns = [acceleration, velocity, sign, effort.to_vec()];
     let decimation_cutoff_hz = parallel_filter(&mut columns, rate, settings.decimation)?;
     let [acceleration, velocity, sign, effort] = &columns;
+    // A NaN speed would pass for a slow row: say what overflowed instead.
+    if acceleration.iter().chain(velocity).any(|v| !v.is_finite()) {
+        return Err(IdimError::Overflow {
+            what: "speed or acceleration derived from the positions",
+        });
+    }
     let (rows, slow_rows) = select_rows(velocity, settings);
     if rows.len() < 2 * 4 {
         return Err(IdimError::TooFewRows {
@@ -354,9 +365,30 @@ struct LeastSquares {
     condition_number: f64,
 }
 
+/// Iterations of the SVD at most (it takes a few dozen on a well-posed record; the
+/// cap makes a pathological one an error, not a hang).
+const SVD_MAX_ITERATIONS: usize = 10_000;
+
 /// Least squares through the SVD of W (robust to the columns' different scales).
+/// Non-finite rows (speeds or accelerations that overflow: angles of 1e308, a sample
+/// period of 1e-300 s) are refused before the SVD, which never returns on them.
 fn least_squares(w: &DMatrix<f64>, y: &DVector<f64>) -> Result<LeastSquares, IdimError> {
-    let svd = w.clone().svd(true, true);
+    if w.iter().any(|v| !v.is_finite()) {
+        return Err(IdimError::Overflow {
+            what: "speed or acceleration derived from the positions",
+        });
+    }
+    if y.iter().any(|v| !v.is_finite()) {
+        return Err(IdimError::Overflow {
+            what: "filtered effort",
+        });
+    }
+    let svd = w
+        .clone()
+        .try_svd(true, true, f64::EPSILON, SVD_MAX_ITERATIONS)
+        .ok_or(IdimError::Singular {
+            condition: f64::INFINITY,
+        })?;
     let (max, min) = (svd.singular_values.max(), svd.singular_values.min());
     let condition = max / min;
     if !(condition.is_finite() && condition < 1e12) {
@@ -377,10 +409,16 @@ fn least_squares(w: &DMatrix<f64>, y: &DVector<f64>) -> Result<LeastSquares, Idi
             .sum();
         *e = (sigma2 * var).sqrt();
     }
+    let residual_rms = (residual.norm_squared() / rows).sqrt();
+    if !(residual_rms.is_finite() && theta.iter().chain(&std_errors).all(|v| v.is_finite())) {
+        return Err(IdimError::Overflow {
+            what: "least-squares fit (its residual or standard errors)",
+        });
+    }
     Ok(LeastSquares {
         theta: [theta[0], theta[1], theta[2], theta[3]],
         std_errors,
-        residual_rms: (residual.norm_squared() / rows).sqrt(),
+        residual_rms,
         condition_number: condition,
     })
 }

@@ -226,6 +226,33 @@ fn bad_input_gives_one_error_naming_it() {
     assert!(matches!(e, IdimError::Singular { .. }), "{e}");
 }
 
+/// Records whose derivatives or fit overflow (issue 28: the SVD never returned on
+/// them) give one error saying so, at once.
+#[test]
+fn records_out_of_any_physical_range_are_refused_not_hung_on() {
+    let (q, f) = record(2_000, sine(0.1, 1.0));
+    let s = IdimSettings::default();
+    let huge: Vec<f64> = (0..q.len())
+        .map(|k| if k % 2 == 0 { 1e308 } else { -1e308 })
+        .collect();
+    let tiny = 1e-300;
+    for (ts, position, effort, settings, expected) in [
+        (TS, &huge, &f, s, "speed or acceleration"),
+        (
+            tiny,
+            &q,
+            &f,
+            IdimSettings::for_sample_period(tiny),
+            "speed or acceleration",
+        ),
+        (TS, &q, &huge, s, "filtered effort"),
+    ] {
+        let e = identify(ts, position, effort, &settings).unwrap_err();
+        assert!(matches!(e, IdimError::Overflow { .. }), "{e}");
+        assert!(e.to_string().contains(expected), "{e}");
+    }
+}
+
 #[test]
 fn the_result_states_its_settings_and_serialises() {
     let (q, f) = record(3_000, sine(0.1, 1.0));

@@ -15,6 +15,7 @@ use crate::identify::space::ParamSpace;
 
 /// The identity of an identification problem.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Fingerprint {
     /// The experiment files, in order.
     pub experiments: Vec<String>,
@@ -28,6 +29,14 @@ pub struct Fingerprint {
     pub starts: usize,
     pub seed: u64,
     pub stages: usize,
+    /// The parameter set the others are held at (its JSON): the same names fitted
+    /// with other values held are another problem.
+    #[serde(default)]
+    pub held: String,
+    /// Each experiment's files' SHA-256 (manifest, then data file): the same paths
+    /// holding other data are another problem.
+    #[serde(default)]
+    pub data: Vec<String>,
 }
 
 impl Fingerprint {
@@ -57,12 +66,20 @@ impl Fingerprint {
             starts: first.starts,
             seed: first.seed,
             stages: plan.stages.len(),
+            held: serde_json::to_string(&config.base).unwrap_or_default(),
+            data: config
+                .experiments
+                .iter()
+                .flat_map(|e| [Some(&e.experiment.path), e.experiment.data_path.as_ref()])
+                .flatten()
+                .map(|p| crate::io::provenance::sha256(p).unwrap_or_default())
+                .collect(),
         }
     }
 
     /// The first field in which `other` differs, if any.
     pub fn difference(&self, other: &Fingerprint) -> Option<&'static str> {
-        let fields: [(&'static str, bool); 10] = [
+        let fields: [(&'static str, bool); 12] = [
             ("the experiments", self.experiments == other.experiments),
             ("the weights", self.weights == other.weights),
             ("the objectives", self.objectives == other.objectives),
@@ -73,6 +90,8 @@ impl Fingerprint {
             ("the number of starts", self.starts == other.starts),
             ("the seed", self.seed == other.seed),
             ("the stages (the model)", self.stages == other.stages),
+            ("the parameters held", self.held == other.held),
+            ("the experiment files' contents", self.data == other.data),
         ];
         fields.into_iter().find(|(_, same)| !same).map(|(f, _)| f)
     }
@@ -80,6 +99,7 @@ impl Fingerprint {
 
 /// A checkpoint file's content.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Checkpoint {
     pub fingerprint: Fingerprint,
     /// Stage reached (0: the search; 1: the nonlinear corrections).
@@ -106,6 +126,12 @@ pub enum CheckpointError {
     Parse { path: PathBuf, message: String },
     #[error("{path} belongs to another problem ({field} differ)")]
     OtherProblem { path: PathBuf, field: &'static str },
+    #[error("{path}: the checkpoint's stage is {stage}, but the problem has {stages} (stage 0 the search, 1 the corrections): the file is corrupted")]
+    Stage {
+        path: PathBuf,
+        stage: usize,
+        stages: usize,
+    },
     #[error("{path}: the checkpoint holds {found} values for {expected} fitted parameters")]
     Values {
         path: PathBuf,
@@ -148,6 +174,13 @@ impl Checkpoint {
             return Err(CheckpointError::OtherProblem {
                 path: path.into(),
                 field,
+            });
+        }
+        if c.stage >= c.fingerprint.stages {
+            return Err(CheckpointError::Stage {
+                path: path.into(),
+                stage: c.stage,
+                stages: c.fingerprint.stages,
             });
         }
         c.check_sizes(path)?;

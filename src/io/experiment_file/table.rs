@@ -258,6 +258,11 @@ impl Table {
         for (line, record) in &self.rows {
             let text = record.get(col.index).unwrap_or("");
             let x = number(text).map_err(|m| self.cell(*line, col.index, m))?;
+            if (x * col.scale).abs() > MAX_MAGNITUDE {
+                let message =
+                    format!("{x:e} is beyond ±1e15 in SI units: not a measurement (a unit slip?)");
+                return Err(self.cell(*line, col.index, message));
+            }
             if let (Order::Increasing, Some(p)) = (order, previous) {
                 if x <= p {
                     let message = format!("{x} does not increase (previous row {p})");
@@ -308,6 +313,11 @@ enum Order {
     Any,
     Increasing,
 }
+
+/// The largest magnitude a record's value may have in SI units (s, rad, m, N·m, N, Hz,
+/// dB…), as for parameters: beyond, a typo or a unit slip. (Angles of ±1e308 made
+/// every derived range overflow, and a plot's axis never finish.)
+const MAX_MAGNITUDE: f64 = 1e15;
 
 /// A finite number.
 fn number(text: &str) -> Result<f64, String> {

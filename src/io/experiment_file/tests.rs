@@ -576,6 +576,8 @@ fn malformed_csv_files_name_file_line_and_column() {
         (pos, "target_deg,direction,run,measured_deg\n0,up,0,0\n", "line 2, column `run`: run 0: runs are numbered from 1"),
         (pos, "target_deg,direction,run,measured_deg\n0,up,-1,0\n", "line 2, column `run`: `-1` is not a run number"),
         (pos, "target_deg,direction,run,measured_deg\n0,up,1.5,0\n", "line 2, column `run`: `1.5` is not a run number"),
+        (pos, "target_deg,direction,run,deviation_arcsec\n0,up,1,1\n0,up,2,1e7\n", "line 3, column `deviation_arcsec`: a deviation of 4.848"),
+        (pos, "target_mm,direction,run,measured_mm\n0,up,1,1\n10,up,1,2000\n", "line 3, column `measured_mm`: a deviation of 1.99e0 (SI) is beyond 1 m"),
     ] {
         let err = read_csv(kind, csv).unwrap_err().to_string();
         assert!(err.contains(expected), "{csv:?}:\n  got  {err}\n  want {expected}");
@@ -693,6 +695,9 @@ fn malformed_manifests_name_the_file_and_position() {
         ("{\"kind\": \"resonance\", \"peaks_hz\": [100, 200], \"peak_gain_db\": [3]}", "m.json: `peaks_hz` has 2 values but `peak_gain_db` has 1"),
         ("{\"kind\": \"resonance\"}", "m.json: a resonance experiment needs `peaks_hz`"),
         ("{\"kind\": \"resonance\", \"peaks_hz\": []}", "m.json: `peaks_hz` is empty"),
+        ("{\"kind\": \"resonance\", \"peaks_hz\": [100, 0]}", "m.json: `peaks_hz`[1] = 0: a resonance frequency is positive (Hz)"),
+        ("{\"kind\": \"resonance\", \"peaks_hz\": [-100]}", "m.json: `peaks_hz`[0] = -100: a resonance frequency is positive (Hz)"),
+        ("{\"kind\": \"resonance\", \"peaks_hz\": [100, 1e308]}", "m.json: `peaks_hz`[1] = 1e308 Hz: above 1 MHz"),
     ] {
         let (_dir, path) = files(&[("m.json", manifest)]);
         let err = read(&path).unwrap_err().to_string();

@@ -133,6 +133,7 @@ impl Table {
         } else {
             self.numbers(deviation, Any)?
         };
+        self.deviations_in_range(&deviation_si, deviation, axis)?;
         let (direction, run) = (
             self.parse(d, |s| {
                 s.parse()
@@ -157,6 +158,27 @@ impl Table {
                 extra,
             },
         })
+    }
+
+    /// Every deviation within a turn (rotary) or a metre (linear): beyond, it is not a
+    /// positioning error but a wrong column or unit (and ISO 230-2's ranges of
+    /// deviations of 1e308 overflow).
+    fn deviations_in_range(&self, deviation_si: &[f64], col: Col, axis: Axis) -> Result<(), Error> {
+        let (limit, what) = match axis {
+            Axis::Rotary => (std::f64::consts::TAU, "a turn (2π rad)"),
+            Axis::Linear => (1.0, "1 m"),
+        };
+        match deviation_si.iter().position(|d| d.abs() > limit) {
+            Some(i) => Err(self.cell(
+                self.rows[i].0,
+                col.index,
+                format!(
+                    "a deviation of {:e} (SI) is beyond {what}: not a positioning error",
+                    deviation_si[i]
+                ),
+            )),
+            None => Ok(()),
+        }
     }
 
     /// measured − target in SI units. In a common unit, subtract first and scale once:
