@@ -18,7 +18,6 @@ mod support;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rtid::identify::{identify, Config, ExperimentSpec, FidelityChoice, Monitor};
-use rtid::io::experiment_file::Data;
 use rtid::objectives::{Fidelity, ObjectiveKind, Source};
 
 fn bench(c: &mut Criterion) {
@@ -61,9 +60,7 @@ fn bench(c: &mut Criterion) {
 fn complex(c: &mut Criterion) {
     let with_phase = support::experiment("frf/worm_frf.json");
     let mut gain_only = with_phase.clone();
-    if let Data::FrequencyResponse { phase_rad, .. } = &mut gain_only.experiment.data {
-        *phase_rad = None;
-    }
+    gain_only.experiment.data.drop_phase();
     let truth = rtid::model::presets::load("worm-gear").unwrap();
     let curve = ObjectiveKind::named("gain_curve").unwrap();
     let names = ["Kw", "Kg", "Ciw", "Cig"];

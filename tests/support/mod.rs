@@ -47,10 +47,7 @@ pub fn worm_frequency_response() -> Fixture {
 /// The fixture's gain alone, its phase column dropped: the resonance fit (with phase
 /// a frequency response feeds its whole complex curve by default).
 pub fn gain_only(mut f: Fixture) -> Fixture {
-    if let experiment_file::Data::FrequencyResponse { phase_rad, .. } = &mut f.spec.experiment.data
-    {
-        *phase_rad = None;
-    }
+    f.spec.experiment.data.drop_phase();
     f
 }
 

@@ -212,10 +212,17 @@ pub fn identify(
     let mut columns = [acceleration, velocity, sign, effort.to_vec()];
     let decimation_cutoff_hz = parallel_filter(&mut columns, rate, settings.decimation)?;
     let [acceleration, velocity, sign, effort] = &columns;
-    // A NaN speed would pass for a slow row: say what overflowed instead.
+    // Records out of any physical range (angles of 1e308, a sample period of
+    // 1e-300 s) overflow here: a NaN speed would pass for a slow row, and the SVD
+    // never returns on a non-finite regressor.
     if acceleration.iter().chain(velocity).any(|v| !v.is_finite()) {
         return Err(IdimError::Overflow {
             what: "speed or acceleration derived from the positions",
+        });
+    }
+    if effort.iter().any(|v| !v.is_finite()) {
+        return Err(IdimError::Overflow {
+            what: "filtered effort",
         });
     }
     let (rows, slow_rows) = select_rows(velocity, settings);
@@ -369,20 +376,9 @@ struct LeastSquares {
 /// cap makes a pathological one an error, not a hang).
 const SVD_MAX_ITERATIONS: usize = 10_000;
 
-/// Least squares through the SVD of W (robust to the columns' different scales).
-/// Non-finite rows (speeds or accelerations that overflow: angles of 1e308, a sample
-/// period of 1e-300 s) are refused before the SVD, which never returns on them.
+/// Least squares through the SVD of W (robust to the columns' different scales;
+/// [`identify`] has refused non-finite columns).
 fn least_squares(w: &DMatrix<f64>, y: &DVector<f64>) -> Result<LeastSquares, IdimError> {
-    if w.iter().any(|v| !v.is_finite()) {
-        return Err(IdimError::Overflow {
-            what: "speed or acceleration derived from the positions",
-        });
-    }
-    if y.iter().any(|v| !v.is_finite()) {
-        return Err(IdimError::Overflow {
-            what: "filtered effort",
-        });
-    }
     let svd = w
         .clone()
         .try_svd(true, true, f64::EPSILON, SVD_MAX_ITERATIONS)

@@ -201,6 +201,14 @@ impl Data {
         }
     }
 
+    /// A frequency response's phase dropped, its gain kept (other kinds unchanged):
+    /// what a gain-only file of the same data would give.
+    pub fn drop_phase(&mut self) {
+        if let Data::FrequencyResponse { phase_rad, .. } = self {
+            *phase_rad = None;
+        }
+    }
+
     /// The channels of a `frequency_response_time` record (torque- or current-driven);
     /// `None` for other kinds.
     pub fn time_record(&self) -> Option<TimeRecord<'_>> {

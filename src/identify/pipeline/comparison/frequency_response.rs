@@ -30,21 +30,18 @@ pub(super) fn compare(
     let grid = model_grid(&f);
     let mut out = vec![gain(source, response, (&f, &g), &grid, start, fitted)];
     if let Some(m) = measured::complex_points(exp, |_| true) {
-        let delay = fitted_delay(source, exp, fitted);
+        // The fitted delay taken out, on the canonical ratio's sign.
+        let sign = if measured::form(exp).inverted {
+            -1.0
+        } else {
+            1.0
+        };
+        let delay = sign * fitted_delay(source, exp, fitted);
         let phase: Vec<f64> = m
             .phase_rad
             .iter()
             .zip(&m.frequency_hz)
-            .map(|(p, f)| {
-                p + TAU
-                    * f
-                    * delay
-                    * if measured::form(exp).inverted {
-                        -1.0
-                    } else {
-                        1.0
-                    }
-            })
+            .map(|(p, f)| p + TAU * f * delay)
             .collect();
         out.push(phase_plot(
             source,
