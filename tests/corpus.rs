@@ -617,7 +617,8 @@ fn negative_values_reach_the_options_own_check() {
 /// (angles or torques of ±1e308, a time step of 1e-300 s or 1e300 s) are evaluated at
 /// once with no null among the friction law's numbers (the law's least squares hung on
 /// them, or wrote null); a resonance file's non-positive or absurd peak, a parameter
-/// file's null and a weight of 1e308 are refused naming the field or option.
+/// file's null, a weight of 1e308 and a sample rate below the band's are refused
+/// naming the field or option.
 #[test]
 fn records_and_values_out_of_range_are_met_at_their_root() {
     let dir = tempfile::tempdir().unwrap();
@@ -695,6 +696,19 @@ fn records_and_values_out_of_range_are_met_at_their_root() {
             ]),
             "--weight 1e308",
         ),
+        (
+            strings(&[
+                "experiment",
+                "frequency-response-time",
+                "--preset",
+                "worm-gear",
+                "--sample-rate-hz",
+                "1",
+                "--out",
+                "slow",
+            ]),
+            "--sample-rate-hz 1: a record sampled at it holds frequencies up to 0.5 Hz",
+        ),
     ];
     let mut params: serde_json::Value = serde_json::from_str(&rtid_ok_json(d)).unwrap();
     params["Cw"] = serde_json::Value::Null;
@@ -755,6 +769,20 @@ fn records_and_values_out_of_range_are_met_at_their_root() {
     let (run, args) = fit(&["--resume"]);
     assert_eq!(run.code, Some(1), "{}", run.stderr);
     check(&args, &run, "not an rtid checkpoint");
+    // A finished start whose cost was emptied runs again from its result (it ended
+    // "no parameter set could be evaluated: stopped before any evaluation").
+    for start in c["starts"].as_array_mut().unwrap() {
+        start["cost"] = serde_json::Value::Null;
+    }
+    std::fs::write(d.join("c.json"), c.to_string()).unwrap();
+    let (run, args) = fit(&["--resume", "--out", "f.json"]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let f: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("f.json")).unwrap()).unwrap();
+    assert!(
+        f["cost"].as_f64().is_some_and(f64::is_finite),
+        "{args:?}: {f}"
+    );
 }
 
 /// The worm preset's parameter file, as `rtid params --out` writes it.

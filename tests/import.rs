@@ -267,6 +267,79 @@ fn a_laser_table_becomes_a_linear_positioning_test() {
     assert!(e.contains("`r` row 1") && e.contains("from 1"), "{e}");
 }
 
+/// `rtid import FILE --kind servo-trace` of columns t (s), r and q (deg) and u (the
+/// effort as `effort` maps it), in `dir`.
+fn import_trace(dir: &Path, file: &str, effort: &str) -> Output {
+    rtid(
+        &[
+            "import",
+            file,
+            "--kind",
+            "servo-trace",
+            "--map",
+            "time=t:s",
+            "--map",
+            "reference_position=r:deg",
+            "--map",
+            "position=q:deg",
+            "--map",
+            effort,
+            "--out",
+            "o",
+        ],
+        dir,
+    )
+}
+
+/// A mapped value beyond ±1e15 in SI, or one that overflows on conversion, is refused
+/// by the import naming the source file, its line, the map and the channel, not
+/// written for the experiment's reader to refuse (issue 28: a TwinCAT cell of 1e308
+/// was written, and the written file then did not read).
+#[test]
+fn a_value_out_of_range_is_refused_at_its_source_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows: String = (0..20)
+        .map(|i| {
+            let u = if i == 6 {
+                "1e300".to_string()
+            } else {
+                format!("{}", i % 3)
+            };
+            format!("{},{i},{i},{u}\n", i as f64 * 1e-3)
+        })
+        .collect();
+    std::fs::write(dir.path().join("trace.csv"), format!("t,r,q,u\n{rows}")).unwrap();
+    let e = err(&import_trace(dir.path(), "trace.csv", "effort=u:N·m"));
+    assert!(
+        e.contains("trace.csv, line 8: --map effort=u:N·m: `u` is 1e300 in SI units, beyond ±1e15"),
+        "{e}"
+    );
+    assert_eq!(e.lines().count(), 1, "{e}");
+    let e = err(&import_trace(dir.path(), "trace.csv", "effort=u*1e10:N·m"));
+    assert!(
+        e.contains("line 8") && e.contains("not a finite number"),
+        "{e}"
+    );
+    assert!(!dir.path().join("o").exists(), "nothing written");
+}
+
+/// A servo trace whose time base skips a sample is refused naming the source line
+/// (it named the written file's row before, issue 28).
+#[test]
+fn a_gap_in_a_servo_trace_is_refused_at_its_source_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows: String = (0..20)
+        .filter(|&i| i != 9)
+        .map(|i| format!("{},{i},{i},1\n", i as f64 * 1e-3))
+        .collect();
+    std::fs::write(dir.path().join("gap.csv"), format!("t,r,q,u\n{rows}")).unwrap();
+    let e = err(&import_trace(dir.path(), "gap.csv", "effort=u:N·m"));
+    assert!(
+        e.contains("gap.csv, line 11: the time base of `t`: the step from the previous row is 2.000000e-3 s"),
+        "{e}"
+    );
+}
+
 const EPOS_SPEED: &str = "speed=Velocity actual value averaged*-1:rpm";
 const EPOS_EFFORT: &str = "effort=Torque actual value averaged*-1:%(9.84 mN·m)";
 

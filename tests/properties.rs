@@ -117,25 +117,6 @@ fn apply(text: &str, m: &Mutation) -> String {
     }
 }
 
-/// Whether a debug print holds a non-finite number: a token `NaN`, `inf` or `-inf`
-/// outside the quoted strings (a column name may say anything).
-fn non_finite(debug: &str) -> bool {
-    let mut unquoted = String::with_capacity(debug.len());
-    let (mut quoted, mut escaped) = (false, false);
-    for c in debug.chars() {
-        match (quoted, escaped, c) {
-            (true, false, '\\') => escaped = true,
-            (true, true, _) => escaped = false,
-            (_, false, '"') => quoted = !quoted,
-            (false, _, c) => unquoted.push(c),
-            _ => {}
-        }
-    }
-    unquoted
-        .split(|c: char| !(c.is_alphanumeric() || c == '-'))
-        .any(|t| matches!(t, "NaN" | "inf" | "-inf"))
-}
-
 /// An experiment (manifest and its CSV, the CSV cut to its first lines) to mutate.
 struct Seed {
     manifest: String,
@@ -210,7 +191,7 @@ proptest! {
         let dir = tempfile::tempdir().unwrap();
         let (_, text, ok) = read_experiment(dir.path(), &manifest, csv.as_deref());
         if ok {
-            prop_assert!(!non_finite(&text), "non-finite data read: {mutations:?}");
+            prop_assert!(!support::non_finite(&text), "non-finite data read: {mutations:?}");
         } else {
             prop_assert!(
                 text.contains("run.json") || text.contains("run.csv"),
@@ -232,7 +213,7 @@ proptest! {
         }
         match params_file::parse(&text, Path::new("p.json")) {
             Ok(p) => {
-                prop_assert!(!non_finite(&format!("{p:?}")), "non-finite: {mutations:?}");
+                prop_assert!(!support::non_finite(&format!("{p:?}")), "non-finite: {mutations:?}");
                 prop_assert!(p.validate().is_ok(), "an invalid set read: {mutations:?}");
             }
             Err(e) => prop_assert!(e.to_string().contains("p.json"), "{e}"),
@@ -370,7 +351,7 @@ fn the_unmutated_seeds_read() {
         let dir = tempfile::tempdir().unwrap();
         let (path, text, ok) = read_experiment(dir.path(), &s.manifest, s.csv.as_deref());
         assert!(ok, "{}: {text}", path.display());
-        assert!(!non_finite(&text));
+        assert!(!support::non_finite(&text));
     }
     let (file, partial) = {
         let dir = tempfile::tempdir().unwrap();
@@ -379,5 +360,9 @@ fn the_unmutated_seeds_read() {
         stream::read(&path).unwrap()
     };
     assert!(!partial && file.rows.len() == 9);
-    assert!(non_finite("[1.0, NaN]") && non_finite("x: -inf,") && !non_finite("\"inf\" 2.0"));
+    assert!(
+        support::non_finite("[1.0, NaN]")
+            && support::non_finite("x: -inf,")
+            && !support::non_finite("\"inf\" 2.0")
+    );
 }

@@ -540,10 +540,13 @@ fn a_cancelled_task_resubmitted_resumes(cluster: &Cluster, docs: &Docs, want: &[
     let job = cluster.submit(&dir, &SMALL);
     let kept = cancel_mid_run(cluster, &job, &dir, rows);
     // rtid ends between rows on SIGTERM, so the shard has no cut-off line: merge
-    // counts its points without a row and says to resume.
+    // counts its points without a row, names the shard's file and says to resume.
     let out = shell(&docs.merge, &dir);
+    let unfinished = format!("shards/part-2.csv ({} of {rows} rows missing)", rows - kept);
     assert!(
-        !out.status.success() && text(&out.stderr).contains("--resume"),
+        !out.status.success()
+            && text(&out.stderr).contains(&unfinished)
+            && text(&out.stderr).contains("--resume"),
         "merge with a cancelled shard: {}",
         text(&out.stderr)
     );

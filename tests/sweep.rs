@@ -238,6 +238,14 @@ fn the_merge_of_n_shards_equals_the_unsharded_sweep() {
         err.contains("missing") && err.contains("missing shard 1/3"),
         "{err}"
     );
+    // A shard stopped between rows (a cancelled job) is named with what it lacks.
+    let text = std::fs::read_to_string(&shards[1]).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    std::fs::write(&shards[1], lines[..lines.len() - 2].join("\n") + "\n").unwrap();
+    let err = sweep::load_complete(&shards).unwrap_err().to_string();
+    let named = format!("{} (2 of 16 rows missing)", shards[1].display());
+    assert!(err.contains(&named) && err.contains("--resume"), "{err}");
+    std::fs::write(&shards[1], &text).unwrap();
     let (merged_sweep, rows) = sweep::load_complete(&shards).unwrap();
     assert_eq!(merged_sweep, s);
     let out = dir.path().join("merged.csv");

@@ -62,9 +62,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let sb = compare::summarize(&a.b)?;
     if a.json {
         let mut map = serde_json::Map::new();
-        map.insert(a.a.display().to_string(), serde_json::to_value(&sa)?);
-        map.insert(a.b.display().to_string(), serde_json::to_value(&sb)?);
-        println!("{}", serde_json::to_string_pretty(&map)?);
+        map.insert(a.a.display().to_string(), rtid::io::json::value(&sa)?);
+        map.insert(a.b.display().to_string(), rtid::io::json::value(&sb)?);
+        println!("{}", rtid::io::json::pretty(&map)?);
     } else {
         println!("Table 3. Comparison between driving mechanisms");
         println!("{}", table(&[(&a.a, &sa), (&a.b, &sb)]));

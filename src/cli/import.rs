@@ -243,7 +243,7 @@ fn report(path: &Path, imported: &import::Imported, json: bool, quiet: bool) -> 
             "rows": imported.data.len(),
             "findings": imported.findings,
         });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        println!("{}", rtid::io::json::pretty(&out)?);
         return Ok(());
     }
     println!(
@@ -269,7 +269,7 @@ fn list(sources: &[Source], json: bool) -> anyhow::Result<()> {
         } else {
             Value::Array(all)
         };
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        println!("{}", rtid::io::json::pretty(&out)?);
         return Ok(());
     }
     for s in sources {

@@ -124,7 +124,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 "kind": s.kind.name(),
             })).collect::<Vec<_>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        println!("{}", rtid::io::json::pretty(&v)?);
     } else if !a.quiet {
         println!("wrote {}", a.out.display());
     }

@@ -51,7 +51,7 @@ FILE-indices.csv (local/morris/sobol) and FILE-COLUMN.svg plots (tornado charts 
 grid plots).
 
 Clusters: --shard I/N (1 ≤ I ≤ N, counted from 1) computes design points I−1, I−1+N, … into its own \
---out; run N of them as a job array (Slurm: --shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT), \
+--out; run N of them as a job array (Slurm: --shard $SLURM_ARRAY_TASK_ID/N, N the array's size), \
 then `rtid sweep merge SHARD-FILES… --out FILE.csv` joins them and computes the indices. \
 docs/sweeps.md has a Slurm script.
 
@@ -259,7 +259,7 @@ fn run_sweep(a: RunArgs) -> anyhow::Result<()> {
     if let Some(shard) = a.shard {
         if a.json {
             let v = serde_json::json!({"file": out, "shard": shard.to_string(), "run": report});
-            println!("{}", serde_json::to_string_pretty(&v)?);
+            println!("{}", rtid::io::json::pretty(&v)?);
         } else {
             println!(
                 "{}: shard {shard}, {} rows ({} computed now, {} failed); join the shards with `rtid sweep merge`",
@@ -345,7 +345,7 @@ fn print(
             "indices": indices,
             "files": files,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        println!("{}", rtid::io::json::pretty(&v)?);
         return Ok(());
     }
     match report {

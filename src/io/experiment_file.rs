@@ -28,6 +28,7 @@ pub use data::{Approaches, Data, ServoTrace, Signal, TimeRecord};
 pub use friction_map::FrictionMap;
 pub use response::{Delay, Reference, Response, ResponseForm};
 pub use sampling::{check_uniform, sample_period, NonUniform, SAMPLING_TOLERANCE};
+pub use table::MAX_MAGNITUDE;
 pub use units::{Axis, CommandUnit};
 pub use writer::write;
 

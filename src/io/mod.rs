@@ -5,6 +5,7 @@ pub mod atomic;
 pub mod experiment_file;
 pub mod formats;
 pub mod import;
+pub mod json;
 pub mod params_file;
 pub mod provenance;
 pub mod torque_file;

@@ -92,11 +92,13 @@ fn null_field(v: &serde_json::Value, prefix: &str) -> Option<String> {
 
 /// Writes a parameter file atomically (temporary file in the same folder, then rename).
 pub fn write(path: &Path, params: &Params) -> Result<(), ParamsFileError> {
-    let text = serde_json::to_string_pretty(params).expect("Params always serialises");
-    crate::io::atomic::write(path, text.as_bytes()).map_err(|source| ParamsFileError::Write {
+    let write_error = |source| ParamsFileError::Write {
         path: path.to_path_buf(),
         source,
-    })
+    };
+    let text =
+        crate::io::json::pretty(params).map_err(|e| write_error(std::io::Error::other(e)))?;
+    crate::io::atomic::write(path, text.as_bytes()).map_err(write_error)
 }
 
 #[cfg(test)]

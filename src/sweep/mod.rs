@@ -65,11 +65,13 @@ pub enum SweepError {
     Config { path: String, reason: String },
     #[error("no output requested: give --outputs, e.g. resonances,peak_gain")]
     NoOutputs,
-    #[error("{missing} of the {total} design points have no row (first: index {first}): finish the sweep (--resume) or merge every shard")]
+    #[error("{missing} of the {total} design points have no row (first: index {first}); unfinished: {files}: finish each with --resume")]
     Incomplete {
         missing: usize,
         total: usize,
         first: usize,
+        /// The files the missing points belong to, each with its count.
+        files: String,
     },
 }
 
@@ -364,9 +366,35 @@ pub fn load_complete(
             missing: missing.len(),
             total: n,
             first,
+            files: unfinished(&missing, n, &sources),
         });
     }
     Ok((sweep, file.rows))
+}
+
+/// The files that lack rows, in shard order, each as `FILE (k of m rows missing)`:
+/// design point i is in shard i mod N, the (i mod N)-th of `sources`.
+fn unfinished(missing: &[usize], points: usize, sources: &[std::path::PathBuf]) -> String {
+    let shards = sources.len().max(1);
+    let mut lacking = vec![0usize; shards];
+    for &i in missing {
+        lacking[i % shards] += 1;
+    }
+    let in_shard = |s: usize| (points + shards - 1 - s) / shards;
+    lacking
+        .iter()
+        .enumerate()
+        .filter(|(_, &k)| k > 0)
+        .map(|(s, k)| {
+            let name = sources.get(s).map(|p| p.display().to_string());
+            format!(
+                "{} ({k} of {} rows missing)",
+                name.unwrap_or_default(),
+                in_shard(s)
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Writes the merged (or finished) rows as the final file of `sweep`, atomically.

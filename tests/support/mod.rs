@@ -147,3 +147,22 @@ pub fn number_spans(text: &str) -> Vec<(usize, usize)> {
     }
     out
 }
+
+/// Whether a debug print holds a non-finite number: a token `NaN`, `inf` or `-inf`
+/// outside the quoted strings (a column name may say anything).
+pub fn non_finite(debug: &str) -> bool {
+    let mut unquoted = String::with_capacity(debug.len());
+    let (mut quoted, mut escaped) = (false, false);
+    for c in debug.chars() {
+        match (quoted, escaped, c) {
+            (true, false, '\\') => escaped = true,
+            (true, true, _) => escaped = false,
+            (_, false, '"') => quoted = !quoted,
+            (false, _, c) => unquoted.push(c),
+            _ => {}
+        }
+    }
+    unquoted
+        .split(|c: char| !(c.is_alphanumeric() || c == '-'))
+        .any(|t| matches!(t, "NaN" | "inf" | "-inf"))
+}

@@ -179,11 +179,11 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
 
 fn print(e: &Evaluation, kind: Kind, json: bool, source: &Path) -> anyhow::Result<()> {
     if json {
-        let mut value = serde_json::to_value(e)?;
+        let mut value = rtid::io::json::value(e)?;
         value["kind"] = serde_json::json!(kind.name());
         value["source"] = serde_json::json!(source);
         value["unit"] = serde_json::json!("arcsec");
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        println!("{}", rtid::io::json::pretty(&value)?);
     } else {
         println!("{}: {kind} evaluation, arc-seconds", source.display());
         println!("{}", table(e, kind));

@@ -294,13 +294,13 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
             "points": frequency_hz.len(),
         });
         if let Some(c) = &complex {
-            value["modes"] = serde_json::to_value(&c.modes)?;
+            value["modes"] = rtid::io::json::value(&c.modes)?;
             value["response"] = c.form.response.name().into();
             value["noise_stated"] = c.noise_stated.into();
-            value["phase_plot"] = serde_json::to_value(&c.plots[0])?;
-            value["nyquist_plot"] = serde_json::to_value(&c.plots[1])?;
+            value["phase_plot"] = rtid::io::json::value(&c.plots[0])?;
+            value["nyquist_plot"] = rtid::io::json::value(&c.plots[1])?;
         }
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        println!("{}", rtid::io::json::pretty(&value)?);
     } else {
         println!(
             "{}: resonances (local maxima of the gain, parabolic interpolation)",

@@ -202,6 +202,16 @@ impl Args {
             table_noise_rad: (self.noise_arcsec / 3600.0).to_radians(),
             seed: self.seed,
         };
+        if to >= test.sample_rate_hz / 2.0 {
+            bail!(
+                "--sample-rate-hz {}: a record sampled at it holds frequencies up to {} Hz \
+                 (half the rate), below --to-hz {}: sample more than twice as fast as the \
+                 highest frequency excited",
+                Num(test.sample_rate_hz),
+                Num(test.sample_rate_hz / 2.0),
+                Num(to)
+            );
+        }
         check::work(
             test.duration(),
             check::MAX_SIMULATED_S,
@@ -284,7 +294,7 @@ pub fn report_with(
     let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
     plot_evaluation(&e, mechanism, plot)?;
     if json {
-        let mut value = serde_json::to_value(&e)?;
+        let mut value = rtid::io::json::value(&e)?;
         value["kind"] = serde_json::json!(exp.manifest.kind.name());
         value["source"] = serde_json::json!(exp.path);
         if let Evaluation::Periodic(p) = &e {
@@ -294,7 +304,7 @@ pub fn report_with(
                 v.extend(keys);
             }
         }
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        println!("{}", rtid::io::json::pretty(&value)?);
         return Ok(());
     }
     match &e {

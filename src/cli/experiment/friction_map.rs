@@ -225,10 +225,10 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
     figures::residuals(&e, &format!("{mechanism}: friction map, residuals"))
         .write(&plot.with_file_name(format!("{stem}-residuals.svg")))?;
     if json {
-        let mut value = serde_json::to_value(&e).context("the evaluation as JSON")?;
+        let mut value = rtid::io::json::value(&e).context("the evaluation as JSON")?;
         value["kind"] = serde_json::json!("friction_map");
         value["source"] = serde_json::json!(exp.path);
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        println!("{}", rtid::io::json::pretty(&value)?);
     } else {
         println!("{}: friction map, {} runs", exp.path.display(), map.len());
         println!("{}", runs_table(&e));

@@ -220,18 +220,20 @@ fn print_positioning(
 ) -> anyhow::Result<()> {
     let k = u.deviation_per_si;
     if json {
+        let mut targets = Vec::with_capacity(report.targets.len());
+        for t in &report.targets {
+            let mut v = rtid::io::json::value(&t.scaled(k))?;
+            v[format!("target_{}", u.target_key)] = serde_json::json!(t.target * u.target_per_si);
+            targets.push(v);
+        }
         let value = serde_json::json!({
             "kind": "positioning",
             "source": source,
             "unit": u.deviation_key,
-            "axis": report.axis.scaled(k),
-            "targets": report.targets.iter().map(|t| {
-                let mut v = serde_json::to_value(t.scaled(k)).expect("serialises");
-                v[format!("target_{}", u.target_key)] = serde_json::json!(t.target * u.target_per_si);
-                v
-            }).collect::<Vec<_>>(),
+            "axis": rtid::io::json::value(&report.axis.scaled(k))?,
+            "targets": targets,
         });
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        println!("{}", rtid::io::json::pretty(&value)?);
     } else {
         println!(
             "{}: ISO 230-2 evaluation, {}",

@@ -190,7 +190,7 @@ pub fn report(
         simulation_error: misfit,
     };
     if json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        println!("{}", rtid::io::json::pretty(&report)?);
     } else {
         print_report(&report);
     }

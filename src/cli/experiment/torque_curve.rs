@@ -159,13 +159,13 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
         figure.write(&plot.with_file_name(format!("{stem}-vs-angle.svg")))?;
     }
     if json {
-        let mut value = serde_json::to_value(&report)?;
+        let mut value = rtid::io::json::value(&report)?;
         if linear {
             in_newtons(&mut value);
         }
         value["kind"] = serde_json::json!("torque_curve");
         value["source"] = serde_json::json!(exp.path);
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        println!("{}", rtid::io::json::pretty(&value)?);
     } else {
         let amplitude = if linear {
             format!("{:.2} mm", test.amplitude * 1e3)

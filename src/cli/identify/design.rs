@@ -100,7 +100,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "fit": a.fit,
             "candidates": ranked,
         });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        println!("{}", rtid::io::json::pretty(&out)?);
     } else {
         println!("{}", table(&ranked, &a.fit));
     }

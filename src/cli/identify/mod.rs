@@ -502,7 +502,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         save_params(path, &result, params)?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&result)?);
+        println!("{}", rtid::io::json::pretty(&result)?);
     } else {
         print_summary(&result);
     }

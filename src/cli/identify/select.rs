@@ -55,7 +55,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .collect::<anyhow::Result<Vec<_>>>()?;
     let s = selection::select(&results)?;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&s)?);
+        println!("{}", rtid::io::json::pretty(&s)?);
     } else {
         print(&s);
     }

@@ -36,7 +36,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.model.load()?;
     let m = modes::modes(&p)?;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&m)?);
+        println!("{}", rtid::io::json::pretty(&m)?);
         return Ok(());
     }
     println!(

@@ -43,7 +43,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&p)?);
+        println!("{}", rtid::io::json::pretty(&p)?);
         return Ok(());
     }
     let mut t = Table::new();

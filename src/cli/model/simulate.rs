@@ -369,7 +369,7 @@ fn print_summary(a: &Args, sim: &Simulation, ratio: f64, wall: f64) -> anyhow::R
             "steps_per_s": steps / wall,
             "final": STATE_NAMES.iter().zip(y).map(|(n, v)| (n.to_string(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        println!("{}", rtid::io::json::pretty(&summary)?);
         return Ok(());
     }
     let mut t = Table::new();

@@ -130,6 +130,12 @@ fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
 /// distortion: an exactly periodic synthetic signal has σ̂² = 0 and |X̄|² ≈ 1e-30.
 const NUMERICAL_FLOOR: f64 = 1e-24;
 
+/// A line's level over its noise counts at most this (120 dB): a line above the
+/// numerical floor with no scatter over the periods (a synthetic record) is distortion
+/// beyond doubt, and a finite cap keeps the mean and the score finite (f64::MAX here
+/// summed to infinity and made the score NaN, written as null).
+const MAX_RATIO: f64 = 1e12;
+
 fn class(x: &PeriodSpectra, lines: &[usize], z: f64, floor: f64) -> LineClass {
     let level = mean(lines.iter().map(|&k| x.mean(k).norm_sqr()));
     let noise = mean(lines.iter().map(|&k| x.mean_variance(k)));
@@ -138,9 +144,9 @@ fn class(x: &PeriodSpectra, lines: &[usize], z: f64, floor: f64) -> LineClass {
         if s <= floor {
             0.0
         } else if n > 0.0 {
-            s / n
+            (s / n).min(MAX_RATIO)
         } else {
-            f64::MAX
+            MAX_RATIO
         }
     }));
     let (l, p) = (lines.len() as f64, x.periods() as f64);
@@ -233,6 +239,14 @@ mod tests {
         assert!((paulson_z(63.69 / 40.0, 40.0, 1e12) - 2.326).abs() < 0.03);
         assert!((paulson_z(9.21 / 2.0, 2.0, 1e12) - 2.326).abs() < 0.15);
         assert!(paulson_z(1.0, 1e9, 1e9).abs() < 1e-3);
+        // Lines at the cap (no scatter) give a finite score; decisive but for the
+        // fewest periods, where Paulson's score tends to (1 − b)/√b (2.67 for two).
+        let cases = [(1.0, 2.0, 2.6), (1000.0, 10.0, 8.0), (1e6, 1e3, 10.0)];
+        for (lines, periods, least) in cases {
+            let z = paulson_z(MAX_RATIO, 2.0 * lines, 2.0 * (periods - 1.0));
+            let what = format!("{lines} lines, {periods} periods: {z}");
+            assert!(z.is_finite() && z > least, "{what}");
+        }
     }
 
     #[test]

@@ -12,6 +12,7 @@ use crate::identify::plan::Plan;
 use crate::identify::result::starts::StartRecord;
 use crate::identify::search::settings::Method;
 use crate::identify::space::ParamSpace;
+use crate::identify::Termination;
 
 /// The identity of an identification problem.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -153,7 +154,7 @@ impl Checkpoint {
     }
 
     pub fn write(&self, path: &Path) -> std::io::Result<()> {
-        let text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
+        let text = crate::io::json::pretty(self).map_err(std::io::Error::other)?;
         crate::io::atomic::write(path, text.as_bytes())
     }
 
@@ -184,7 +185,20 @@ impl Checkpoint {
             });
         }
         c.check_sizes(path)?;
-        Ok(c)
+        Ok(c.without_costless_results())
+    }
+
+    /// The checkpoint with each finished start that has no cost (a file edited by
+    /// hand, or a start that never met a finite cost) marked interrupted, so that it
+    /// runs again from its result: the resumed search ranks the starts by their costs,
+    /// and with none it would report nothing evaluated.
+    fn without_costless_results(mut self) -> Checkpoint {
+        for s in &mut self.starts {
+            if s.result.is_some() && !s.cost.is_some_and(|c| c >= 0.0) {
+                s.termination = Termination::Interrupted;
+            }
+        }
+        self
     }
 
     /// Every stored point has one value per fitted parameter.

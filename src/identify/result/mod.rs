@@ -114,7 +114,7 @@ pub struct IdentifyResult {
 
 impl IdentifyResult {
     pub fn write(&self, path: &Path) -> std::io::Result<()> {
-        let text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
+        let text = crate::io::json::pretty(self).map_err(std::io::Error::other)?;
         crate::io::atomic::write(path, format!("{text}\n").as_bytes())
     }
 

@@ -317,7 +317,7 @@ enum Order {
 /// The largest magnitude a record's value may have in SI units (s, rad, m, N·m, N, Hz,
 /// dB…), as for parameters: beyond, a typo or a unit slip. (Angles of ±1e308 made
 /// every derived range overflow, and a plot's axis never finish.)
-const MAX_MAGNITUDE: f64 = 1e15;
+pub const MAX_MAGNITUDE: f64 = 1e15;
 
 /// A finite number.
 fn number(text: &str) -> Result<f64, String> {

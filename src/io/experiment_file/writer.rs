@@ -82,7 +82,7 @@ pub fn write(
         out.data = Some(name);
     }
     let mut text =
-        serde_json::to_string_pretty(&out).map_err(|e| invalid(manifest_path, e.to_string()))?;
+        crate::io::json::pretty(&out).map_err(|e| invalid(manifest_path, e.to_string()))?;
     text.push('\n');
     crate::io::atomic::write(manifest_path, text.as_bytes()).map_err(|source| {
         ExperimentFileError::Write {

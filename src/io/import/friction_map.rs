@@ -11,7 +11,7 @@ use serde_json::{json, Value};
 
 use super::plateaus::{plateaus, Segments};
 use super::runs::{self, short, Run, RunError};
-use super::{axis, channel_findings, fill, manifest, role, Filled};
+use super::{axis, channel_findings, check_magnitudes, fill, manifest, role, Filled};
 use super::{ImportError, Imported, Request, Source};
 use crate::io::experiment_file::{Data, FrictionMap};
 use crate::io::formats::{Channel, Samples};
@@ -116,6 +116,7 @@ pub(super) fn build(sources: &[Source], request: &Request) -> Result<Imported, I
 fn record<'a>(source: &'a Source, request: &Request) -> Result<Record<'a>, ImportError> {
     let in_file = |e: ImportError| ImportError(format!("{}: {}", source.path.display(), e.0));
     let filled = fill(&[&source.recording], request).map_err(in_file)?;
+    check_magnitudes(&filled, |_| &source.path)?;
     let axis = axis(&filled).map_err(in_file)?;
     let r = Record {
         source,

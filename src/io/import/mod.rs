@@ -13,12 +13,13 @@ pub mod mapping;
 pub mod plateaus;
 pub mod runs;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
 
 use crate::io::experiment_file::{
-    Approaches, CommandUnit, Conditions, Data, Direction, Manifest, ServoTrace, Signal,
+    check_uniform, Approaches, CommandUnit, Conditions, Data, Direction, Manifest, ServoTrace,
+    Signal, MAX_MAGNITUDE,
 };
 use crate::io::formats::units::{self, Quantity};
 use crate::io::formats::{Abscissa, Channel, Recording, Samples};
@@ -76,10 +77,14 @@ pub fn build(sources: &[Source], request: &Request) -> Result<Imported, ImportEr
     }
     let recordings: Vec<&Recording> = sources.iter().map(|s| &s.recording).collect();
     let filled = fill(&recordings, request)?;
+    check_magnitudes(&filled, |file| &sources[file].path)?;
     let data = if request.kind == ImportKind::Positioning {
         positioning(&filled)?
     } else {
         let axis_values = abscissa_of(&filled, request.kind)?;
+        check_time_base(request.kind, &filled, &axis_values, |file| {
+            &sources[file].path
+        })?;
         assemble(request.kind, &filled, axis_values)?
     };
     let findings = findings(sources, &filled);
@@ -194,6 +199,88 @@ fn converted(r: &Resolved, role: &Role) -> Result<(Vec<f64>, Option<Vec<f64>>), 
             r.spec.given, r.channel.name
         ))),
     }
+}
+
+/// A mapped value that is not finite, or beyond ±[`MAX_MAGNITUDE`] in SI, is not a
+/// measurement (a recorder's NaN, a damaged cell, a unit slip): refused naming the
+/// file, the line or sample, the channel and the map, here rather than by the reader of
+/// what the import would write.
+fn check_magnitudes<'p>(
+    filled: &[Filled],
+    path_of: impl Fn(usize) -> &'p Path,
+) -> Result<(), ImportError> {
+    for f in filled {
+        let channel = f.resolved.channel;
+        let Some((i, v)) = f
+            .values
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !v.is_finite() || v.abs() > MAX_MAGNITUDE)
+        else {
+            continue;
+        };
+        let place = match channel.first_line {
+            Some(line) => format!("line {}", line + i),
+            None => format!("sample {}", i + 1),
+        };
+        let what = if v.is_finite() {
+            format!("{v:e} in SI units, beyond ±1e15: not a measurement (a unit slip?)")
+        } else {
+            format!("{v} in SI units, not a finite number")
+        };
+        return Err(ImportError(format!(
+            "{}, {place}: --map {}: `{}` is {what}",
+            path_of(f.resolved.file).display(),
+            f.resolved.spec.given,
+            channel.name
+        )));
+    }
+    Ok(())
+}
+
+/// The time base of a servo trace or a raw time record increases in uniform steps;
+/// a step that does not (a gap, a skipped or repeated sample) is refused naming the
+/// source's line, not the written file's row.
+fn check_time_base<'p>(
+    kind: ImportKind,
+    filled: &[Filled],
+    base: &[f64],
+    path_of: impl Fn(usize) -> &'p Path,
+) -> Result<(), ImportError> {
+    if !matches!(
+        kind,
+        ImportKind::ServoTrace | ImportKind::FrequencyResponseTime
+    ) {
+        return Ok(());
+    }
+    let Some(source) = filled
+        .iter()
+        .find(|f| f.role.name == "time")
+        .or(filled.first())
+    else {
+        return Ok(());
+    };
+    let (row, what) = match (
+        base.windows(2).position(|w| w[1] <= w[0]),
+        check_uniform(base),
+    ) {
+        (Some(i), _) => (
+            i + 1,
+            format!("the time {} s does not increase", base[i + 1]),
+        ),
+        (None, Err(e)) => (e.row, e.to_string()),
+        (None, Ok(())) => return Ok(()),
+    };
+    let channel = source.resolved.channel;
+    let place = match channel.first_line {
+        Some(line) => format!("line {}", line + row),
+        None => format!("sample {}", row + 1),
+    };
+    Err(ImportError(format!(
+        "{}, {place}: the time base of `{}`: {what}",
+        path_of(source.resolved.file).display(),
+        channel.name
+    )))
 }
 
 /// A negative scale turns a complex response by half a turn.

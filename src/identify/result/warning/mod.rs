@@ -137,7 +137,7 @@ pub struct Coded<T>(pub T);
 
 impl<T: Serialize + fmt::Display> Serialize for Coded<T> {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let mut value = serde_json::to_value(&self.0).map_err(serde::ser::Error::custom)?;
+        let mut value = crate::io::json::value(&self.0).map_err(serde::ser::Error::custom)?;
         if let serde_json::Value::Object(map) = &mut value {
             map.insert("message".into(), self.0.to_string().into());
         }

@@ -90,7 +90,15 @@ fn push_row(table: &mut Table, cells: &[&str], header: &Header) -> Result<(), St
         cells[i]
             .trim()
             .parse::<f64>()
-            .map_err(|_| format!("column {} ({name}): `{}` is not a number", i + 1, cells[i]))
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                format!(
+                    "column {} ({name}): `{}` is not a finite number",
+                    i + 1,
+                    cells[i]
+                )
+            })
     };
     let time = number(0)?;
     let row: Vec<f64> = (1..columns).map(number).collect::<Result<_, _>>()?;

@@ -398,3 +398,23 @@ fn the_first_line_of_every_export_sniffs_as_epos() {
         assert!(!sniff(other), "{other}");
     }
 }
+
+/// EPOS Studio writes no NaN; a cell that reads as one, or overflows to infinity, is
+/// damage (issue 28: a time of `1e3080` made an infinite abscissa).
+#[test]
+fn a_cell_that_is_not_finite_is_refused() {
+    for (cell, column) in [("1e3080", "column 1 (time)"), ("NaN", "column 1 (time)")] {
+        let mut lines = fixture_lines(PLAIN);
+        let (_, rest) = lines[299].split_once(';').unwrap();
+        lines[299] = format!("{cell};{rest}");
+        let needle = format!("{column}: `{cell}` is not a finite number");
+        assert_fails_at(lines.concat().as_bytes(), 300, &needle);
+    }
+    let mut lines = fixture_lines(PLAIN);
+    lines[299] = lines[299].replacen(';', ";inf", 1);
+    assert_fails_at(
+        lines.concat().as_bytes(),
+        300,
+        "(Velocity actual value averaged): `inf",
+    );
+}

@@ -112,6 +112,10 @@ impl<'h> Columns<'h> {
         }
         let x = match self.kinds[col] {
             Kind::Time { group } => {
+                if !x.is_finite() {
+                    let msg = format!("column {}: the time {x} ms is not a finite number", col + 1);
+                    return Err((line, msg));
+                }
                 if x.abs() >= MAX_RELATIVE_MS {
                     let msg = format!(
                         "column {}: the time {x} ms is an absolute file time (export option \

@@ -513,3 +513,20 @@ fn an_empty_file_is_refused() {
     let err = read(&path).unwrap_err();
     assert_eq!(err.location, Location::File);
 }
+
+/// A time cell of `NaN` (or one that overflows) is refused by its line: as an
+/// abscissa it would make every later step, and the import's sample period, NaN
+/// (issue 28).
+#[test]
+fn a_time_that_is_not_finite_is_refused() {
+    let text = fixture_text(TAB_SEPARATED);
+    let first = first_data_line(text.as_bytes());
+    for cell in ["NaN", "1e3080"] {
+        let mut lines: Vec<String> = text.split('\n').map(str::to_string).collect();
+        let row = &mut lines[first + 9];
+        let (_, rest) = row.split_once('\t').unwrap();
+        *row = format!("{cell}\t{rest}");
+        let words = "column 1: the time";
+        assert_fails_at("time.csv", lines.join("\n").as_bytes(), first + 10, words);
+    }
+}

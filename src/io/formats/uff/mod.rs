@@ -70,6 +70,7 @@ use std::path::Path;
 use self::binary_id::BinaryLayout;
 use self::channel::Names;
 use self::columns::Tolerated;
+use self::header::Header58;
 use self::lines::{excerpt, is_blank, is_delimiter, LineReader};
 use super::{Channel, FormatError, Location, Recording};
 
@@ -239,6 +240,8 @@ fn read_dataset58<R: BufRead>(
         Some(layout) => binary_data::read_values(lines, &header, layout, start)?,
         None => ascii_data::read_values(lines, &header, start)?,
     };
+    let columns = columns.into_columns();
+    check_abscissae(&header, &columns, start)?;
     let name = collected.names.unique(&channel::base_name(&header));
     collected
         .notes
@@ -248,8 +251,30 @@ fn read_dataset58<R: BufRead>(
     }
     collected
         .channels
-        .push(channel::channel(name, &header, columns.into_columns()));
+        .push(channel::channel(name, &header, columns));
     Ok(())
+}
+
+/// An uneven abscissa (the first column) must be finite: a NaN or an overflowed
+/// frequency or time cannot place its sample. The ordinates may hold NaN (a writer's
+/// missing value); what uses a channel decides.
+fn check_abscissae(header: &Header58, columns: &[Vec<f64>], start: usize) -> Result<(), Fault> {
+    if header.form.even {
+        return Ok(());
+    }
+    let Some((k, v)) = columns
+        .first()
+        .and_then(|c| c.iter().enumerate().find(|(_, v)| !v.is_finite()))
+    else {
+        return Ok(());
+    };
+    Err(Fault::line(
+        start,
+        format!(
+            "the abscissa of point {} of the dataset opened here is {v}, not a finite number",
+            k + 1
+        ),
+    ))
 }
 
 /// Skips a dataset of another number through its closing `-1`: line by line, or for a

@@ -356,3 +356,17 @@ fn a_folder_is_no_file() {
     );
     assert!(err.to_string().contains("cannot open"), "{err}");
 }
+
+/// An uneven abscissa that is NaN, or that overflows (an exponent of 99999), cannot
+/// place its point: refused at the dataset's opening line (issue 28; it read as an
+/// infinite frequency). The ordinates may hold NaN.
+#[test]
+fn an_uneven_abscissa_that_is_not_finite() {
+    let text = String::from_utf8(fixture_bytes("pyuff_frf_uneven.uff")).unwrap();
+    for (field, shown) in [("          NaN", "NaN"), ("   1.0e+99999", "inf")] {
+        let broken = text.replacen("  1.00000e+01", field, 1);
+        assert_ne!(broken, text);
+        let words = format!("abscissa of point 1 of the dataset opened here is {shown}");
+        assert_fault(broken.as_bytes(), Location::Line(1), &words);
+    }
+}
