@@ -101,6 +101,9 @@ pub(crate) fn default_fit(specs: &[ExperimentSpec], p: &Params) -> Result<Vec<St
 pub struct Declared {
     /// Some objective is rough (a closed-loop simulation).
     pub rough: bool,
+    /// Some objective is rough at the scale of any difference step
+    /// ([`Smoothness::Rough`]): the search is derivative-free.
+    pub derivative_free: bool,
     /// Some objective depends on the frequency-response model.
     pub frequency_response: bool,
     /// Some experiment is a measured gain curve (the nonlinear stage has flanks to fit).
@@ -111,6 +114,7 @@ pub struct Declared {
 pub(crate) fn declared(specs: &[ExperimentSpec], stage: Stage) -> Result<Declared, SetupError> {
     let mut d = Declared {
         rough: false,
+        derivative_free: false,
         frequency_response: false,
         gain_curve: false,
     };
@@ -119,7 +123,8 @@ pub(crate) fn declared(specs: &[ExperimentSpec], stage: Stage) -> Result<Declare
             spec.experiment.manifest.kind == crate::io::experiment_file::Kind::FrequencyResponse;
         for (kind, _) in selection(spec, stage)? {
             let p = kind.properties();
-            d.rough |= p.smoothness == Smoothness::Rough;
+            d.rough |= p.smoothness != Smoothness::Smooth;
+            d.derivative_free |= p.smoothness == Smoothness::Rough;
             d.frequency_response |= p.frequency_response;
         }
     }

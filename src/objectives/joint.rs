@@ -38,11 +38,11 @@ impl Joint {
         });
     }
 
-    /// Whether any part is rough ([`Smoothness::Rough`]).
+    /// Whether any part is rough ([`Smoothness::Rough`] or [`Smoothness::Grainy`]).
     pub fn rough(&self) -> bool {
         self.parts
             .iter()
-            .any(|p| p.kind.properties().smoothness == Smoothness::Rough)
+            .any(|p| p.kind.properties().smoothness != Smoothness::Smooth)
     }
 
     fn factor(part: &Part) -> f64 {

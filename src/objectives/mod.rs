@@ -71,10 +71,16 @@ pub enum Smoothness {
     /// Smooth on the scale of finite differences (the exact linear response, or a
     /// nonlinear test whose roughness the correction stage averages out).
     Smooth,
+    /// A closed-loop replay whose roughness (quantised encoders, a sampled servo)
+    /// lies below a few per cent of the parameters: a bowl at the scale of a
+    /// Jacobian's difference step of 0.03 solver units, so Levenberg–Marquardt
+    /// converges on it (the EMPS servo trace: docs/performance.md); one start,
+    /// standard errors that are lower bounds.
+    Grainy,
     /// A closed-loop time simulation read through quantised encoders: the cost is
-    /// piecewise constant on tiny scales and each evaluation costs seconds — a
-    /// derivative-free search from one start, larger difference steps, and standard
-    /// errors that are lower bounds.
+    /// piecewise constant on tiny scales, rough up to the scale of any difference
+    /// step, and each evaluation costs seconds — a derivative-free search from one
+    /// start, larger difference steps, and standard errors that are lower bounds.
     Rough,
 }
 

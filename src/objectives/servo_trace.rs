@@ -30,7 +30,7 @@ pub static DEFINITION: Definition = Definition {
     reads: &[Kind::ServoTrace],
     needs: "a servo_trace experiment",
     properties: Properties {
-        smoothness: Smoothness::Rough,
+        smoothness: Smoothness::Grainy,
         frequency_response: false,
     },
     determines: |_, p| determines(p),

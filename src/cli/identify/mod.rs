@@ -81,8 +81,10 @@ Search: positive parameters in log space inside --bound (default 0.1×..10× the
 --starts N starts (the preset's values, then a Latin hypercube in the bounds) in parallel \
 (default 4; 1 with a torque curve or an unbalance test, whose every evaluation is a closed-loop \
 simulation); \
---method lsq (Gauss–Newton with line search; default), nelder-mead (default with a torque \
-curve or an unbalance test, whose quantised encoders make finite differences rough) or pso. Ctrl-C ends the \
+--method lsq (Gauss–Newton with line search; default), lm (Levenberg–Marquardt; default with a \
+direct-drive servo trace, rough only below a few per cent), nelder-mead (default with a torque \
+curve, an unbalance test or a geared axis's servo trace, whose quantised encoders and backlash \
+make finite differences rough) or pso. Ctrl-C ends the \
 search and still writes the best result; with --checkpoint FILE, --resume continues.
 
 Output: a table of parameter, start, identified ± standard error; warnings when the data \
@@ -141,8 +143,8 @@ pub struct Args {
     /// relative, within 1e-6..1e6).
     #[arg(long = "weight", value_delimiter = ',', allow_negative_numbers = true)]
     pub weights: Vec<f64>,
-    /// Solver [default: lsq; nelder-mead when a torque curve or an unbalance test is
-    /// fitted].
+    /// Solver [default: lsq; lm for a direct-drive servo trace; nelder-mead when a
+    /// torque curve, an unbalance test or a geared axis's servo trace is fitted].
     #[arg(long, value_enum)]
     pub method: Option<MethodArg>,
     /// Frequency-response model of the objectives.
@@ -212,6 +214,8 @@ fn objective_names() -> clap::builder::PossibleValuesParser {
 pub enum MethodArg {
     /// Gauss–Newton with line search, finite-difference Jacobian in parallel.
     Lsq,
+    /// Levenberg–Marquardt, Jacobian and trial steps in parallel.
+    Lm,
     /// Nelder–Mead simplex.
     NelderMead,
     /// Particle swarm in the bounds.
@@ -222,6 +226,7 @@ impl From<MethodArg> for Method {
     fn from(m: MethodArg) -> Method {
         match m {
             MethodArg::Lsq => Method::Lsq,
+            MethodArg::Lm => Method::Lm,
             MethodArg::NelderMead => Method::NelderMead,
             MethodArg::Pso => Method::Pso,
         }

@@ -3,6 +3,7 @@
 //! finishes (to checkpoint); a start finished before a resume is not run again, one
 //! interrupted continues from where it had got to.
 
+mod levenberg_marquardt;
 pub mod problem;
 pub mod progress;
 pub mod settings;
@@ -134,7 +135,7 @@ mod tests {
             ("Kg".to_string(), Bound { lo: 1e2, hi: 1e4 }),
         ];
         let space = ParamSpace::new(base, &names, &bounds).unwrap();
-        for method in [Method::Lsq, Method::NelderMead, Method::Pso] {
+        for method in [Method::Lsq, Method::Lm, Method::NelderMead, Method::Pso] {
             let monitor = Monitor::default();
             let settings = Settings {
                 method,

@@ -192,6 +192,14 @@ impl<'a> Problem<'a> {
         }
     }
 
+    /// The residuals at each of `points`, in parallel.
+    pub(crate) fn evaluate_all(
+        &self,
+        points: &[DVector<f64>],
+    ) -> Result<Vec<Vec<f64>>, ObjectiveError> {
+        points.par_iter().map(|x| self.evaluate(x)).collect()
+    }
+
     /// Forward-difference Jacobian of the residuals in solver coordinates, the columns
     /// in parallel; `r0` are the residuals at `x`.
     pub(crate) fn jacobian_at(

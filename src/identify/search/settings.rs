@@ -47,6 +47,9 @@ impl Default for Settings {
 pub enum Method {
     /// Gauss–Newton with line search, finite-difference Jacobian in parallel.
     Lsq,
+    /// Levenberg–Marquardt, finite-difference Jacobian and trial steps in parallel,
+    /// stopped on relative cost and step (for closed-loop simulations).
+    Lm,
     /// Nelder–Mead simplex.
     NelderMead,
     /// Particle swarm in the bounds.
@@ -57,6 +60,7 @@ impl Method {
     pub fn name(self) -> &'static str {
         match self {
             Method::Lsq => "lsq",
+            Method::Lm => "lm",
             Method::NelderMead => "nelder-mead",
             Method::Pso => "pso",
         }

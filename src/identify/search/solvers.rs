@@ -67,6 +67,8 @@ pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limit
                     (x, c * c, i, t)
                 })
         }
+        Method::Lm => super::levenberg_marquardt::run(&problem, x0, limits.max_iters)
+            .map_err(argmin::core::Error::from),
         Method::NelderMead => {
             let mut simplex = vec![x0.clone()];
             for j in 0..n {
