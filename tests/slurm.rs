@@ -561,6 +561,11 @@ fn a_cancelled_task_resubmitted_resumes(cluster: &Cluster, docs: &Docs, want: &[
         log.contains(&summary),
         "the resumed task's log lacks `{summary}`: {log}"
     );
+    // The script appends: the cancelled run's end is still in the log.
+    assert!(
+        log.contains("CANCELLED"),
+        "the cancelled run's log is gone: {log}"
+    );
     assert!(
         merge(cluster, docs, &dir) == want,
         "the merged shards after the resumed task differ from the unsharded sweep"
