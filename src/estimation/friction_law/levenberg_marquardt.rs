@@ -105,28 +105,19 @@ pub fn minimise(problem: &impl Problem, start: DVector<f64>, settings: &Settings
         problem.jacobian(&p, &mut j);
         let jtj = j.transpose() * &j;
         let gradient = j.transpose() * &r;
-        let largest = jtj.diagonal().max();
-        let damping = jtj.diagonal().map(|d| d.max(DAMPING_FLOOR * largest));
+        let damping = damping(&jtj);
         let taken = loop {
             if lambda > MAX_DAMPING {
                 break None;
             }
-            let mut a = jtj.clone();
-            for i in 0..k {
-                a[(i, i)] += lambda * damping[i];
-            }
-            let step = a.cholesky().map(|c| c.solve(&(-&gradient)));
-            match step {
-                Some(h) if h.iter().all(|x| x.is_finite()) => {
-                    let trial = &p + &h;
-                    problem.residuals(&trial, &mut trial_r);
-                    let trial_cost = trial_r.norm_squared();
-                    if trial_cost.is_finite() && trial_cost < cost {
-                        lambda = (lambda / 10.0).max(1e-15);
-                        break Some((trial, trial_cost, h.norm()));
-                    }
+            if let Some(h) = damped_step(&jtj, &gradient, &damping, lambda) {
+                let trial = &p + &h;
+                problem.residuals(&trial, &mut trial_r);
+                let trial_cost = trial_r.norm_squared();
+                if trial_cost.is_finite() && trial_cost < cost {
+                    lambda = (lambda / 10.0).max(1e-15);
+                    break Some((trial, trial_cost, h.norm()));
                 }
-                _ => {}
             }
             lambda *= 10.0;
         };
@@ -148,6 +139,30 @@ pub fn minimise(problem: &impl Problem, start: DVector<f64>, settings: &Settings
         iterations,
         stop,
     }
+}
+
+/// Marquardt's scaling D: JᵀJ's diagonal, floored at [`DAMPING_FLOOR`] of its
+/// largest element.
+pub(crate) fn damping(jtj: &DMatrix<f64>) -> DVector<f64> {
+    let largest = jtj.diagonal().max();
+    jtj.diagonal().map(|d| d.max(DAMPING_FLOOR * largest))
+}
+
+/// The step h of (JᵀJ + λ·D)·h = −Jᵀr (`gradient` = Jᵀr), if the system is
+/// solvable and h finite.
+pub(crate) fn damped_step(
+    jtj: &DMatrix<f64>,
+    gradient: &DVector<f64>,
+    damping: &DVector<f64>,
+    lambda: f64,
+) -> Option<DVector<f64>> {
+    let mut a = jtj.clone();
+    for i in 0..damping.len() {
+        a[(i, i)] += lambda * damping[i];
+    }
+    a.cholesky()
+        .map(|c| c.solve(&(-gradient)))
+        .filter(|h| h.iter().all(|x| x.is_finite()))
 }
 
 #[cfg(test)]

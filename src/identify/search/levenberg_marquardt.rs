@@ -8,10 +8,9 @@
 //! tests, rough at any step, it stops above Nelder–Mead's cost: they keep Nelder–Mead,
 //! docs/identification.md.)
 //!
-//! Each iteration solves (JᵀJ + λ·D)·h = −Jᵀr, D = diag(JᵀJ) floored at
-//! [`DAMPING_FLOOR`] of its largest element (Marquardt's scaling; K. Madsen,
-//! H. B. Nielsen, O. Tingleff, *Methods for Non-Linear Least Squares Problems*, DTU
-//! 2004, §3.2), for [`TRIALS`] dampings λ and 10λ at once, and takes the trial of
+//! Each iteration solves (JᵀJ + λ·D)·h = −Jᵀr, D = diag(JᵀJ) floored (Marquardt's
+//! scaling; the damped step of the friction laws' solver,
+//! [`crate::estimation::friction_law::levenberg_marquardt`]), for [`TRIALS`] dampings λ and 10λ at once, and takes the trial of
 //! lower cost if it lowers the cost; λ then becomes a tenth of the damping that won.
 //! If neither does, λ rises [`GROWTH`]-fold and the batch is tried again. It stops:
 //! - converged, when a step lowered the cost by less than [`COST_TOLERANCE`] of it;
@@ -21,12 +20,11 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::estimation::friction_law::levenberg_marquardt::{damped_step, damping};
 use crate::identify::result::termination::Termination;
 use crate::identify::search::problem::Problem;
 use crate::objectives::{sum_of_squares, ObjectiveError};
 
-/// The floor of the damping's diagonal, relative to its largest element.
-const DAMPING_FLOOR: f64 = 1e-12;
 /// The first damping.
 const FIRST_DAMPING: f64 = 1e-3;
 /// Dampings tried at once, λ and 10λ: two cores evaluate them in the time of one.
@@ -107,16 +105,16 @@ fn descend(
     let g = j.transpose() * DVector::from_column_slice(&at.r);
     let d = damping(&jtj);
     for _ in 0..BATCHES {
-        let trials: Vec<(DVector<f64>, f64)> = (0..TRIALS)
+        let (points, dampings): (Vec<DVector<f64>>, Vec<f64>) = (0..TRIALS)
             .map(|k| lambda * 10f64.powi(k as i32))
-            .filter_map(|l| step(&jtj, &g, &d, l).map(|h| (&at.x + h, l)))
-            .collect();
-        let points: Vec<DVector<f64>> = trials.iter().map(|(x, _)| x.clone()).collect();
+            .filter_map(|l| damped_step(&jtj, &g, &d, l).map(|h| (&at.x + h, l)))
+            .unzip();
         let residuals = problem.evaluate_all(&points)?;
-        let best = trials
+        let best = points
             .into_iter()
             .zip(residuals)
-            .map(|((x, l), r)| (Point::new(x, r), l))
+            .zip(dampings)
+            .map(|((x, r), l)| (Point::new(x, r), l))
             .min_by(|a, b| a.0.cost.total_cmp(&b.0.cost));
         if let Some((p, l)) = best.filter(|(p, _)| p.cost < at.cost) {
             return Ok(Some((p, l)));
@@ -124,27 +122,6 @@ fn descend(
         lambda *= GROWTH;
     }
     Ok(None)
-}
-
-/// Marquardt's scaling: JᵀJ's diagonal, floored.
-fn damping(jtj: &DMatrix<f64>) -> DVector<f64> {
-    let diag = jtj.diagonal();
-    let floor = DAMPING_FLOOR * diag.amax().max(f64::MIN_POSITIVE);
-    diag.map(|v| v.max(floor))
-}
-
-/// The step h of (JᵀJ + λ·D)·h = −g, if the system is solvable.
-fn step(
-    jtj: &DMatrix<f64>,
-    g: &DVector<f64>,
-    d: &DVector<f64>,
-    lambda: f64,
-) -> Option<DVector<f64>> {
-    let mut a = jtj.clone();
-    for i in 0..d.len() {
-        a[(i, i)] += lambda * d[i];
-    }
-    a.cholesky().map(|c| -c.solve(g))
 }
 
 #[cfg(test)]

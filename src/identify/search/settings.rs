@@ -48,7 +48,7 @@ pub enum Method {
     /// Gauss–Newton with line search, finite-difference Jacobian in parallel.
     Lsq,
     /// Levenberg–Marquardt, finite-difference Jacobian and trial steps in parallel,
-    /// stopped on relative cost and step (for closed-loop simulations).
+    /// stopped on the relative cost (for a direct-drive servo trace's replay).
     Lm,
     /// Nelder–Mead simplex.
     NelderMead,

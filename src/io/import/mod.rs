@@ -219,10 +219,7 @@ fn check_magnitudes<'p>(
         else {
             continue;
         };
-        let place = match channel.first_line {
-            Some(line) => format!("line {}", line + i),
-            None => format!("sample {}", i + 1),
-        };
+        let place = place(channel, i);
         let what = if v.is_finite() {
             format!("{v:e} in SI units, beyond ±1e15: not a measurement (a unit slip?)")
         } else {
@@ -272,15 +269,21 @@ fn check_time_base<'p>(
         (None, Ok(())) => return Ok(()),
     };
     let channel = source.resolved.channel;
-    let place = match channel.first_line {
-        Some(line) => format!("line {}", line + row),
-        None => format!("sample {}", row + 1),
-    };
+    let place = place(channel, row);
     Err(ImportError(format!(
         "{}, {place}: the time base of `{}`: {what}",
         path_of(source.resolved.file).display(),
         channel.name
     )))
+}
+
+/// Where sample `index` of `channel` is: its line in a text file where each sample
+/// is a line, else its 1-based number.
+fn place(channel: &Channel, index: usize) -> String {
+    match channel.first_line {
+        Some(line) => format!("line {}", line + index),
+        None => format!("sample {}", index + 1),
+    }
 }
 
 /// A negative scale turns a complex response by half a turn.
@@ -621,10 +624,7 @@ pub fn channel_findings(file: &std::path::Path, channel: &Channel, is_time: bool
     let Samples::Real(raw) = &channel.samples else {
         return Vec::new();
     };
-    let place = |index: usize| match channel.first_line {
-        Some(line) => format!("{}, line {}", file.display(), line + index),
-        None => format!("{}, sample {}", file.display(), index + 1),
-    };
+    let place = |index: usize| format!("{}, {}", file.display(), place(channel, index));
     if is_time {
         return glitches::gaps(raw)
             .into_iter()
