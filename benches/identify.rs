@@ -12,6 +12,11 @@
 //! data (fixtures/frf/worm_frf: the worm's linear response with 2 % complex noise,
 //! 5–2000 Hz, 1996 lines), `gain_curve` with the linear model — `cost/*` one
 //! evaluation, `fit/*` Kw, Kg, Ciw, Cig from +40 % starts (`--model linear`).
+//!
+//! `identify/torque-curve/…` on the worm's clean torque curve (fixtures/worm-gear,
+//! 6001 samples): `cost` one evaluation (the closed-loop torque test), `fit` fm and
+//! Cm from 0.2 and 0.01 (Nelder–Mead, one start), `profile` the profiles of both
+//! at that fit (a bowl fitted to the rough cost around it).
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -54,6 +59,34 @@ fn bench(c: &mut Criterion) {
     });
     group.finish();
     complex(c);
+    torque_curve(c);
+}
+
+/// The torque-curve fit and its profiles (module docs).
+fn torque_curve(c: &mut Criterion) {
+    let support::Fixture { spec, truth } = support::worm_torque_curve();
+    let start = support::off(&truth, &[("fm", 0.2 / 0.14), ("Cm", 0.01 / 8e-3)]);
+    let config = Config::new(vec![spec.clone()], start, &["fm", "Cm"]);
+    let source = Source {
+        file: &spec.source,
+        experiment: &spec.experiment,
+    };
+    let objective = ObjectiveKind::named("torque_curve")
+        .unwrap()
+        .build(&source, Fidelity::Nonlinear)
+        .unwrap();
+    let mut group = c.benchmark_group("identify/torque-curve");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(1));
+    group.bench_function("cost", |b| b.iter(|| objective.residuals(&truth).unwrap()));
+    group.bench_function("fit", |b| {
+        b.iter(|| identify(&config, &Monitor::default()).unwrap())
+    });
+    let fit = identify(&config, &Monitor::default()).unwrap();
+    group.bench_function("profile", |b| {
+        b.iter(|| support::profiles(&fit, &["fm", "Cm"]))
+    });
+    group.finish();
 }
 
 /// The complex residual against the gain alone (module docs).

@@ -7,6 +7,8 @@
 //! record as converted in shared/data/emps) and fixtures/real/emps/axis.json (the
 //! published model as an rtid parameter file).
 
+mod support;
+
 use std::path::PathBuf;
 
 use rtid::controller::{Controller, Gains};
@@ -286,6 +288,43 @@ fn output_error_from_the_idim_estimate_reaches_the_published_model() {
         position_rms <= 2.10e-6 && force_rms <= 2.41,
         "{position_rms} m, {force_rms} N"
     );
+}
+
+#[test]
+#[cfg_attr(
+    not(feature = "slow-tests"),
+    ignore = "slow tier (~6 s): --features slow-tests"
+)]
+fn the_emps_profiles_count_the_misfits_correlation() {
+    // The model's misfit on the real record is correlated over hundreds of samples:
+    // the profiles (a bowl fitted to the replay's rough cost) count the residuals'
+    // correlation, the standard errors do not (docs/identification.md).
+    use rtid::identify::{identify, Config, ExperimentSpec, Monitor};
+    let e = experiment_file::read(&fixture("emps_estimation.json")).unwrap();
+    let spec = ExperimentSpec::new("emps_estimation.json", e);
+    let fit = identify(
+        &Config::new(vec![spec], emps_axis(), &[]),
+        &Monitor::default(),
+    )
+    .unwrap();
+    let names: Vec<&str> = fit.result.parameters.keys().map(String::as_str).collect();
+    let (profiles, _) = support::profiles(&fit, &names);
+    let m = fit.result.residuals[0].residuals.len() as f64;
+    for (name, p) in &profiles {
+        let s = p
+            .surface
+            .as_ref()
+            .expect("a servo trace's replay is profiled on a bowl");
+        let (lo, hi) = (p.lower.unwrap(), p.upper.unwrap());
+        let v = fit.result.parameters[name];
+        assert!(lo < v && v < hi, "{name}: the fit {v} outside {lo}…{hi}");
+        assert!(s.effective_residuals < m / 10.0, "{name}: {s:?}");
+        let se = fit.result.standard_error(name).unwrap();
+        assert!(
+            hi - lo > 5.0 * 2.0 * 1.96 * se,
+            "{name}: {lo}…{hi}, se {se}"
+        );
+    }
 }
 
 /// The EMPS record as the force curve a user first tries (issue 11): time, force and

@@ -19,7 +19,7 @@ use crate::identify::search::settings::Settings;
 use crate::identify::space::ParamSpace;
 use crate::identify::start::start;
 use crate::model::Params;
-use crate::objectives::{Objective, ObjectiveError};
+use crate::objectives::{Objective, ObjectiveError, Smoothness};
 
 /// The identified parameters and the complete parameter set, with the objective
 /// the result minimises and the search's settings (for a profile of the result).
@@ -32,6 +32,8 @@ pub struct Identified {
     pub objective: Box<dyn Objective>,
     /// The settings of the search stage.
     pub settings: Settings,
+    /// How `objective`'s cost varies (the roughest of its parts).
+    pub smoothness: Smoothness,
 }
 
 /// Runs the identification. `monitor` carries the stop flag (Ctrl-C) and the count
@@ -87,6 +89,12 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
     Ok(Identified {
         result: assemble(config, &plan, &space, run, assessment),
         params,
+        smoothness: match (&ran.surrogate, plan.declared) {
+            (Some(_), _) => Smoothness::Smooth,
+            (None, d) if d.derivative_free => Smoothness::Rough,
+            (None, d) if d.rough => Smoothness::Grainy,
+            _ => Smoothness::Smooth,
+        },
         objective: match ran.surrogate {
             Some(s) => Box::new(s),
             None => Box::new(ran.joint),

@@ -39,6 +39,9 @@ const PLOT_CAP: f64 = 5.0;
 /// A profile: the likelihood-ratio statistic against the held value (capped at
 /// [`PLOT_CAP`] × the threshold), the fitted points as markers joined by a line,
 /// the 95 % threshold dashed.
+///
+/// On a rough cost ([`Profile::surface`]) the line is the fitted bowl's profile and
+/// the markers the evaluated design, whose scatter about it is the roughness.
 pub fn profile(name: &str, p: &Profile) -> Figure {
     let cap = PLOT_CAP * THRESHOLD;
     let points: Vec<(f64, f64)> = p
@@ -47,18 +50,41 @@ pub fn profile(name: &str, p: &Profile) -> Figure {
         .zip(&p.statistic)
         .map(|(q, &s)| (q[0], s.min(cap)))
         .collect();
-    let (lo, hi) = points
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
-            (a.min(q.0), b.max(q.0))
-        });
+    if let Some(surface) = &p.surface {
+        let curve: Vec<(f64, f64)> = surface
+            .curve
+            .iter()
+            .map(|q| (q[0], q[1].min(cap)))
+            .collect();
+        return profile_figure(
+            name,
+            &curve,
+            "bowl fitted to the rough cost",
+            points,
+            "evaluated points",
+        );
+    }
+    profile_figure(name, &points.clone(), "profile", points, "re-fitted points")
+}
+
+fn profile_figure(
+    name: &str,
+    line: &[(f64, f64)],
+    line_label: &str,
+    points: Vec<(f64, f64)>,
+    points_label: &str,
+) -> Figure {
+    let points_and_line = points.iter().chain(line);
+    let (lo, hi) = points_and_line.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
+        (a.min(q.0), b.max(q.0))
+    });
     Figure::new(
         format!("profile likelihood of {name}"),
         &format!("{name} (held), SI"),
         "likelihood-ratio statistic (capped at 19.2)",
     )
-    .with(Series::new("profile", points.clone(), Style::Line))
-    .with(Series::new("re-fitted points", points, Style::Markers))
+    .with(Series::new(line_label, line.to_vec(), Style::Line))
+    .with(Series::new(points_label, points, Style::Markers))
     .with(Series::new(
         "95 % level (χ²₁ = 3.84)",
         vec![(lo, THRESHOLD), (hi, THRESHOLD)],

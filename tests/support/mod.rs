@@ -166,3 +166,25 @@ pub fn non_finite(debug: &str) -> bool {
         .split(|c: char| !(c.is_alphanumeric() || c == '-'))
         .any(|t| matches!(t, "NaN" | "inf" | "-inf"))
 }
+
+/// The profiles of `names` at `fit` (`--profile`), and their warnings.
+pub fn profiles(
+    fit: &rtid::identify::Identified,
+    names: &[&str],
+) -> (
+    std::collections::BTreeMap<String, rtid::identify::result::profile::Profile>,
+    Vec<rtid::identify::Warning>,
+) {
+    use rtid::identify::intervals::profile;
+    profile::profiles(&profile::Request {
+        result: &fit.result,
+        params: &fit.params,
+        objective: fit.objective.as_ref(),
+        settings: fit.settings,
+        smoothness: fit.smoothness,
+        names: names.iter().map(|n| n.to_string()).collect(),
+        stop: &|| false,
+        on_point: &|| {},
+    })
+    .unwrap()
+}

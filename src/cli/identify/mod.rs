@@ -15,7 +15,9 @@ use std::time::Duration;
 use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
-use crate::cli::identify::profile::{add_profiles, profile_table, write_profile_plots};
+use crate::cli::identify::profile::{
+    add_profiles, profile_table, surface_notes, write_profile_plots,
+};
 use crate::cli::identify::resample::{add_resampling, resample_table};
 use crate::cli::ModelArgs;
 use rtid::identify::pipeline::comparison;
@@ -97,7 +99,9 @@ data (FILE-1.svg, …; a servo trace has two: effort and following error); \
 --save-params FILE for `--params FILE` everywhere. --profile adds each fitted \
 parameter's profile likelihood: its 95 % likelihood-ratio interval (open where the data do \
 not bound it, naming the parameters that move with it), beside ±1.96 standard errors, and \
-a plot each. --resample N repeats the whole fit on N replicates of the data (the fitted \
+a plot each; on a rough cost (torque curve, unbalance test, servo trace) it is read off a bowl fitted to \
+the cost at a few dozen points around the fit, evaluated in parallel (about a second for \
+the worm's torque curve, where a walk of re-fits took a minute). --resample N repeats the whole fit on N replicates of the data (the fitted \
 response plus the residuals resampled in blocks): its 95 % interval holds where the cost is \
 rough (torque curve, servo trace) and the standard errors are lower bounds.
 
@@ -180,8 +184,11 @@ pub struct Args {
     /// Profile likelihood of these fitted parameters (comma-separated; `--profile`
     /// alone: every fitted one): each is held at values walking out from the fit both
     /// ways while the others are re-fitted, giving its 95 % likelihood-ratio interval
-    /// (open on a side where the profile stays flat up to the bound). In the result as
-    /// `profiles`, plotted as FILE-profile-NAME.svg beside --out.
+    /// (open on a side where the profile stays flat up to the bound). On a rough cost
+    /// (torque curve, unbalance test, servo trace) the profile is a quadratic bowl's,
+    /// fitted to the cost at points around the fit, its statistic counting the
+    /// residuals' correlation. In the result as `profiles`, plotted as
+    /// FILE-profile-NAME.svg beside --out.
     #[arg(long, value_name = "NAMES", num_args = 0..=1, default_missing_value = "")]
     pub profile: Option<String>,
     /// Residual block bootstrap with N replicates (`--resample` alone: 20): each
@@ -483,9 +490,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         params,
         objective,
         settings,
+        smoothness,
     } = outcome?;
     if let Some(names) = &a.profile {
-        let fit = (objective.as_ref(), settings);
+        let fit = (objective.as_ref(), settings, smoothness);
         add_profiles(names, &mut result, &params, fit, &monitor, a.quiet)?;
     }
     if let Some(n) = a.resample {
@@ -588,6 +596,9 @@ fn print_summary(r: &IdentifyResult) {
     println!("{}", parameter_table(r));
     if let Some(t) = profile_table(r) {
         println!("{t}");
+        for line in surface_notes(r) {
+            println!("{line}");
+        }
     }
     if let Some(t) = resample_table(r) {
         println!("{t}");

@@ -17,7 +17,11 @@ pub fn add_profiles(
     names: &str,
     result: &mut IdentifyResult,
     params: &Params,
-    fit: (&dyn rtid::objectives::Objective, rtid::identify::Settings),
+    fit: (
+        &dyn rtid::objectives::Objective,
+        rtid::identify::Settings,
+        rtid::objectives::Smoothness,
+    ),
     monitor: &Monitor,
     quiet: bool,
 ) -> anyhow::Result<()> {
@@ -32,6 +36,7 @@ pub fn add_profiles(
         params,
         objective: fit.0,
         settings: fit.1,
+        smoothness: fit.2,
         names,
         stop: &|| monitor.stopped(),
         on_point: &|| {
@@ -95,4 +100,28 @@ pub fn profile_table(r: &IdentifyResult) -> Option<Table> {
         ]);
     }
     Some(t)
+}
+
+/// For each profile read off a bowl fitted to a rough cost, one line: where the
+/// bowl's minimum is, and what the interval is made of.
+pub fn surface_notes(r: &IdentifyResult) -> Vec<String> {
+    let profiles = r.profiles.iter().flatten();
+    profiles
+        .filter_map(|(name, p)| {
+            let s = p.surface.as_ref()?;
+            Some(format!(
+                "{name}: the cost is rough; its profile is a bowl fitted to {} evaluations \
+                 around the fit (their scatter about it {:.2e}), minimum at {:.5e}; \
+                 half-width {:.2e} from the residuals ({:.0} effective of {}) and \
+                 {:.2e} from where the roughness leaves the minimum",
+                p.points.len(),
+                s.roughness,
+                s.minimum,
+                s.statistic_half_width,
+                s.effective_residuals,
+                r.residuals.iter().map(|e| e.residuals.len()).sum::<usize>(),
+                1.96 * s.minimum_spread,
+            ))
+        })
+        .collect()
 }

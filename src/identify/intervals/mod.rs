@@ -4,4 +4,5 @@
 
 pub mod profile;
 pub mod resample;
+pub mod surface;
 pub mod uncertainty;

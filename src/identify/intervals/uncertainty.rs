@@ -58,6 +58,33 @@ pub(crate) fn with_residuals(
     Ok(from_jacobian(space, values, &jac, sigma2))
 }
 
+/// The uncertainty at `values` (residuals `r0`) from the Jacobian `solver_jac` a
+/// search took at solver coordinates `x` near them. The solver's coordinate is
+/// x = asin(2u − 1) of the unit coordinate u in the bounds (u = ln(p/lo)/ln(hi/lo)
+/// for a log parameter, (p − lo)/(hi − lo) for a linear one), so each column ∂r/∂x
+/// becomes [`jacobian`]'s ∂r/∂u = ∂r/∂x / (cos x / 2), then divided by ln(hi/lo)
+/// for a log parameter (∂r/∂ln p).
+pub(crate) fn from_solver_jacobian(
+    space: &ParamSpace,
+    values: &[f64],
+    (x, solver_jac): (&[f64], &DMatrix<f64>),
+    r0: &[f64],
+) -> Assessed {
+    let mut jac = solver_jac.clone();
+    for (j, (b, x)) in space.bounds.iter().zip(x).enumerate() {
+        let du_dx = 0.5 * x.cos();
+        let dlnp_du = if b.log() { (b.hi / b.lo).ln() } else { 1.0 };
+        jac.column_mut(j).unscale_mut(du_dx * dlnp_du);
+    }
+    let (m, n) = jac.shape();
+    let sigma2 = if m > n {
+        r0.iter().map(|r| r * r).sum::<f64>() / (m - n) as f64
+    } else {
+        f64::NAN
+    };
+    from_jacobian(space, values, &jac, sigma2)
+}
+
 /// The uncertainty at `values` from the Jacobian `jac` (columns as [`jacobian`]
 /// takes them) and the residual variance `sigma2` (NaN: unknown): what the data of
 /// a fit determine, or — with a stated σ² — what a planned test would
@@ -279,4 +306,76 @@ fn zero_undefined(correlation: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
                 .collect()
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identify::search::problem::{Monitor, Problem};
+    use crate::identify::search::settings::Settings;
+    use crate::identify::space::Bound;
+    use crate::model::{presets, Params};
+
+    /// Three smooth residuals of Kw and Kg (no exact fit: σ² > 0).
+    struct Smooth;
+
+    impl Objective for Smooth {
+        fn name(&self) -> &'static str {
+            "smooth"
+        }
+        fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+            let (a, b) = (p.kw / 3e5, p.kg.unwrap_or(0.0) / 900.0);
+            Ok(vec![a * b - 1.1, (a - 1.0).exp() - 0.9, b * b - 0.8 * a])
+        }
+        fn len(&self) -> usize {
+            3
+        }
+        fn scale(&self) -> String {
+            String::new()
+        }
+    }
+
+    #[test]
+    fn a_searchs_jacobian_in_solver_coordinates_gives_the_central_differences_errors() {
+        // Kw in log space, Kg linear: both conversions (asin coordinate, ln p).
+        let base = presets::load("worm-gear").unwrap();
+        let names = ["Kw".to_string(), "Kg".to_string()];
+        let bounds = [
+            ("Kw".to_string(), Bound { lo: 3e4, hi: 3e6 }),
+            (
+                "Kg".to_string(),
+                Bound {
+                    lo: 0.0,
+                    hi: 2000.0,
+                },
+            ),
+        ];
+        let space = ParamSpace::new(base, &names, &bounds).unwrap();
+        let values = [3.3e5, 870.0];
+        let direct = at_optimum(&space, &Smooth, &values, 1e-5).unwrap();
+        let monitor = Monitor::default();
+        let settings = Settings {
+            fd_step: 1e-7,
+            ..Settings::default()
+        };
+        let problem = Problem::new(&space, &Smooth, &monitor, &settings);
+        let x = space.to_solver(&values);
+        let r0 = Smooth.residuals(&space.params(&values).unwrap()).unwrap();
+        let j = problem.jacobian_at(&x, &r0).unwrap();
+        let converted = from_solver_jacobian(&space, &values, (x.as_slice(), &j), &r0);
+        let pairs = direct
+            .uncertainty
+            .standard_errors
+            .iter()
+            .zip(&converted.uncertainty.standard_errors);
+        for ((name, a), (_, b)) in pairs {
+            let (a, b) = (a.unwrap(), b.unwrap());
+            assert!((b / a - 1.0).abs() < 1e-4, "{name}: {a} against {b}");
+        }
+        let (ca, cb) = (
+            direct.uncertainty.correlation[0][1],
+            converted.uncertainty.correlation[0][1],
+        );
+        assert!((ca - cb).abs() < 1e-4, "{ca} against {cb}");
+    }
 }

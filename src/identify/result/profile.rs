@@ -25,6 +25,31 @@ pub struct Profile {
     /// Why a side ended before its level or bound (a failed fit, Ctrl-C).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
+    /// On a rough cost, the bowl fitted to the cost around the fit that the
+    /// interval is read from (`points` are then the evaluated design, not re-fits).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface: Option<Surface>,
+}
+
+/// The quadratic bowl behind a rough cost's profile
+/// ([`crate::identify::intervals::surface`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Surface {
+    /// The parameter's value at the bowl's minimum, the interval's centre.
+    pub minimum: f64,
+    /// The bowl's cost there.
+    pub cost: f64,
+    /// n_eff: the residuals' count over the factor by which their correlation
+    /// inflates this parameter's variance.
+    pub effective_residuals: f64,
+    /// RMS scatter of the evaluated costs about the bowl.
+    pub roughness: f64,
+    /// Standard deviation of the minimum over resamplings of that scatter.
+    pub minimum_spread: f64,
+    /// The half-width the statistic alone gives.
+    pub statistic_half_width: f64,
+    /// `[value, statistic]` of the bowl's profile, for the plot.
+    pub curve: Vec<[f64; 2]>,
 }
 
 /// The variance behind the statistic.

@@ -22,7 +22,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::estimation::friction_law::levenberg_marquardt::{damped_step, damping};
 use crate::identify::result::termination::Termination;
-use crate::identify::search::problem::Problem;
+use crate::identify::search::problem::{Problem, SearchJacobian};
 use crate::objectives::{sum_of_squares, ObjectiveError};
 
 /// The first damping.
@@ -70,6 +70,11 @@ pub(crate) fn run(
     for iteration in 1..=max_iters {
         problem.monitor.progress().advance(1);
         let j = problem.jacobian_at(&at.x, &at.r)?;
+        problem.monitor.keep_jacobian(SearchJacobian {
+            x: at.x.iter().copied().collect(),
+            j: j.clone(),
+            step: problem.fd_step,
+        });
         let Some((next, won)) = descend(problem, &at, &j, lambda)? else {
             return Ok(done(at, iteration, Termination::Converged));
         };

@@ -33,11 +33,22 @@ pub struct Best {
     pub values: Vec<f64>,
 }
 
+/// A forward-difference Jacobian a search took (solver coordinates).
+#[derive(Clone, Debug)]
+pub(crate) struct SearchJacobian {
+    /// Where, in solver coordinates.
+    pub x: Vec<f64>,
+    pub j: DMatrix<f64>,
+    /// The difference step, solver units.
+    pub step: f64,
+}
+
 /// Shared bookkeeping of a search.
 #[derive(Default)]
 pub struct Monitor {
     evaluations: AtomicUsize,
     best: Mutex<Option<Best>>,
+    jacobian: Mutex<Option<SearchJacobian>>,
     failure: Mutex<Option<String>>,
     stop: AtomicBool,
     progress: Arc<Progress>,
@@ -79,11 +90,28 @@ impl Monitor {
         }
     }
 
-    /// Forgets the best point (between stages whose costs differ in kind).
+    /// Forgets the best point (between stages whose costs differ in kind), and the
+    /// last Jacobian.
     pub(crate) fn reset_best(&self) {
         if let Ok(mut b) = self.best.lock() {
             *b = None;
         }
+        if let Ok(mut j) = self.jacobian.lock() {
+            *j = None;
+        }
+    }
+
+    /// Keeps the last Jacobian a search took (Levenberg–Marquardt), for the
+    /// uncertainty at its result.
+    pub(crate) fn keep_jacobian(&self, jacobian: SearchJacobian) {
+        if let Ok(mut j) = self.jacobian.lock() {
+            *j = Some(jacobian);
+        }
+    }
+
+    /// The last Jacobian kept.
+    pub(crate) fn jacobian(&self) -> Option<SearchJacobian> {
+        self.jacobian.lock().map(|j| j.clone()).unwrap_or(None)
     }
 
     /// The first evaluation error (an invalid parameter set, a diverged simulation).
