@@ -134,7 +134,7 @@ struct Point {
     /// The walk's coordinate: ln value for a log-bounded parameter, else the value.
     u: f64,
     cost: f64,
-    /// What the statistic compares ([`Context::level`]).
+    /// What the statistic compares ([`Context::level_of`]).
     level: f64,
     params: Params,
 }
@@ -153,7 +153,7 @@ struct Context<'a> {
     /// The profiled objective's residuals and cost at the fit.
     r0: Vec<f64>,
     cost0: f64,
-    /// [`Context::level`] at the fit.
+    /// [`Context::level_of`] at the fit.
     level0: f64,
     variance: Variance,
     /// Residuals in the fit's cost.
@@ -185,7 +185,10 @@ impl<'a> Context<'a> {
             Variance::Unit
         };
         let parts = (request.result.residuals.iter())
-            .map(|e| (e.residuals.len(), e.residuals.len() as f64 / e.weight))
+            .map(|e| {
+                let n = e.residuals.len();
+                (n, if e.weight > 0.0 { n as f64 / e.weight } else { 0.0 })
+            })
             .collect();
         let mut context = Context {
             request,
@@ -217,7 +220,9 @@ impl<'a> Context<'a> {
     fn chi2(&self, r: &[f64]) -> f64 {
         let total: usize = self.parts.iter().map(|p| p.0).sum();
         if r.len() != total {
-            let weight: f64 = self.parts.iter().map(|p| p.0 as f64 / p.1).sum();
+            let weight: f64 = (self.parts.iter().filter(|p| p.1 > 0.0))
+                .map(|p| p.0 as f64 / p.1)
+                .sum();
             return sum_of_squares(r) * total as f64 / weight.max(f64::MIN_POSITIVE);
         }
         let mut at = 0;
