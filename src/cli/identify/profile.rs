@@ -49,7 +49,7 @@ pub fn add_profiles(
     let (profiles, warnings) = profile::profiles(&request)?;
     bar.finish_and_clear();
     result.warnings.extend(warnings.into_iter().map(Coded));
-    result.profiles = Some(profiles);
+    profile::attach(result, profiles);
     Ok(())
 }
 

@@ -128,6 +128,18 @@ pub fn profiles(
     Ok((out, warnings))
 }
 
+/// Adds `profiles` to `result`. Where every fitted parameter's profile was read off
+/// a bowl fitted to the rough cost, both ends closed, they replace the warning that
+/// the standard errors are lower bounds (as the bootstrap's intervals do).
+pub fn attach(result: &mut IdentifyResult, profiles: BTreeMap<String, Profile>) {
+    let closed = |p: &Profile| p.surface.is_some() && p.lower.is_some() && p.upper.is_some();
+    let covered = (result.parameters.keys()).all(|n| profiles.get(n).is_some_and(closed));
+    if covered {
+        result.warnings.retain(|w| w.0 != Warning::RoughCost);
+    }
+    result.profiles = Some(profiles);
+}
+
 /// One point of a walk.
 #[derive(Clone)]
 struct Point {
@@ -187,7 +199,14 @@ impl<'a> Context<'a> {
         let parts = (request.result.residuals.iter())
             .map(|e| {
                 let n = e.residuals.len();
-                (n, if e.weight > 0.0 { n as f64 / e.weight } else { 0.0 })
+                (
+                    n,
+                    if e.weight > 0.0 {
+                        n as f64 / e.weight
+                    } else {
+                        0.0
+                    },
+                )
             })
             .collect();
         let mut context = Context {

@@ -118,7 +118,7 @@ fn correlated(a: &str, b: &str, correlation: f64) -> String {
     )
 }
 
-const ROUGH_COST: &str = "the standard errors of a fit to a closed-loop simulation (torque curve, unbalance test, servo trace) count the residuals' scatter only: the quantised encoders make the cost rough, and the search stops in its local minima (fm +0.67 % against a 0.08 % standard error on the worm fixture from fm 0.2): read them as lower bounds, or run --resample for an interval that holds";
+const ROUGH_COST: &str = "the standard errors of a fit to a closed-loop simulation (torque curve, unbalance test, servo trace) count the residuals' scatter only: the quantised encoders make the cost rough, and the search stops in its local minima (fm +0.67 % against a 0.08 % standard error on the worm fixture from fm 0.2): read them as lower bounds, or run --profile (a bowl fitted to the rough cost: seconds) or --resample (the whole fit repeated) for intervals that hold";
 
 fn estimate_unused(source: &str, values: &str) -> String {
     format!(
