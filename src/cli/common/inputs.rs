@@ -1,6 +1,7 @@
 //! Inputs are never outputs: an output path that resolves to one of the command's
 //! input files (a manifest, its data file, a parameter file) is refused before any
-//! work starts, naming the option and the file.
+//! work starts, naming the option and the file; so is an output in a folder that
+//! does not exist.
 
 use std::path::{Path, PathBuf};
 
@@ -17,6 +18,19 @@ fn resolved(path: &Path) -> Option<PathBuf> {
         _ => Path::new("."),
     };
     Some(dir.canonicalize().ok()?.join(path.file_name()?))
+}
+
+/// Refuses an `output` (given with `option`) whose folder does not exist, before a
+/// long run finds out at its end.
+pub fn require_folder(option: &str, output: &Path) -> anyhow::Result<()> {
+    match output.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => bail!(
+            "{option} {}: the folder {} does not exist: create it first",
+            output.display(),
+            dir.display()
+        ),
+        _ => Ok(()),
+    }
 }
 
 /// Refuses to write `output` (given with `option`) over any of `inputs`.
@@ -52,5 +66,15 @@ mod tests {
             .to_string();
         assert!(err.contains("--out") && err.contains("input"), "{err}");
         assert!(refuse_overwrite("--out", &dir.path().join("fit.json"), &[&input]).is_ok());
+    }
+
+    #[test]
+    fn an_output_in_a_missing_folder_is_refused_naming_the_option_and_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing = dir.path().join("runs/fit.json");
+        let err = require_folder("--out", &missing).unwrap_err().to_string();
+        assert!(err.starts_with("--out ") && err.contains("runs"), "{err}");
+        assert!(require_folder("--out", &dir.path().join("fit.json")).is_ok());
+        assert!(require_folder("--out", Path::new("fit.json")).is_ok());
     }
 }

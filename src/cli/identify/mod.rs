@@ -368,8 +368,8 @@ impl Args {
         inputs
     }
 
-    /// No output (--out, --save-params, --checkpoint) over an input: a manifest, its
-    /// data file or the parameter file.
+    /// No output (--out, --save-params, --checkpoint) over an input — a manifest, its
+    /// data file or the parameter file — or in a folder that does not exist.
     fn refuse_overwrites(&self, experiments: &[ExperimentSpec]) -> anyhow::Result<()> {
         let inputs = self.inputs(experiments);
         let outputs = [
@@ -380,6 +380,7 @@ impl Args {
         for (option, path) in outputs {
             if let Some(path) = path {
                 crate::cli::common::inputs::refuse_overwrite(option, path, &inputs)?;
+                crate::cli::common::inputs::require_folder(option, path)?;
             }
         }
         Ok(())
