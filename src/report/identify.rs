@@ -56,6 +56,16 @@ pub fn profile(name: &str, p: &Profile) -> Figure {
             .iter()
             .map(|q| (q[0], q[1].min(cap)))
             .collect();
+        // The design's points within the curve's span: the outer ones lie far above
+        // the cap and would squeeze the bowl into the middle of the plot.
+        let (lo, hi) = (
+            curve.first().map_or(0.0, |q| q.0),
+            curve.last().map_or(0.0, |q| q.0),
+        );
+        let points = points
+            .into_iter()
+            .filter(|q| lo <= q.0 && q.0 <= hi)
+            .collect();
         return profile_figure(
             name,
             &curve,

@@ -52,6 +52,9 @@ const RESAMPLES: usize = 400;
 const Z: f64 = 1.959_963_984_540_054;
 /// Points of the plotted profile curve.
 const CURVE_POINTS: usize = 61;
+/// The curve reaches a quarter beyond where the statistic is this (five times the
+/// level, where the plot caps it): the design's outer points lie far above.
+const CURVE_TOP: f64 = 5.0 * THRESHOLD;
 
 /// The fitted parameters around the fit, in their own units: a friction or damping
 /// coefficient enters a torque linearly, so its cost is a quadratic in the value
@@ -540,7 +543,8 @@ impl Bowl {
         let b = &coords.bounds[j];
         let end = |u: f64| (b.lo < u && u < b.hi).then_some(u);
         let design = projected(points, j);
-        let reach = 1.5 * (design.iter().map(|q| (q[0] - centre).abs())).fold(half, f64::max);
+        let top = (2.0 * v * self.cost * ((CURVE_TOP / effective).exp() - 1.0)).sqrt();
+        let reach = (1.25 * top).max(1.5 * half);
         Profile {
             lower: end(centre - half),
             upper: end(centre + half),
