@@ -212,11 +212,15 @@ impl Quadratic {
 }
 
 /// A least-squares fit of the quadratic to the design: the coefficients' solver,
-/// the fitted values and the residuals.
+/// the fitted values, the residuals and their RMS scatter (over n − p, p the
+/// quadratic's coefficients).
 struct Fitted {
     pinv: DMatrix<f64>,
     fitted: DVector<f64>,
     residuals: DVector<f64>,
+    /// The quadratic's coefficient count p.
+    coefficients: usize,
+    scatter: f64,
     quadratic: Quadratic,
 }
 
@@ -232,10 +236,13 @@ fn fit(points: &[Evaluated], k: usize) -> Option<Fitted> {
     let beta = &pinv * &y;
     let fitted = &x * &beta;
     let residuals = &y - &fitted;
+    let scatter = (residuals.norm_squared() / (points.len() - p) as f64).sqrt();
     Some(Fitted {
         pinv,
         fitted,
         residuals,
+        coefficients: p,
+        scatter,
         quadratic: Quadratic::from_coefficients(k, &beta),
     })
 }
@@ -394,7 +401,7 @@ fn design(
         // ⅓ is the last ⅔).
         let inner = if points.len() > 1 { radius / 2.0 } else { 0.0 };
         points.extend(evaluate(request, coords, (inner, radius), &mut notes));
-        if let Some(f) = fit(&points, k).filter(|f| rises_above_roughness(f, &points, k)) {
+        if let Some(f) = fit(&points, k).filter(|f| rises_above_roughness(f, &points)) {
             return (points, Some(f), notes);
         }
         radius *= 2.0;
@@ -471,12 +478,10 @@ fn residuals_at(
 
 /// Whether the fitted quadratic is a bowl whose rise at the outer radius, along its
 /// flattest direction, stands [`ROUGHNESS_MARGIN`] times above the points' scatter.
-fn rises_above_roughness(f: &Fitted, points: &[Evaluated], k: usize) -> bool {
-    let p = 1 + k + k * (k + 1) / 2;
-    let scatter = (f.residuals.norm_squared() / (points.len() - p) as f64).sqrt();
+fn rises_above_roughness(f: &Fitted, points: &[Evaluated]) -> bool {
     let outer = points.iter().map(|q| q.w.norm()).fold(0.0, f64::max);
     let flattest = f.quadratic.h.symmetric_eigenvalues().min();
-    flattest > 0.0 && 0.5 * flattest * outer * outer > ROUGHNESS_MARGIN * scatter
+    flattest > 0.0 && 0.5 * flattest * outer * outer > ROUGHNESS_MARGIN * f.scatter
 }
 
 /// The fitted bowl: its minimum, and how the roughness moves it.
@@ -496,11 +501,10 @@ impl Bowl {
         if cost <= 0.0 {
             return None;
         }
-        let p = 1 + k + k * (k + 1) / 2;
         let n = points.len();
         // The residuals scaled up by √(n / (n − p)): a fit's residuals are smaller
         // than its errors by that factor.
-        let inflate = (n as f64 / (n - p) as f64).sqrt();
+        let inflate = (n as f64 / (n - fitted.coefficients) as f64).sqrt();
         let mut rng = StdRng::seed_from_u64(seed ^ 0x0073_7572_6661_6365);
         let resampled = (0..RESAMPLES)
             .filter_map(|_| {
@@ -513,13 +517,12 @@ impl Bowl {
                     .map(|m| m.0)
             })
             .collect();
-        let scatter = (fitted.residuals.norm_squared() / (n - p) as f64).sqrt();
         Some(Bowl {
             minimum,
             cost,
             inverse,
             resampled,
-            scatter,
+            scatter: fitted.scatter,
         })
     }
 

@@ -50,11 +50,7 @@ pub(crate) fn with_residuals(
 ) -> Result<Assessed, ObjectiveError> {
     let jac = jacobian(space, objective, values, step)?;
     let (m, n) = jac.shape();
-    let sigma2 = if m > n {
-        r0.iter().map(|r| r * r).sum::<f64>() / (m - n) as f64
-    } else {
-        f64::NAN
-    };
+    let sigma2 = residual_variance(r0, m, n);
     Ok(from_jacobian(space, values, &jac, sigma2))
 }
 
@@ -77,12 +73,18 @@ pub(crate) fn from_solver_jacobian(
         jac.column_mut(j).unscale_mut(du_dx * dlnp_du);
     }
     let (m, n) = jac.shape();
-    let sigma2 = if m > n {
+    let sigma2 = residual_variance(r0, m, n);
+    from_jacobian(space, values, &jac, sigma2)
+}
+
+/// σ² = Σr²/(m − n) of `m` residuals `r0` after fitting `n` parameters (NaN: unknown,
+/// no more residuals than parameters).
+fn residual_variance(r0: &[f64], m: usize, n: usize) -> f64 {
+    if m > n {
         r0.iter().map(|r| r * r).sum::<f64>() / (m - n) as f64
     } else {
         f64::NAN
-    };
-    from_jacobian(space, values, &jac, sigma2)
+    }
 }
 
 /// The uncertainty at `values` from the Jacobian `jac` (columns as [`jacobian`]
