@@ -22,7 +22,8 @@ fn a_sweep_and_an_identification_report_the_same_resonance() {
         .evaluate(&p)
         .unwrap();
         // The objective's model resonances, paired with the fixture's two measured ones.
-        let test = rtid::objectives::measured::frequency_test(&spec.experiment);
+        let test =
+            rtid::experiments::frequency_response::measured::frequency_test(&spec.experiment);
         let objective = ResonanceMatch::new(vec![187.0, 234.0], Fidelity::Linear, test);
         let identified = objective.model_hz(&p).unwrap();
         for (k, model) in identified.iter().enumerate() {

@@ -107,7 +107,7 @@ impl ParamSpace {
         let mut specs: Vec<&'static str> = Vec::new();
         let mut start = Vec::new();
         for n in names {
-            let spec = crate::model::params::spec(n.trim())?;
+            let spec = crate::model::spec(n.trim())?;
             if specs.contains(&spec.name) {
                 return Err(SpaceError::Twice {
                     name: spec.name.into(),
@@ -126,7 +126,7 @@ impl ParamSpace {
         }
         let mut out = Vec::new();
         for (name, &v) in specs.iter().zip(&start) {
-            let signed = crate::model::params::spec(name)?.constraint == Constraint::Finite;
+            let signed = crate::model::spec(name)?.constraint == Constraint::Finite;
             let b = match bounds.iter().find(|(n, _)| n == name) {
                 Some((_, b)) => {
                     let bad = |reason: &str| SpaceError::BadBound {

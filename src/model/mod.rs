@@ -3,6 +3,7 @@
 //! at rest and modal analysis.
 
 pub mod backlash;
+mod by_name;
 pub mod drive;
 pub mod friction;
 pub mod kernel;
@@ -15,6 +16,8 @@ pub mod presets;
 pub mod registry;
 pub mod rest;
 
+pub use by_name::MAGNITUDE_RANGE;
 pub use drive::{idx, Drive, NSTATE};
 pub use kernel::{Kernel, States};
 pub use params::{Axis, ControllerParams, LoopMode, ParamError, Params, Topology};
+pub use registry::{spec, Applies, Constraint, ParamSpec, PARAMS};

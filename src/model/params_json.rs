@@ -15,7 +15,8 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-use super::params::{spec, Axis, ControllerParams, ParamError, Params, Topology};
+use super::params::{Axis, ControllerParams, ParamError, Params, Topology};
+use super::registry::spec;
 
 /// [`Params`] as it is written: every field that may be absent is an `Option`.
 #[derive(Clone, Debug, Serialize, Deserialize)]

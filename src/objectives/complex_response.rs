@@ -8,7 +8,7 @@
 //! be wrapped or unwrapped, and either reads the same.
 //!
 //! **Delay.** A delay given in the manifest is taken out of the phase when the file is
-//! read ([`super::measured::complex_points`]); an unknown one is fitted at every
+//! read ([`measured::complex_points`](crate::experiments::frequency_response::measured::complex_points)); an unknown one is fitted at every
 //! evaluation, for the model being evaluated (variable projection: the cost the
 //! search sees is already minimised over the delay, and finite differences of these
 //! residuals give the Jacobian of the reduced problem). It starts from a straight
@@ -17,7 +17,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use super::measured::{ComplexPoints, DB_PER_NEPER};
+use crate::experiments::frequency_response::measured::{ComplexPoints, DB_PER_NEPER};
 
 /// A phase in (−π, π].
 pub fn wrap(phase: f64) -> f64 {

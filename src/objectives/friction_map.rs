@@ -10,7 +10,7 @@
 //! identifiability warning. The search starts at the direct fit of the law to the map
 //! (estimation/friction_law), carried onto the model: the first estimate.
 
-use super::registry::{Definition, Estimated, SetupError, Source};
+use super::definition::{Definition, Estimated, SetupError, Source};
 use super::{Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::estimation::friction_law::{check_map, LawFit};
 use crate::experiments::friction_map::{evaluate, model_effort};

@@ -10,11 +10,12 @@
 use std::f64::consts::TAU;
 
 use super::complex_response::{fit_delay, rms_errors, sigmas, wrap};
-use super::measured::DB_PER_NEPER;
+use super::definition::{Definition, SetupError, Source, Stage};
+use super::measured_peaks::measured_peaks;
 use super::model_peaks::{nonlinear_responses, GRID_BAND};
-use super::registry::{Definition, SetupError, Source, Stage};
 use super::resonance::drive_stiffnesses;
-use super::{measured, Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
+use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
+use crate::experiments::frequency_response::measured::{self, fits_whole_curve, DB_PER_NEPER};
 use crate::experiments::frequency_response::FrequencyTest;
 use crate::io::experiment_file::{Delay, Experiment, Kind, Response};
 use crate::model::linear_response::{Channel, LinearResponse};
@@ -60,34 +61,13 @@ pub static NEAR_PEAKS: Definition = Definition {
 };
 
 fn near_peaks(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, SetupError> {
-    let peaks = measured::peaks(source)?;
+    let peaks = measured_peaks(source)?;
     let near = |f: f64| {
         peaks
             .iter()
             .any(|pk| (f - pk.frequency_hz).abs() <= GRID_BAND * pk.frequency_hz)
     };
     Ok(Box::new(GainCurve::of(source, fidelity, near)?))
-}
-
-/// Whether a frequency response is fitted by its whole curve by default rather than
-/// by its resonances: where it has phase (the complex curve says which damping belongs
-/// to which mesh; the peaks alone fix the stiffnesses only roughly when the damping is
-/// unknown), or where it is not table over motor (a compliance's peaks are not the
-/// motor-held modes the resonance objectives compare). A gain-only table over motor
-/// feeds its resonances; `--objective gain-curve` fits its whole curve.
-pub fn fits_whole_curve(exp: &Experiment) -> bool {
-    exp.manifest.kind == Kind::FrequencyResponse
-        && (has_phase(exp) || measured::form(exp).response != Response::TableOverMotor)
-}
-
-fn has_phase(exp: &Experiment) -> bool {
-    matches!(
-        exp.data,
-        crate::io::experiment_file::Data::FrequencyResponse {
-            phase_rad: Some(_),
-            ..
-        }
-    )
 }
 
 /// What a whole curve determines: table over motor, the drive stiffnesses and, with
@@ -102,7 +82,7 @@ fn curve_determines(exp: &Experiment, p: &Params) -> Vec<&'static str> {
         (Response::TableOverMotor, _) => Vec::new(),
     };
     out.extend(drive_stiffnesses(p));
-    if has_phase(exp) {
+    if measured::has_phase(exp) {
         out.push("Ciw");
         if p.cig.is_some() {
             out.push("Cig");

@@ -4,7 +4,8 @@
 //! objectives of different units add up in one weighted least-squares cost (χ²-like,
 //! ~1 per point at a perfect fit to noisy data). One objective per file, each with its
 //! [`Definition`] (name, the experiments it reads, its properties, what it determines,
-//! how it is built), listed once in [`registry::REGISTRY`]:
+//! how it is built), listed once in [`registry::REGISTRY`] (the types a definition is made of are
+//! [`definition`]'s, apart from the list):
 //!
 //! - [`resonance`]: relative error of the resonance frequencies;
 //! - [`peak_amplitude`]: dB error of the resonance peak heights;
@@ -23,10 +24,11 @@
 //! `DEFINITION`) and one line in [`registry::REGISTRY`].
 
 pub mod complex_response;
+pub mod definition;
 pub mod friction_map;
 pub mod gain_curve;
 pub mod joint;
-pub mod measured;
+pub mod measured_peaks;
 pub mod model_peaks;
 pub mod peak_amplitude;
 pub mod registry;
@@ -41,8 +43,8 @@ use crate::io::experiment_file::Direction;
 use crate::model::{ParamError, Params};
 use crate::sim::SimError;
 
+pub use definition::{Definition, Estimated, ObjectiveKind, SetupError, Source, Stage};
 pub use joint::Joint;
-pub use registry::{Definition, Estimated, ObjectiveKind, SetupError, Source, Stage};
 
 /// What the model's frequency response is computed with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -8,11 +8,12 @@
 //! has ζ ≈ 7.5e-5 (0.025 Hz half-power width): a measurement on a 1 Hz grid
 //! under-estimates such a peak by tens of dB, so compare like with like.
 
-use super::gain_curve::fits_whole_curve;
+use super::definition::{Definition, SetupError, Source, Stage};
+use super::measured_peaks::measured_peaks;
 use super::model_peaks::ModelPeaks;
-use super::registry::{Definition, SetupError, Source, Stage};
-use super::{measured, Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
+use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::estimation::peaks::Peak;
+use crate::experiments::frequency_response::measured::{self, fits_whole_curve};
 use crate::experiments::frequency_response::FrequencyTest;
 use crate::io::experiment_file::Kind;
 use crate::model::Params;
@@ -52,7 +53,7 @@ pub static DEFINITION: Definition = Definition {
 };
 
 fn build(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, SetupError> {
-    let peaks = measured::peaks(source)?;
+    let peaks = measured_peaks(source)?;
     if peaks.iter().any(|p| !p.gain_db.is_finite()) {
         return Err(SetupError::Mismatch {
             file: source.file.into(),

@@ -12,10 +12,11 @@
 //! ascending frequency, against the measured ones in ascending frequency. A measured
 //! peak the model does not have costs a residual of 100 % of its frequency.
 
-use super::gain_curve::fits_whole_curve;
+use super::definition::{Definition, SetupError, Source, Stage};
+use super::measured_peaks::measured_peaks;
 use super::model_peaks::ModelPeaks;
-use super::registry::{Definition, SetupError, Source, Stage};
-use super::{measured, Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
+use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
+use crate::experiments::frequency_response::measured::{self, fits_whole_curve};
 use crate::experiments::frequency_response::FrequencyTest;
 use crate::io::experiment_file::Kind;
 use crate::model::Params;
@@ -51,7 +52,7 @@ pub(super) fn drive_stiffnesses(p: &Params) -> Vec<&'static str> {
 }
 
 fn build(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, SetupError> {
-    let hz = measured::peaks(source)?
+    let hz = measured_peaks(source)?
         .iter()
         .map(|p| p.frequency_hz)
         .collect();

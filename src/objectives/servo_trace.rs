@@ -13,7 +13,7 @@
 //! 140 times below the replay's model error (2 µm), and weighting by it would make
 //! the fit a position-only one; by each signal's RMS both count.
 
-use super::registry::{Definition, Estimated, SetupError, Source};
+use super::definition::{Definition, Estimated, SetupError, Source};
 use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::estimation::inverse_dynamics::IdimSettings;
 use crate::experiments::servo_trace::{replay, ServoTrace, TraceError};

@@ -11,7 +11,7 @@
 //! one Coulomb and one viscous sum. Fit one Coulomb and one viscous parameter (the
 //! rest fixed), or expect the identifiability warning.
 
-use super::registry::{Definition, SetupError, Source};
+use super::definition::{Definition, SetupError, Source};
 use super::{Detail, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::torque_curve::{
     from_data, motion_difference, simulate_torque, MotionDifference, TorqueTest,

@@ -22,7 +22,7 @@
 
 use rayon::prelude::*;
 
-use super::registry::{Definition, SetupError, Source};
+use super::definition::{Definition, SetupError, Source};
 use super::{Detail, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::fluctuation::{
     self, locate_step, pass_samples, run_window, FluctuationTest, STEP_LOCATE_HALF_WIDTH,

@@ -213,7 +213,7 @@ fn axis(f: &Factor, v: f64) -> f64 {
 }
 
 fn axis_label(f: &Factor) -> String {
-    let unit = crate::model::params::spec(&f.name).map_or("", |s| s.unit);
+    let unit = crate::model::spec(&f.name).map_or("", |s| s.unit);
     match f.scale {
         Scale::Lin => format!("{} ({unit})", f.name),
         Scale::Log => format!("log10 {} ({unit})", f.name),

@@ -31,7 +31,7 @@ use ndarray::Array2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::params::{self, Params};
+use crate::model::{registry, Params};
 pub use designs::{Design, DesignError, Method};
 pub use outputs::{Evaluator, Output, TestLength};
 pub use spec::{Factor, Scale, SpecError};
@@ -60,7 +60,7 @@ pub enum SweepError {
     #[error(transparent)]
     Stream(#[from] StreamError),
     #[error(transparent)]
-    Params(#[from] params::ParamError),
+    Params(#[from] crate::model::ParamError),
     #[error("{path}: the `# config` line does not describe a sweep: {reason}")]
     Config { path: String, reason: String },
     #[error("no output requested: give --outputs, e.g. resonances,peak_gain")]
@@ -98,7 +98,7 @@ pub(crate) fn unit_suffix(unit: &str) -> String {
 
 /// A factor's CSV column: its name and unit (`Kw_nm_per_rad`, `theta_bw_rad`, `Rw`).
 pub(crate) fn factor_column(name: &str) -> String {
-    match params::spec(name).map(|s| unit_suffix(s.unit)) {
+    match registry::spec(name).map(|s| unit_suffix(s.unit)) {
         Ok(suffix) if !suffix.is_empty() => format!("{name}_{suffix}"),
         _ => name.to_string(),
     }
@@ -149,9 +149,9 @@ impl Sweep {
         self.factors
             .iter()
             .map(|f| {
-                let spec = params::spec(&f.name)?;
+                let spec = registry::spec(&f.name)?;
                 spec.get(&self.params).ok_or(SweepError::Params(
-                    params::ParamError::NotApplicable { name: spec.name },
+                    crate::model::ParamError::NotApplicable { name: spec.name },
                 ))
             })
             .collect()
@@ -191,7 +191,7 @@ impl Sweep {
     }
 
     /// The parameter set at design point `values`.
-    pub(crate) fn params_at(&self, values: &[f64]) -> Result<Params, params::ParamError> {
+    pub(crate) fn params_at(&self, values: &[f64]) -> Result<Params, crate::model::ParamError> {
         let mut p = self.params.clone();
         for (f, &v) in self.factors.iter().zip(values) {
             p.set(&f.name, v)?;

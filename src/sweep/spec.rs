@@ -10,7 +10,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::model::params::{self, Params, PARAMS};
+use crate::model::registry::{self, PARAMS};
+use crate::model::Params;
 
 /// Grid levels of a parameter whose specification gives none.
 pub const DEFAULT_LEVELS: usize = 5;
@@ -66,7 +67,7 @@ pub enum SpecError {
     Bound {
         spec: String,
         #[source]
-        source: params::ParamError,
+        source: crate::model::ParamError,
     },
 }
 
@@ -129,7 +130,7 @@ pub fn parse(spec: &str, base: &Params) -> Result<Factor, SpecError> {
         Some((n, r)) => (n.trim(), Some(r.trim())),
         None => (spec.trim(), None),
     };
-    let registered = params::spec(name).map_err(|_| SpecError::UnknownParameter {
+    let registered = registry::spec(name).map_err(|_| SpecError::UnknownParameter {
         spec: spec.to_string(),
         name: name.to_string(),
         known: PARAMS.iter().map(|s| s.name).collect::<Vec<_>>().join(", "),
@@ -138,7 +139,7 @@ pub fn parse(spec: &str, base: &Params) -> Result<Factor, SpecError> {
     let Some(rest) = rest else {
         let v = base_value.ok_or_else(|| SpecError::Bound {
             spec: spec.to_string(),
-            source: params::ParamError::NotApplicable {
+            source: crate::model::ParamError::NotApplicable {
                 name: registered.name,
             },
         })?;

@@ -7,11 +7,11 @@ use anyhow::{bail, Context};
 use super::check;
 use super::Common;
 use crate::cli::common::progress;
+use rtid::experiments::frequency_response::measured;
 use rtid::experiments::frequency_response::{self as fr, modal, FrequencyTest, Point};
 use rtid::experiments::measurement_noise;
 use rtid::io::experiment_file::{Data, Delay, Experiment, Manifest, Response, ResponseForm};
 use rtid::objectives::complex_response::wrap;
-use rtid::objectives::measured;
 
 pub const LONG_ABOUT: &str = "\
 Frequency response (paper §4.1): open loop, the motor driven by a sinusoidal torque \

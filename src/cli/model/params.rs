@@ -6,7 +6,7 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::ModelArgs;
 use rtid::io::params_file;
-use rtid::model::params::PARAMS;
+use rtid::model::PARAMS;
 
 pub const LONG_ABOUT: &str = "\
 Lists every parameter of a mechanism with its value, SI unit and meaning, and the notes on \

@@ -27,6 +27,7 @@
 //! each mesh is out of contact (inside its gap) is reported. Where it is not zero the
 //! table rattles in the gap and the "gain" is not a property of the drive.
 
+pub mod measured;
 pub mod modal;
 pub mod periodic_evaluation;
 mod record;

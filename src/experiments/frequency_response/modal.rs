@@ -30,9 +30,9 @@
 use rustfft::num_complex::Complex;
 use serde::Serialize;
 
+use super::measured::{ComplexPoints, DB_PER_NEPER, PROMINENCE_DB};
 use crate::estimation::local_mode_fit::{fit, ModeFitOptions, SecondOrder};
 use crate::estimation::peaks::{self, Peak};
-use crate::objectives::measured::{ComplexPoints, DB_PER_NEPER, PROMINENCE_DB};
 
 /// One resonance of a complex frequency response.
 #[derive(Clone, Debug, PartialEq, Serialize)]

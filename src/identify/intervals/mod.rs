@@ -3,6 +3,7 @@
 //! the residual block bootstrap ([`resample`]).
 
 pub mod profile;
+pub mod request;
 pub mod resample;
 pub mod surface;
 pub mod uncertainty;

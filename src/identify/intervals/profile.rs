@@ -35,12 +35,10 @@ use crate::identify::search::search;
 use crate::identify::search::settings::Settings;
 use crate::identify::space::{Bound, ParamSpace};
 use crate::model::Params;
-use crate::objectives::{sum_of_squares, Objective, ObjectiveError, Smoothness};
+use crate::objectives::{sum_of_squares, ObjectiveError, Smoothness};
 
-/// The confidence level of the intervals.
-pub const LEVEL: f64 = 0.95;
-/// χ²₁ at [`LEVEL`]: the likelihood-ratio statistic at an interval's end.
-pub const THRESHOLD: f64 = 3.841_458_820_694_124;
+pub use super::request::{Request, LEVEL, THRESHOLD};
+
 /// Points of one walk, at most (refinements of the crossing included).
 const MAX_POINTS: usize = 16;
 /// Refinements of an interval's end once the walk has crossed it: regula falsi,
@@ -59,26 +57,6 @@ pub const EXACT_RMS: f64 = 1e-4;
 /// A profile point improves on the fit when it lowers the statistic by more than
 /// this (less is the search's tolerance, not a missed optimum).
 const BETTER_BY: f64 = 0.5;
-
-/// What is profiled and how each point is fitted.
-pub struct Request<'a> {
-    /// The fit's result and identified parameter set.
-    pub result: &'a IdentifyResult,
-    pub params: &'a Params,
-    /// The objective the result minimises and the search's settings
-    /// ([`crate::identify::run::Identified`]).
-    pub objective: &'a dyn Objective,
-    pub settings: Settings,
-    /// How the objective's cost varies: a rough one ([`Smoothness::Rough`] or
-    /// [`Smoothness::Grainy`]) is profiled on a bowl fitted to it ([`super::surface`]).
-    pub smoothness: Smoothness,
-    /// The parameters to profile (fitted ones).
-    pub names: Vec<String>,
-    /// Asked between points whether to stop (Ctrl-C).
-    pub stop: &'a (dyn Fn() -> bool + Sync),
-    /// Called after each fitted point (progress).
-    pub on_point: &'a (dyn Fn() + Sync),
-}
 
 /// Why profiles cannot be computed.
 #[derive(Debug, thiserror::Error)]

@@ -30,7 +30,7 @@ use nalgebra::{DMatrix, DVector};
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use rayon::prelude::*;
 
-use crate::identify::intervals::profile::{Request, LEVEL, THRESHOLD};
+use super::request::{Request, LEVEL, THRESHOLD};
 use crate::identify::intervals::resample::block_length;
 use crate::identify::result::profile::{Profile, Surface, Variance};
 use crate::identify::space::Bound;

@@ -21,6 +21,7 @@
 use rayon::prelude::*;
 
 use crate::estimation::peaks::vertex;
+use crate::experiments::frequency_response::measured::{self, fits_whole_curve};
 use crate::experiments::frequency_response::{simulate_point, FrequencyTest};
 use crate::identify::config::Config;
 use crate::identify::error::IdentifyError;
@@ -29,10 +30,10 @@ use crate::identify::result::NonlinearCheck;
 use crate::io::experiment_file::Experiment;
 use crate::model::linear_response::{Channel, LinearResponse};
 use crate::model::Params;
-use crate::objectives::gain_curve::fits_whole_curve;
+use crate::objectives::measured_peaks::measured_peaks;
 use crate::objectives::model_peaks::nonlinear_peak_on_grid;
 use crate::objectives::model_peaks::GRID_BAND;
-use crate::objectives::{measured, sum_of_squares, ObjectiveError, Source};
+use crate::objectives::{sum_of_squares, ObjectiveError, Source};
 
 /// The relative miss of a resonance (nonlinear test at the linear fit against the
 /// measurement) beyond which `auto` goes on to the nonlinear fit.
@@ -105,7 +106,7 @@ fn resolved_peaks(
     p: &Params,
     test: &FrequencyTest,
 ) -> Result<Vec<f64>, IdentifyError> {
-    let peaks: Vec<f64> = measured::peaks(source)?
+    let peaks: Vec<f64> = measured_peaks(source)?
         .iter()
         .map(|pk| pk.frequency_hz)
         .collect();

@@ -5,12 +5,13 @@
 use std::f64::consts::TAU;
 
 use super::curve;
+use crate::experiments::frequency_response::measured;
 use crate::identify::result::comparison::{Comparison, Curve, Role};
 use crate::io::experiment_file::{Experiment, Response};
 use crate::model::linear_response::{Channel, LinearResponse};
 use crate::model::Params;
 use crate::objectives::complex_response::unwrap;
-use crate::objectives::{gain_curve, measured, Detail, Fidelity, Source};
+use crate::objectives::{gain_curve, Detail, Fidelity, Source};
 
 /// Points of the model's curve over the measured frequency range.
 const CURVE_POINTS: usize = 600;

@@ -1,15 +1,16 @@
-//! What a measured experiment says, as the objectives read it: its resonances (the
-//! manifest's, or the prominent peaks of its gain curve), the frequencies it was
-//! measured at, and the conditions of the test the model must reproduce.
+//! What a measured frequency-response experiment says, as the model is compared with
+//! it: the lines that are measurements of the drive (inside its band, above the
+//! encoder's resolution), the gain as the drive's ratio, its complex response with
+//! each line's noise, the frequencies it was measured at, and the conditions of the
+//! test the model must reproduce. Read by the objectives, the identification's checks
+//! and the modal fit alike.
 
-use super::registry::{SetupError, Source};
-use crate::estimation::peaks::{self, Peak};
-use crate::experiments::frequency_response::FrequencyTest;
+use super::FrequencyTest;
 use crate::io::experiment_file::{Data, Delay, Experiment, Kind, Response, ResponseForm};
 
 /// A local maximum of a measured gain curve counts as a resonance when it stands
 /// this far above the lowest point between it and any higher point (or the curve's
-/// end) on each side — its topographic prominence ([`peaks::prominent`]).
+/// end) on each side — its topographic prominence ([`crate::estimation::peaks::prominent`]).
 /// Measurement noise makes many small maxima; a friction-damped worm resonance may
 /// stand only ~1.6 dB out.
 pub const PROMINENCE_DB: f64 = 1.0;
@@ -25,64 +26,13 @@ pub fn frequency_test(exp: &Experiment) -> FrequencyTest {
     }
 }
 
-/// The measured resonances of an experiment: the manifest's peaks, or the prominent
-/// peaks of the gain curve ([`PROMINENCE_DB`]), inside its band when it has one.
-/// Heights are NaN where not given.
-pub fn peaks(source: &Source<'_>) -> Result<Vec<Peak>, SetupError> {
-    match &source.experiment.data {
-        Data::Resonance {
-            peaks_hz,
-            peak_gain_db,
-        } => Ok(peaks_hz
-            .iter()
-            .enumerate()
-            .map(|(k, &f)| Peak {
-                frequency_hz: f,
-                gain_db: peak_gain_db
-                    .as_ref()
-                    .and_then(|g| g.get(k))
-                    .copied()
-                    .unwrap_or(f64::NAN),
-            })
-            .filter(|pk| in_band(source.experiment, pk.frequency_hz))
-            .collect()),
-        Data::FrequencyResponse { .. }
-            if form(source.experiment).response != Response::TableOverMotor =>
-        {
-            Err(SetupError::Data {
-                file: source.file.into(),
-                reason: format!(
-                    "a {} response's peaks are not the motor-held resonances the \
-                     resonance objectives compare: it is fitted by its whole curve \
-                     (--objective gain_curve, the default)",
-                    form(source.experiment).response.name()
-                ),
-            })
-        }
-        Data::FrequencyResponse { .. } => {
-            let curve: Vec<(f64, f64)> = valid_points(source.experiment).collect();
-            let found = peaks::prominent(&curve, None, PROMINENCE_DB);
-            if found.is_empty() {
-                return Err(SetupError::NoPeaks {
-                    file: source.file.into(),
-                });
-            }
-            Ok(found)
-        }
-        _ => Err(SetupError::Unsupported {
-            file: source.file.into(),
-            kind: source.kind().name(),
-        }),
-    }
-}
-
 /// The band of an experiment's resonances (`conditions.band_hz`), Hz.
 pub fn band(exp: &Experiment) -> Option<(f64, f64)> {
     exp.manifest.conditions.band_hz.map(|[lo, hi]| (lo, hi))
 }
 
 /// Whether `hz` lies in the experiment's band (always, without one).
-fn in_band(exp: &Experiment, hz: f64) -> bool {
+pub fn in_band(exp: &Experiment, hz: f64) -> bool {
     band(exp).map_or(true, |(lo, hi)| lo <= hz && hz <= hi)
 }
 
@@ -210,4 +160,26 @@ pub fn grid(exp: &Experiment) -> Option<Vec<f64>> {
     let mut f: Vec<f64> = valid_points(exp).map(|(f, _)| f).collect();
     f.sort_by(f64::total_cmp);
     Some(f)
+}
+
+/// Whether a frequency response is fitted by its whole curve by default rather than
+/// by its resonances: where it has phase (the complex curve says which damping belongs
+/// to which mesh; the peaks alone fix the stiffnesses only roughly when the damping is
+/// unknown), or where it is not table over motor (a compliance's peaks are not the
+/// motor-held modes the resonance objectives compare). A gain-only table over motor
+/// feeds its resonances; `--objective gain-curve` fits its whole curve.
+pub fn fits_whole_curve(exp: &Experiment) -> bool {
+    exp.manifest.kind == Kind::FrequencyResponse
+        && (has_phase(exp) || form(exp).response != Response::TableOverMotor)
+}
+
+/// Whether a frequency-response file has a phase column.
+pub fn has_phase(exp: &Experiment) -> bool {
+    matches!(
+        exp.data,
+        Data::FrequencyResponse {
+            phase_rad: Some(_),
+            ..
+        }
+    )
 }
