@@ -9,7 +9,7 @@
 //! rigid body of `direct_drive`.
 
 use super::backlash::{dead_zone, mesh_torque};
-use super::friction::Stribeck;
+use super::friction::DriveFriction;
 use super::params::{ParamError, Params, Topology, GRAVITY};
 
 /// Index of each state in the kernel's state vector. Slots a topology does not
@@ -71,9 +71,9 @@ pub struct Drive {
     pub(crate) ciw: f64,
     /// Coulomb friction of motor, shaft, table (direct: motor includes the shaft's).
     pub(crate) fc: [f64; 3],
-    /// The Stribeck law of motor, shaft, table (friction.rs); `None` for the Coulomb
-    /// law of the paper, which the kernel then runs on a path without it.
-    pub(crate) stribeck: Option<Stribeck>,
+    /// The friction law of motor, shaft, table (friction/): the paper's Coulomb
+    /// levels `fc`, or another law; the kernel runs each law's own path.
+    pub(crate) friction: DriveFriction,
     pub(crate) kg: f64,
     pub(crate) kw: f64,
     pub(crate) kb: f64,
@@ -128,7 +128,7 @@ impl Drive {
             cig: p.cig.unwrap_or(0.0),
             ciw: p.ciw,
             fc: [fm, if spur { p.fw } else { 0.0 }, p.ft],
-            stribeck: Stribeck::of(p, [fm, if spur { p.fw } else { 0.0 }, p.ft]),
+            friction: DriveFriction::of(p, [fm, if spur { p.fw } else { 0.0 }, p.ft]),
             kg: p.kg.unwrap_or(0.0),
             kw: p.kw,
             kb: p.kb,
@@ -188,12 +188,14 @@ impl Drive {
     }
 
     /// The friction torque of each body (motor, shaft, table) sliding at `speed`
-    /// (rad/s or m/s, positive), N·m (N): the Coulomb level, or the Stribeck curve.
+    /// (rad/s or m/s, positive), N·m (N): the Coulomb level, or the drive's law.
     pub fn sliding_friction(&self, body: usize, speed: f64) -> f64 {
-        match &self.stribeck {
-            Some(law) => law.level(body, speed.abs()),
-            None => self.fc[body],
-        }
+        self.friction.sliding(body, speed.abs())
+    }
+
+    /// The drive's friction law.
+    pub fn friction_law(&self) -> &DriveFriction {
+        &self.friction
     }
 
     /// Total mechanical energy (kinetic + mesh and bearing springs + unbalance

@@ -18,9 +18,10 @@
 //! Jt·ωt' = Tw − Ct·ωt − m·g·e·sin(θt + ψ) + Tload − friction_t
 //! ```
 //!
-//! Friction is the stick/slip clamp of friction.rs: Coulomb levels, or a Stribeck
-//! law whose level is evaluated at each stage's velocity (the kernel is compiled for
-//! both, `S`, and the drive picks one outside the step loop). Tload is the lane's external
+//! Friction is the stick/slip clamp of `friction/clamp.rs` with the drive's law
+//! (`friction/`): Coulomb levels, or a law whose level is evaluated at each stage's
+//! velocity, such as Stribeck's (the kernel is generic over the [`FrictionLaw`] and
+//! the drive picks its law outside the step loop). Tload is the lane's external
 //! table torque, which includes the drive's constant `Tload` parameter (added by
 //! the caller, see [`Kernel::step`]).
 //!
@@ -35,7 +36,7 @@
 //! **Lanes.** The common path of a step has no per-lane control flow: the dead
 //! zones, the contact clamp, the friction decision and the stop at a velocity
 //! reversal are selects between values computed for every lane (backlash.rs,
-//! friction.rs, lanes.rs), so the compiler vectorises the `L` lanes. What is rare
+//! friction/clamp.rs, lanes.rs), so the compiler vectorises the `L` lanes. What is rare
 //! is taken out of line, and only when some lane needs it: the library `sin_cos` of
 //! the fluctuation phase (every 1024 steps, or after a jump), and the re-integration
 //! of a step split at a contact event (2.8 % of worm steps at ±5 N·m), which is done
@@ -63,10 +64,10 @@
 
 use super::backlash::mesh_torque_lanes;
 use super::drive::{idx::*, taylor_sin_cos, Drive, NSTATE, PHASE_RESYNC, SMALL_ANGLE};
-use super::friction::Stribeck;
-use super::friction::{
+use super::friction::clamp::{
     decide_direction_lanes, decide_lanes, stop_at_reversal, stop_at_reversal_lanes, Friction,
 };
+use super::friction::{with_law, FrictionLaw};
 use super::lanes::Lanes;
 
 /// The state of `L` lanes: `y[i][l]` is state `i` (see [`idx`](super::drive::idx)) of lane `l`.
@@ -159,21 +160,18 @@ impl<const L: usize> LaneState<L> {
     }
 
     /// Decides the friction of body `b` (inverse inertia `inv_j`) from the sum `t`
-    /// of its other torques and its velocity `w`: with the Coulomb level (`S` false)
-    /// its torque for the whole step, with the Stribeck law its direction.
+    /// of its other torques and its velocity `w`: with a constant level (Coulomb)
+    /// its torque for the whole step, with another law its direction.
     #[inline(always)]
-    fn decide<const S: bool>(&mut self, d: &Drive, b: usize, t: Lanes<L>, w: Lanes<L>, inv_j: f64) {
-        let free = match (S, &d.stribeck) {
-            (true, Some(law)) => {
-                let (direction, free) = decide_direction_lanes(t, w, law.fs[b]);
-                self.direction[b] = direction.0;
-                free
-            }
-            _ => {
-                let (torque, free) = decide_lanes(t, w, d.fc[b]);
-                self.friction[b] = torque.0;
-                free
-            }
+    fn decide<F: FrictionLaw>(&mut self, law: &F, b: usize, t: Lanes<L>, w: Lanes<L>, inv_j: f64) {
+        let free = if F::CONSTANT_LEVEL {
+            let (torque, free) = decide_lanes(t, w, law.breakaway(b));
+            self.friction[b] = torque.0;
+            free
+        } else {
+            let (direction, free) = decide_direction_lanes(t, w, law.breakaway(b));
+            self.direction[b] = direction.0;
+            free
         };
         self.free[b] = free.0;
         self.gain[b] = (free * inv_j).0;
@@ -181,15 +179,14 @@ impl<const L: usize> LaneState<L> {
 
     /// The acceleration of body `b` at velocity `w` under the other torques `t`:
     /// (t − friction)/J, 0 while stuck. (free ∈ {0, 1}, so this equals
-    /// ((t − friction)·free)/J exactly.) With the Stribeck law (`S`) the friction's
-    /// level is that of `w`.
+    /// ((t − friction)·free)/J exactly.) With a law whose level varies the
+    /// friction's level is that of `w`.
     #[inline(always)]
-    fn accel<const S: bool>(&self, d: &Drive, b: usize, t: Lanes<L>, w: Lanes<L>) -> Lanes<L> {
-        let friction = match (S, &d.stribeck) {
-            (true, Some(law)) => {
-                Lanes(self.direction[b]).zip(w, |sign, w| sign * law.level(b, w.abs()))
-            }
-            _ => Lanes(self.friction[b]),
+    fn accel<F: FrictionLaw>(&self, law: &F, b: usize, t: Lanes<L>, w: Lanes<L>) -> Lanes<L> {
+        let friction = if F::CONSTANT_LEVEL {
+            Lanes(self.friction[b])
+        } else {
+            Lanes(self.direction[b]).zip(w, |sign, w| sign * law.sliding(b, w.abs()))
         };
         (t - friction) * Lanes(self.gain[b])
     }
@@ -350,6 +347,29 @@ impl<const L: usize> Kernel<L> {
         }
     }
 
+    /// [`Kernel::step`] with a friction law of the caller's in place of the drive's
+    /// own ([`Drive::friction_law`]): a law under development runs through the same
+    /// clamp, integrator and events before it has its
+    /// [`DriveFriction`](super::friction::DriveFriction) variant
+    /// (`model/friction/tests.rs` runs one). `step` is this with the drive's law.
+    pub fn step_with_law<F: FrictionLaw>(
+        &mut self,
+        d: &Drive,
+        law: &F,
+        y: &mut States<L>,
+        motor: &[[f64; L]; 3],
+        load: &[f64; L],
+        h: f64,
+    ) {
+        if d.form == crate::model::drive::Form::Rigid {
+            rigid_rk4(d, law, &mut self.lanes, y, motor, load, h);
+        } else if d.spur {
+            self.step_with_events::<true, F>(d, law, y, motor, load, h);
+        } else {
+            self.step_with_events::<false, F>(d, law, y, motor, load, h);
+        }
+    }
+
     /// [`Kernel::step`] for a drive with meshes (`spur_gear`, `direct`, `two_mass`).
     /// A loop over steps of one drive calls this (or [`Kernel::step_rigid`]) directly,
     /// the choice made once outside the loop: with the rigid form's branch inside the
@@ -364,12 +384,11 @@ impl<const L: usize> Kernel<L> {
         load: &[f64; L],
         h: f64,
     ) {
-        match (d.spur, d.stribeck.is_some()) {
-            (true, false) => self.step_with_events::<true, false>(d, y, motor, load, h),
-            (false, false) => self.step_with_events::<false, false>(d, y, motor, load, h),
-            (true, true) => self.step_with_events::<true, true>(d, y, motor, load, h),
-            (false, true) => self.step_with_events::<false, true>(d, y, motor, load, h),
-        }
+        with_law!(&d.friction, law => if d.spur {
+            self.step_with_events::<true, _>(d, law, y, motor, load, h)
+        } else {
+            self.step_with_events::<false, _>(d, law, y, motor, load, h)
+        })
     }
 
     /// [`Kernel::step`] for the single rigid body of `direct_drive`.
@@ -382,11 +401,7 @@ impl<const L: usize> Kernel<L> {
         load: &[f64; L],
         h: f64,
     ) {
-        if d.stribeck.is_some() {
-            rigid_rk4::<L, true>(d, &mut self.lanes, y, motor, load, h);
-        } else {
-            rigid_rk4::<L, false>(d, &mut self.lanes, y, motor, load, h);
-        }
+        with_law!(&d.friction, law => rigid_rk4(d, law, &mut self.lanes, y, motor, load, h));
     }
 
     /// Whether motor, shaft and table of lane `l` were stuck during the last step.
@@ -405,16 +420,26 @@ impl<const L: usize> Kernel<L> {
     }
 
     #[inline(always)]
-    fn step_with_events<const SPUR: bool, const S: bool>(
+    fn step_with_events<const SPUR: bool, F: FrictionLaw>(
         &mut self,
         d: &Drive,
+        law: &F,
         y: &mut States<L>,
         motor: &[[f64; L]; 3],
         load: &[f64; L],
         h: f64,
     ) {
         let y0 = *y;
-        rk4::<L, SPUR, S>(d, &mut self.lanes, &y0, y, motor, load, Lanes::splat(h));
+        rk4::<L, SPUR, F>(
+            d,
+            law,
+            &mut self.lanes,
+            &y0,
+            y,
+            motor,
+            load,
+            Lanes::splat(h),
+        );
         let gaps = [SPUR && d.bg > 0.0, d.bw > 0.0];
         if !(gaps[0] || gaps[1]) {
             return;
@@ -447,7 +472,7 @@ impl<const L: usize> Kernel<L> {
             changed |= region_changed(Lanes(st.twist[1]), twist[1], d.bw);
         }
         if changed {
-            self.resolve_events::<SPUR, S>(d, &y0, y, motor, load, h, &twist, &rate);
+            self.resolve_events::<SPUR, F>(d, law, &y0, y, motor, load, h, &twist, &rate);
         }
     }
 
@@ -455,9 +480,10 @@ impl<const L: usize> Kernel<L> {
     #[cold]
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
-    fn resolve_events<const SPUR: bool, const S: bool>(
+    fn resolve_events<const SPUR: bool, F: FrictionLaw>(
         &mut self,
         d: &Drive,
+        law: &F,
         y0: &States<L>,
         y: &mut States<L>,
         motor: &[[f64; L]; 3],
@@ -480,7 +506,7 @@ impl<const L: usize> Kernel<L> {
                 }
             }
             if let Some(s) = earliest.filter(|&s| s > 0.0 && s < 1.0) {
-                self.split_lane::<SPUR, S>(d, y0, y, motor, load, h, l, s);
+                self.split_lane::<SPUR, F>(d, law, y0, y, motor, load, h, l, s);
             }
         }
     }
@@ -489,9 +515,10 @@ impl<const L: usize> Kernel<L> {
     /// `s` of the step, alone (`L = 1`), so that its result does not depend on the
     /// other lanes.
     #[allow(clippy::too_many_arguments)]
-    fn split_lane<const SPUR: bool, const S: bool>(
+    fn split_lane<const SPUR: bool, F: FrictionLaw>(
         &mut self,
         d: &Drive,
+        law: &F,
         y0: &States<L>,
         y: &mut States<L>,
         motor: &[[f64; L]; 3],
@@ -511,9 +538,19 @@ impl<const L: usize> Kernel<L> {
         let m2 = [s, 0.5 * (1.0 + s), 1.0].map(|at| [quadratic(&m, at)]);
         let load = [load[l]];
         let mut mid = part;
-        rk4::<1, SPUR, S>(d, &mut one, &part, &mut mid, &m1, &load, Lanes([s * h]));
-        rk4::<1, SPUR, S>(
+        rk4::<1, SPUR, F>(
             d,
+            law,
+            &mut one,
+            &part,
+            &mut mid,
+            &m1,
+            &load,
+            Lanes([s * h]),
+        );
+        rk4::<1, SPUR, F>(
+            d,
+            law,
             &mut one,
             &mid,
             &mut part,
@@ -607,7 +644,7 @@ fn unbalance_torque(d: &Drive, table_angle: f64) -> f64 {
 /// Jt·ωt' = Tm − Ct·ωt − friction_t − m·g·e·sin(θt + ψ) + Tload
 /// ```
 ///
-/// with the stick/slip decision of friction.rs at the step's first stage and the stop
+/// with the stick/slip decision of friction/clamp.rs at the step's first stage and the stop
 /// at a velocity reversal, as for the table of the other forms. No mesh, so no
 /// contact events. Written lane by lane with the scalar friction law, out of line:
 /// built from the lane-wise helpers of the other forms, its mere presence changed how
@@ -615,8 +652,9 @@ fn unbalance_torque(d: &Drive, table_angle: f64) -> f64 {
 /// per step on the roller-gear cam, mostly spills). Each lane is computed alone, so
 /// lanes equal lone runs.
 #[inline(never)]
-fn rigid_rk4<const L: usize, const S: bool>(
+fn rigid_rk4<const L: usize, F: FrictionLaw>(
     d: &Drive,
+    law: &F,
     st: &mut LaneState<L>,
     y: &mut States<L>,
     motor: &[[f64; L]; 3],
@@ -628,7 +666,7 @@ fn rigid_rk4<const L: usize, const S: bool>(
         let m = [motor[0][l], motor[1][l], motor[2][l]];
         let torque = |t: f64, w: f64, m: f64| m - d.ct * w + rigid_unbalance(d, t) + load[l];
         let first = torque(t1, w1, m[0]);
-        let friction = rigid_friction::<S>(d, first, w1);
+        let friction = RigidFriction::decide(law, first, w1);
         let accel = |t: f64, w: f64| friction.net(t, w) * d.inv_jt;
         let a1 = accel(first, w1);
         let (t2, w2) = (t1 + 0.5 * h * w1, w1 + 0.5 * h * a1);
@@ -640,7 +678,7 @@ fn rigid_rk4<const L: usize, const S: bool>(
         let sixth = h * (1.0 / 6.0);
         let angle = t1 + sixth * (w1 + 2.0 * (w2 + w3) + w4);
         let mut speed = w1 + sixth * (a1 + 2.0 * (a2 + a3) + a4);
-        stop_at_reversal(w1, &mut speed, static_level::<S>(d, 2));
+        stop_at_reversal(w1, &mut speed, law.breakaway(2));
         for (pos, vel) in [(THETA_M, OMEGA_M), (THETA_W, OMEGA_W), (THETA_T, OMEGA_T)] {
             y[pos][l] = angle;
             y[vel][l] = speed;
@@ -652,63 +690,52 @@ fn rigid_rk4<const L: usize, const S: bool>(
     }
 }
 
-/// The rigid body's friction over one step: the Coulomb decision, or the Stribeck
-/// direction with the law to evaluate at each stage.
+/// The rigid body's friction over one step: with a constant level (Coulomb) its
+/// torque, else its direction with the law to evaluate at each stage.
 #[derive(Clone, Copy)]
-enum RigidFriction<'a> {
-    Coulomb(Friction),
-    Stribeck {
-        direction: f64,
-        free: f64,
-        law: &'a Stribeck,
-    },
+struct RigidFriction<'a, F> {
+    /// The friction torque (constant level) or its sign (±1, 0 when stuck).
+    torque_or_direction: f64,
+    free: f64,
+    law: &'a F,
 }
 
-impl RigidFriction<'_> {
+impl<'a, F: FrictionLaw> RigidFriction<'a, F> {
+    /// The stick decision from the torque `t` on the body at velocity `w`.
+    #[inline(always)]
+    fn decide(law: &'a F, t: f64, w: f64) -> Self {
+        let (torque_or_direction, free) = if F::CONSTANT_LEVEL {
+            let f = Friction::decide(t, w, law.breakaway(2));
+            (f.torque, f.free)
+        } else {
+            let (direction, free) =
+                decide_direction_lanes(Lanes([t]), Lanes([w]), law.breakaway(2));
+            (direction.0[0], free.0[0])
+        };
+        RigidFriction {
+            torque_or_direction,
+            free,
+            law,
+        }
+    }
+
     /// The net torque at velocity `w` under the other torques `t` (0 while stuck).
     #[inline(always)]
     fn net(self, t: f64, w: f64) -> f64 {
-        match self {
-            RigidFriction::Coulomb(f) => f.net(t),
-            RigidFriction::Stribeck {
-                direction,
-                free,
-                law,
-            } => (t - direction * law.level(2, w.abs())) * free,
+        let torque = if F::CONSTANT_LEVEL {
+            self.torque_or_direction
+        } else {
+            self.torque_or_direction * self.law.sliding(2, w.abs())
+        };
+        Friction {
+            torque,
+            free: self.free,
         }
+        .net(t)
     }
 
     fn free(self) -> f64 {
-        match self {
-            RigidFriction::Coulomb(f) => f.free,
-            RigidFriction::Stribeck { free, .. } => free,
-        }
-    }
-}
-
-/// The rigid body's stick decision from the torque `t` on it at velocity `w`.
-#[inline(always)]
-fn rigid_friction<const S: bool>(d: &Drive, t: f64, w: f64) -> RigidFriction<'_> {
-    match (S, &d.stribeck) {
-        (true, Some(law)) => {
-            let (direction, free) = decide_direction_lanes(Lanes([t]), Lanes([w]), law.fs[2]);
-            RigidFriction::Stribeck {
-                direction: direction.0[0],
-                free: free.0[0],
-                law,
-            }
-        }
-        _ => RigidFriction::Coulomb(Friction::decide(t, w, d.fc[2])),
-    }
-}
-
-/// The level body `b` must exceed to break away: its Coulomb friction, or with the
-/// Stribeck law (`S`) its static friction.
-#[inline(always)]
-fn static_level<const S: bool>(d: &Drive, b: usize) -> f64 {
-    match (S, &d.stribeck) {
-        (true, Some(law)) => law.fs[b],
-        _ => d.fc[b],
+        self.free
     }
 }
 
@@ -733,11 +760,12 @@ fn axpy<const L: usize>(y: &States<L>, a: Lanes<L>, k: &States<L>) -> States<L> 
 }
 
 /// One classical RK4 step of length `h[l]` for each lane from `y0` into `y`, then
-/// the stop of sliding bodies whose velocity reversed (friction.rs). Stage values
+/// the stop of sliding bodies whose velocity reversed (friction/clamp.rs). Stage values
 /// are locals, not fields, so the compiler can keep them in registers.
 #[inline(always)]
-fn rk4<const L: usize, const SPUR: bool, const S: bool>(
+fn rk4<const L: usize, const SPUR: bool, F: FrictionLaw>(
     d: &Drive,
+    law: &F,
     st: &mut LaneState<L>,
     y0: &States<L>,
     y: &mut States<L>,
@@ -747,17 +775,19 @@ fn rk4<const L: usize, const SPUR: bool, const S: bool>(
 ) {
     let half = h.map(|h| 0.5 * h);
     let load = Lanes(*load);
-    let k1 = derivative::<L, SPUR, true, S>(d, y0, Lanes(motor[0]), load, st);
-    let k2 = derivative::<L, SPUR, false, S>(d, &axpy(y0, half, &k1), Lanes(motor[1]), load, st);
-    let k3 = derivative::<L, SPUR, false, S>(d, &axpy(y0, half, &k2), Lanes(motor[1]), load, st);
-    let k4 = derivative::<L, SPUR, false, S>(d, &axpy(y0, h, &k3), Lanes(motor[2]), load, st);
+    let k1 = derivative::<L, SPUR, true, F>(d, law, y0, Lanes(motor[0]), load, st);
+    let k2 =
+        derivative::<L, SPUR, false, F>(d, law, &axpy(y0, half, &k1), Lanes(motor[1]), load, st);
+    let k3 =
+        derivative::<L, SPUR, false, F>(d, law, &axpy(y0, half, &k2), Lanes(motor[1]), load, st);
+    let k4 = derivative::<L, SPUR, false, F>(d, law, &axpy(y0, h, &k3), Lanes(motor[2]), load, st);
     let sixth = h.map(|h| h * (1.0 / 6.0));
     for i in 0..NSTATE {
         let (a, b, c, e) = (Lanes(k1[i]), Lanes(k2[i]), Lanes(k3[i]), Lanes(k4[i]));
         y[i] = (Lanes(y0[i]) + sixth * (a + 2.0 * (b + c) + e)).0;
     }
     let stop = |y: &States<L>, i: usize, b: usize| {
-        stop_at_reversal_lanes(Lanes(y0[i]), Lanes(y[i]), static_level::<S>(d, b)).0
+        stop_at_reversal_lanes(Lanes(y0[i]), Lanes(y[i]), law.breakaway(b)).0
     };
     y[OMEGA_M] = stop(y, OMEGA_M, 0);
     if SPUR {
@@ -773,8 +803,9 @@ fn rk4<const L: usize, const SPUR: bool, const S: bool>(
 /// (a step's first stage), each body's stick state is decided from the torques at
 /// `y`, and the step-start values are stored in `st` for the later stages.
 #[inline(always)]
-fn derivative<const L: usize, const SPUR: bool, const FIRST: bool, const S: bool>(
+fn derivative<const L: usize, const SPUR: bool, const FIRST: bool, F: FrictionLaw>(
     d: &Drive,
+    law: &F,
     y: &States<L>,
     motor: Lanes<L>,
     load: Lanes<L>,
@@ -807,9 +838,9 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool, const S: bool
     };
     let table = tw - d.ct * wt + unbalance + load;
     if FIRST {
-        st.decide::<S>(d, 2, table, wt, d.inv_jt);
+        st.decide(law, 2, table, wt, d.inv_jt);
     }
-    let at = st.accel::<S>(d, 2, table, wt);
+    let at = st.accel(law, 2, table, wt);
     let ax = (-d.cb * vw - d.kb * xw - tw * d.inv_r) * d.inv_mw;
 
     let mut out = [[0.0; L]; NSTATE];
@@ -824,18 +855,18 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool, const S: bool
         let m = motor - d.cm * wm - d.rg * tg;
         let s = tg - d.cw * ws - lever * tw;
         if FIRST {
-            st.decide::<S>(d, 0, m, wm, d.inv_jm);
-            st.decide::<S>(d, 1, s, ws, d.inv_jw);
+            st.decide(law, 0, m, wm, d.inv_jm);
+            st.decide(law, 1, s, ws, d.inv_jw);
         }
-        out[OMEGA_W] = st.accel::<S>(d, 1, s, ws).0;
+        out[OMEGA_W] = st.accel(law, 1, s, ws).0;
         out[THETA_W] = ws.0;
-        st.accel::<S>(d, 0, m, wm)
+        st.accel(law, 0, m, wm)
     } else {
         let m = motor - d.cm * wm - lever * tw;
         if FIRST {
-            st.decide::<S>(d, 0, m, wm, d.inv_jm);
+            st.decide(law, 0, m, wm, d.inv_jm);
         }
-        let a = st.accel::<S>(d, 0, m, wm);
+        let a = st.accel(law, 0, m, wm);
         out[OMEGA_W] = a.0;
         out[THETA_W] = wm.0;
         a

@@ -7,7 +7,7 @@
 //! ωw = Rg·ω,  ωt = Rg·Rw·ω
 //! ```
 //!
-//! with each body's friction its Coulomb level or Stribeck curve (friction.rs) against
+//! with each body's friction its Coulomb level or Stribeck curve (model/friction/) against
 //! the motion. The gear fluctuation's lever and the unbalance average out over whole
 //! revolutions, which is what the virtual experiment averages over for the fluctuation
 //! (run.rs); the table's unbalance does not average out over a partial revolution.

@@ -1,0 +1,98 @@
+//! Friction of the drive's bodies (docs/model.md §2): one stick/slip clamp
+//! ([`clamp`]) and the laws it clamps with, each a [`FrictionLaw`] — the level a body
+//! at rest must exceed to break away, and the level opposing it while it slides.
+//!
+//! - [`Coulomb`]: the paper's law, a constant level `fm`, `fw`, `ft` per body;
+//! - [`Stribeck`]: the Coulomb level plus a rise that falls off with speed (`fsm`,
+//!   `vsm`, … and `stribeck_shape`).
+//!
+//! A drive's parameters compile into one [`DriveFriction`] (the Coulomb law unless a
+//! Stribeck rise is set), and the kernel is generic over the law: it runs each law's
+//! own path, chosen once per step outside the stepping loop, so the Coulomb path of
+//! the paper costs nothing for the others.
+//!
+//! **Adding a law**: one file here with its struct (compiled from [`Params`]) and its
+//! [`FrictionLaw`] impl, a [`DriveFriction`] variant with its arm in
+//! [`with_law`] and in [`DriveFriction::of`] below; its parameters in the registry
+//! (`model/registry.rs`). The kernel, the simulation and every test on the model then
+//! run it unchanged (docs/architecture.md).
+//!
+//! [`Params`]: crate::model::Params
+
+pub(crate) mod clamp;
+mod coulomb;
+mod stribeck;
+#[cfg(test)]
+mod tests;
+
+pub use clamp::Friction;
+pub use coulomb::Coulomb;
+pub use stribeck::Stribeck;
+
+use super::params::Params;
+
+/// A friction law as the kernel applies it to each body (motor 0, shaft 1, table 2).
+/// The clamp is the same for every law: a body at rest sticks while the torque on it
+/// lies within ±[`breakaway`](FrictionLaw::breakaway), and slides against
+/// [`sliding`](FrictionLaw::sliding) at its speed otherwise.
+pub trait FrictionLaw: Copy + Send + Sync {
+    /// Whether the sliding level is the break-away level at every speed (Coulomb): the
+    /// kernel then decides the friction torque once per step, at its first stage,
+    /// instead of evaluating the law at every stage's speed.
+    const CONSTANT_LEVEL: bool;
+
+    /// The level a body at rest must exceed to break away, N·m (N), ≥ 0.
+    fn breakaway(&self, body: usize) -> f64;
+
+    /// The level opposing a body sliding at `speed` ≥ 0, N·m (N), ≥ 0.
+    fn sliding(&self, body: usize, speed: f64) -> f64;
+}
+
+/// `$body` with `$law` bound to the [`FrictionLaw`] of a [`DriveFriction`], one arm per
+/// law: the kernel's dispatch to its generic path.
+macro_rules! with_law {
+    ($friction:expr, $law:ident => $body:expr) => {
+        match $friction {
+            $crate::model::friction::DriveFriction::Coulomb($law) => $body,
+            $crate::model::friction::DriveFriction::Stribeck($law) => $body,
+        }
+    };
+}
+pub(crate) use with_law;
+
+/// The friction law of a drive's bodies, compiled from its parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DriveFriction {
+    Coulomb(Coulomb),
+    Stribeck(Stribeck),
+}
+
+impl DriveFriction {
+    /// The law of `p` with the bodies' Coulomb levels `fc` (as the kernel lumps them:
+    /// the direct topology's motor carries the shaft's): Stribeck where a rise is set,
+    /// else Coulomb.
+    pub(crate) fn of(p: &Params, fc: [f64; 3]) -> Self {
+        match Stribeck::of(p, fc) {
+            Some(law) => DriveFriction::Stribeck(law),
+            None => DriveFriction::Coulomb(Coulomb::new(fc)),
+        }
+    }
+
+    /// The level opposing body `body` sliding at `speed` ≥ 0, N·m (N).
+    pub fn sliding(&self, body: usize, speed: f64) -> f64 {
+        with_law!(self, law => law.sliding(body, speed))
+    }
+
+    /// The level body `body` at rest must exceed to break away, N·m (N).
+    pub fn breakaway(&self, body: usize) -> f64 {
+        with_law!(self, law => law.breakaway(body))
+    }
+
+    /// The law's name: `coulomb`, `stribeck`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            DriveFriction::Coulomb(_) => "coulomb",
+            DriveFriction::Stribeck(_) => "stribeck",
+        }
+    }
+}
