@@ -151,11 +151,23 @@ fn delimited(dir: &Path) -> PathBuf {
 fn bench(c: &mut Criterion) {
     let dir = tempfile::tempdir().unwrap();
     let files = [
-        ("twincat-scope", Format::TwincatScope, twincat(dir.path())),
-        ("epos-studio", Format::EposStudio, epos(dir.path())),
-        ("uff58", Format::Uff, uff(dir.path())),
-        ("mat", Format::Mat, mat(dir.path())),
-        ("delimited", Format::Delimited, delimited(dir.path())),
+        (
+            "twincat-scope",
+            Format::parse("twincat-scope").unwrap(),
+            twincat(dir.path()),
+        ),
+        (
+            "epos-studio",
+            Format::parse("epos-studio").unwrap(),
+            epos(dir.path()),
+        ),
+        ("uff58", Format::parse("uff").unwrap(), uff(dir.path())),
+        ("mat", Format::parse("mat").unwrap(), mat(dir.path())),
+        (
+            "delimited",
+            Format::parse("delimited").unwrap(),
+            delimited(dir.path()),
+        ),
     ];
     let mut group = c.benchmark_group("import");
     group.sample_size(10);

@@ -122,7 +122,7 @@ pub struct Args {
 
 fn parse_format(s: &str) -> Result<Format, String> {
     Format::parse(s).ok_or_else(|| {
-        let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
+        let names: Vec<&str> = Format::all().map(|f| f.name()).collect();
         format!("unknown format `{s}`: expected {}", names.join(", "))
     })
 }

@@ -21,6 +21,13 @@ use super::text::parse_number;
 use super::units::{self, Quantity};
 use super::{Abscissa, Channel, FormatError, Location, Recording, Samples};
 
+/// The format as `--format` names it and [`super::detect`] recognises it.
+pub static DEFINITION: super::format::Definition = super::format::Definition {
+    name: "delimited",
+    sniff: |_| true,
+    read,
+};
+
 /// Reads a delimited text file.
 pub fn read(path: &Path) -> Result<Recording, FormatError> {
     let file = crate::io::open_input(path)

@@ -1,53 +1,32 @@
-//! Which reader reads a file: the one `--format` names, else the one whose signature
-//! the file's first bytes carry, else delimited text.
+//! Which reader reads a file: the one `--format` names, else the first whose
+//! signature the file's first bytes carry, else delimited text. Adding a format is
+//! one module with its `DEFINITION` ([`Definition`]) and one line in [`FORMATS`].
 
 use std::io::Read;
 use std::path::Path;
 
+pub use super::format::{Definition, Format, Head};
 use super::{delimited, epos_studio, mat, twincat_scope, uff, FormatError, Location, Recording};
 
-/// A format rtid reads.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Format {
-    Mat,
-    TwincatScope,
-    EposStudio,
-    Uff,
-    Delimited,
-}
+/// Every format, in the order their signatures are tried; delimited text, which
+/// takes any file, last.
+pub static FORMATS: &[&Definition] = &[
+    &mat::DEFINITION,
+    &twincat_scope::DEFINITION,
+    &epos_studio::DEFINITION,
+    &uff::DEFINITION,
+    &delimited::DEFINITION,
+];
 
 impl Format {
-    pub const ALL: [Format; 5] = [
-        Format::Mat,
-        Format::TwincatScope,
-        Format::EposStudio,
-        Format::Uff,
-        Format::Delimited,
-    ];
-
-    /// As `--format` spells it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Format::Mat => "mat",
-            Format::TwincatScope => "twincat-scope",
-            Format::EposStudio => "epos-studio",
-            Format::Uff => "uff",
-            Format::Delimited => "delimited",
-        }
+    /// Every format, in [`FORMATS`]' order.
+    pub fn all() -> impl Iterator<Item = Format> {
+        FORMATS.iter().map(|d| Format(d))
     }
 
+    /// The format `--format` names `name`.
     pub fn parse(name: &str) -> Option<Format> {
-        Format::ALL.into_iter().find(|f| f.name() == name)
-    }
-
-    fn read(self, path: &Path) -> Result<Recording, FormatError> {
-        match self {
-            Format::Mat => mat::read(path),
-            Format::TwincatScope => twincat_scope::read(path),
-            Format::EposStudio => epos_studio::read(path),
-            Format::Uff => uff::read(path),
-            Format::Delimited => delimited::read(path),
-        }
+        Format::all().find(|f| f.name() == name)
     }
 }
 
@@ -66,15 +45,11 @@ pub fn sniff(path: &Path) -> Result<Format, FormatError> {
         .and_then(|f| f.take(4096).read_to_end(&mut head))
         .map_err(|e| FormatError::new(path, Location::File, format!("cannot read: {e}")))?;
     let first_line = String::from_utf8_lossy(head.split(|&b| b == b'\n').next().unwrap_or(&[]));
-    Ok(if head.starts_with(b"MATLAB") {
-        Format::Mat
-    } else if twincat_scope::sniff(&first_line) {
-        Format::TwincatScope
-    } else if epos_studio::sniff(&first_line) {
-        Format::EposStudio
-    } else if uff::sniff(&head) {
-        Format::Uff
-    } else {
-        Format::Delimited
-    })
+    let head = Head {
+        bytes: &head,
+        first_line: &first_line,
+    };
+    Ok(Format::all()
+        .find(|f| (f.0.sniff)(&head))
+        .unwrap_or(Format(&delimited::DEFINITION)))
 }

@@ -80,6 +80,13 @@ pub fn sniff(first_line: &str) -> bool {
     line.trim_start_matches('"').starts_with("Date:;")
 }
 
+/// The format as `--format` names it and [`super::detect`] recognises it.
+pub static DEFINITION: super::format::Definition = super::format::Definition {
+    name: "epos-studio",
+    sniff: |head| sniff(head.first_line),
+    read,
+};
+
 /// Reads an EPOS Studio data-recorder CSV export.
 pub fn read(path: &Path) -> Result<Recording, FormatError> {
     let file = crate::io::open_input(path)

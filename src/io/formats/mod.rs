@@ -12,6 +12,7 @@
 pub mod delimited;
 pub mod detect;
 pub mod epos_studio;
+pub mod format;
 pub mod mat;
 mod text;
 pub mod twincat_scope;

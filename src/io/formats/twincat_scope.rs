@@ -87,6 +87,13 @@ pub fn sniff(first_line: &str) -> bool {
     !value.trim().is_empty() && (quoted || !value.contains(sep))
 }
 
+/// The format as `--format` names it and [`super::detect`] recognises it.
+pub static DEFINITION: super::format::Definition = super::format::Definition {
+    name: "twincat-scope",
+    sniff: |head| sniff(head.first_line),
+    read,
+};
+
 /// Reads a TwinCAT 3 Scope View CSV export.
 pub fn read(path: &Path) -> Result<Recording, FormatError> {
     let file = crate::io::open_input(path)

@@ -73,6 +73,13 @@ use super::{FormatError, Location, Recording};
 /// The format's name in a [`Recording`].
 pub const FORMAT: &str = "matlab-v5";
 
+/// The format as `--format` names it and [`super::detect`] recognises it.
+pub static DEFINITION: super::format::Definition = super::format::Definition {
+    name: "mat",
+    sniff: |head| head.bytes.starts_with(b"MATLAB"),
+    read,
+};
+
 /// Reads a level 5 MAT-file (compressed or not, either byte order).
 pub fn read(path: &Path) -> Result<Recording, FormatError> {
     let bytes = read_bytes(path)?;

@@ -111,6 +111,13 @@ impl Fault {
     }
 }
 
+/// The format as `--format` names it and [`super::detect`] recognises it.
+pub static DEFINITION: super::format::Definition = super::format::Definition {
+    name: "uff",
+    sniff: |head| sniff(head.bytes),
+    read,
+};
+
 /// Reads the datasets 58 and 58b of a universal file as channels.
 pub fn read(path: &Path) -> Result<Recording, FormatError> {
     let file = crate::io::open_input(path)
