@@ -6,7 +6,7 @@
 
 use std::fmt;
 
-use super::{Fidelity, Objective, Properties};
+use super::{Detail, Fidelity, Objective, Properties};
 use crate::io::experiment_file::{Experiment, Kind};
 use crate::model::{ParamError, Params};
 
@@ -68,6 +68,9 @@ pub struct Definition {
     pub build: Build,
     /// Its direct estimate of where to start, if it has one.
     pub first_estimate: Option<FirstEstimate>,
+    /// Its [`Detail`] in words, for the console (`None`: it has nothing to add to
+    /// the RMS, or the detail is not its own).
+    pub describe: fn(&Detail) -> Option<String>,
 }
 
 /// An objective by name: a handle on its [`Definition`] in the registry.
@@ -108,6 +111,11 @@ impl ObjectiveKind {
             });
         }
         (self.0.build)(source, fidelity)
+    }
+
+    /// Its detail at a result in words ([`Definition::describe`]).
+    pub fn describe(self, detail: &Detail) -> Option<String> {
+        (self.0.describe)(detail)
     }
 
     /// Its direct estimate from one experiment, when it has one and the experiment and

@@ -31,6 +31,7 @@ pub static DEFINITION: Definition = Definition {
     default_weight: |exp, _| (exp.manifest.kind == Kind::FrictionMap).then_some(1.0),
     build,
     first_estimate: Some(direct_fit_start),
+    describe: |_| None,
 };
 
 /// The body whose friction a map at the motor names: the motor's, or the one body of

@@ -38,6 +38,7 @@ pub static DEFINITION: Definition = Definition {
     default_weight: |exp, stage| (stage == Stage::Search && fits_whole_curve(exp)).then_some(1.0),
     build: |source, fidelity| Ok(Box::new(GainCurve::of(source, fidelity, |_| true)?)),
     first_estimate: None,
+    describe: describe,
 };
 
 /// The measured gain within ±[`GRID_BAND`] of each resonance: the peaks' shape,
@@ -58,6 +59,7 @@ pub static NEAR_PEAKS: Definition = Definition {
     },
     build: near_peaks,
     first_estimate: None,
+    describe: describe,
 };
 
 fn near_peaks(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, SetupError> {
@@ -374,4 +376,24 @@ impl Objective for GainCurve {
                 .flatten(),
         })
     }
+}
+
+/// The gain's and phase's RMS errors, and the delay fitted with the model.
+fn describe(d: &Detail) -> Option<String> {
+    let Detail::ComplexResponse {
+        gain_rms_db,
+        phase_rms_deg,
+        fitted_delay_s,
+        ..
+    } = d
+    else {
+        return None;
+    };
+    Some(format!(
+        "  RMS error {gain_rms_db:.3} dB, {phase_rms_deg:.2}°{}",
+        fitted_delay_s.map_or(String::new(), |d| format!(
+            "; delay fitted {:.1} µs",
+            1e6 * d
+        ))
+    ))
 }

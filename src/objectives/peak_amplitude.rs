@@ -9,6 +9,7 @@
 //! under-estimates such a peak by tens of dB, so compare like with like.
 
 use super::definition::{Definition, SetupError, Source, Stage};
+use super::detail::list;
 use super::measured_peaks::measured_peaks;
 use super::model_peaks::ModelPeaks;
 use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
@@ -50,6 +51,7 @@ pub static DEFINITION: Definition = Definition {
     },
     build,
     first_estimate: None,
+    describe: describe,
 };
 
 fn build(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, SetupError> {
@@ -138,4 +140,12 @@ impl Objective for PeakAmplitude {
             error_db: r.iter().map(|x| x * SCALE_DB).collect(),
         })
     }
+}
+
+/// The peak heights' errors.
+fn describe(d: &Detail) -> Option<String> {
+    let Detail::PeakHeights { error_db, .. } = d else {
+        return None;
+    };
+    Some(format!("  errors {} dB", list(error_db, 2)))
 }

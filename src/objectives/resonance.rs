@@ -13,6 +13,7 @@
 //! peak the model does not have costs a residual of 100 % of its frequency.
 
 use super::definition::{Definition, SetupError, Source, Stage};
+use super::detail::list;
 use super::measured_peaks::measured_peaks;
 use super::model_peaks::ModelPeaks;
 use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
@@ -40,6 +41,7 @@ pub static DEFINITION: Definition = Definition {
     },
     build,
     first_estimate: None,
+    describe: describe,
 };
 
 /// The drive stiffnesses: Kw, and Kg where there is a spur stage.
@@ -149,6 +151,23 @@ impl Objective for ResonanceMatch {
             max_miss_hz: max,
         })
     }
+}
+
+/// The measured and model resonances.
+fn describe(d: &Detail) -> Option<String> {
+    let Detail::Resonance {
+        measured_hz,
+        model_hz,
+        ..
+    } = d
+    else {
+        return None;
+    };
+    Some(format!(
+        "  measured {} Hz, model {} Hz",
+        list(measured_hz, 2),
+        list(model_hz, 2)
+    ))
 }
 
 #[cfg(test)]

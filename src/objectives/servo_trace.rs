@@ -37,6 +37,7 @@ pub static DEFINITION: Definition = Definition {
     default_weight: |exp, _| (exp.manifest.kind == Kind::ServoTrace).then_some(1.0),
     build,
     first_estimate: Some(inverse_dynamics_start),
+    describe: describe,
 };
 
 fn determines(p: &Params) -> Vec<&'static str> {
@@ -177,6 +178,21 @@ impl Objective for TraceResidual {
                 * self.position_scale,
         })
     }
+}
+
+/// The replay's simulation error.
+fn describe(d: &Detail) -> Option<String> {
+    let Detail::Trace {
+        force_rms,
+        position_rms,
+        position_max,
+    } = d
+    else {
+        return None;
+    };
+    Some(format!(
+        "  replay: force {force_rms:.4} RMS; position {position_rms:.4e} RMS, {position_max:.4e} max (SI)"
+    ))
 }
 
 #[cfg(test)]

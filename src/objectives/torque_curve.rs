@@ -35,6 +35,7 @@ pub static DEFINITION: Definition = Definition {
     default_weight: |exp, _| (exp.manifest.kind == Kind::TorqueCurve).then_some(1.0),
     build,
     first_estimate: None,
+    describe: describe,
 };
 
 fn build(
@@ -150,4 +151,12 @@ impl Objective for TorqueResidual {
         let rms = (r.iter().map(|x| x * x).sum::<f64>() / n).sqrt() * self.scale_nm;
         Some(Detail::Torque { rms_error_nm: rms })
     }
+}
+
+/// The torque's RMS error.
+fn describe(d: &Detail) -> Option<String> {
+    let Detail::Torque { rms_error_nm } = d else {
+        return None;
+    };
+    Some(format!("  RMS error {rms_error_nm:.4} N·m"))
 }

@@ -23,6 +23,7 @@
 use rayon::prelude::*;
 
 use super::definition::{Definition, SetupError, Source};
+use super::detail::list;
 use super::{Detail, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::fluctuation::{
     self, locate_step, pass_samples, run_window, FluctuationTest, STEP_LOCATE_HALF_WIDTH,
@@ -46,6 +47,7 @@ pub static DEFINITION: Definition = Definition {
     default_weight: |exp, _| (exp.manifest.kind == Kind::Unbalance).then_some(1.0),
     build,
     first_estimate: None,
+    describe: describe,
 };
 
 fn build(
@@ -223,6 +225,27 @@ impl Objective for UnbalanceStep {
             model_step_deg: model,
         })
     }
+}
+
+/// The step angles, measured and model.
+fn describe(d: &Detail) -> Option<String> {
+    let Detail::UnbalanceSteps {
+        measured_step_deg,
+        model_step_deg,
+        ..
+    } = d
+    else {
+        return None;
+    };
+    let model: Vec<String> = model_step_deg
+        .iter()
+        .map(|x| x.map_or("none".into(), |v| format!("{v:.3}")))
+        .collect();
+    Some(format!(
+        "  step angles measured {} °, model {} °",
+        list(measured_step_deg, 3),
+        model.join(", ")
+    ))
 }
 
 #[cfg(test)]

@@ -611,7 +611,9 @@ fn print_summary(r: &IdentifyResult) {
             res.objective,
             res.rms,
             res.scale,
-            res.detail.as_ref().map_or(String::new(), detail)
+            res.detail
+                .as_ref()
+                .map_or(String::new(), |d| detail(&res.objective, d))
         );
     }
     println!(
@@ -667,61 +669,12 @@ fn correlation_table(u: &rtid::identify::result::uncertainty::Uncertainty) -> Ta
     c
 }
 
-/// A residual detail in the measurement's units.
-fn detail(d: &Detail) -> String {
-    let list = |v: &[f64], decimals: usize| {
-        v.iter()
-            .map(|x| format!("{x:.decimals$}"))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    match d {
-        Detail::Resonance {
-            measured_hz,
-            model_hz,
-            ..
-        } => format!(
-            "  measured {} Hz, model {} Hz",
-            list(measured_hz, 2),
-            list(model_hz, 2)
-        ),
-        Detail::PeakHeights { error_db, .. } => format!("  errors {} dB", list(error_db, 2)),
-        Detail::UnbalanceSteps {
-            measured_step_deg,
-            model_step_deg,
-            ..
-        } => {
-            let model: Vec<String> = model_step_deg
-                .iter()
-                .map(|x| x.map_or("none".into(), |v| format!("{v:.3}")))
-                .collect();
-            format!(
-                "  step angles measured {} °, model {} °",
-                list(measured_step_deg, 3),
-                model.join(", ")
-            )
-        }
-        Detail::Torque { rms_error_nm } => format!("  RMS error {rms_error_nm:.4} N·m"),
-        Detail::ComplexResponse {
-            gain_rms_db,
-            phase_rms_deg,
-            fitted_delay_s,
-            ..
-        } => format!(
-            "  RMS error {gain_rms_db:.3} dB, {phase_rms_deg:.2}°{}",
-            fitted_delay_s.map_or(String::new(), |d| format!(
-                "; delay fitted {:.1} µs",
-                1e6 * d
-            ))
-        ),
-        Detail::Trace {
-            force_rms,
-            position_rms,
-            position_max,
-        } => format!(
-            "  replay: force {force_rms:.4} RMS; position {position_rms:.4e} RMS, {position_max:.4e} max (SI)"
-        ),
-    }
+/// A residual detail in the measurement's units, as its objective describes it.
+fn detail(objective: &str, d: &Detail) -> String {
+    ObjectiveKind::named(objective)
+        .ok()
+        .and_then(|k| k.describe(d))
+        .unwrap_or_default()
 }
 
 /// What to change on the command line, for the warnings that have an option.
