@@ -1,9 +1,18 @@
 //! Measurement noise for virtual experiments (seeded, Gaussian), so that fixtures
 //! can stand in for real data: a gain curve's amplitude ratio or a torque record
 //! disturbed by a given percentage, an angle record by a given standard deviation.
+//! The levels given must be finite (the command line checks them): a non-finite one
+//! is the caller's error and panics.
 
 use rand::{rngs::StdRng, SeedableRng};
 use rand_distr::{Distribution, Normal};
+
+/// N(0, σ²).
+fn normal(sigma: f64) -> Normal<f64> {
+    // Invariant: Normal refuses only a non-finite σ, and the levels given are finite
+    // (module docs), as is the RMS of a simulated record.
+    Normal::new(0.0, sigma).expect("a finite σ")
+}
 
 /// Multiplies each gain's amplitude ratio by (1 + ε), ε ~ N(0, (percent/100)²):
 /// adds 20·log10(1 + ε) dB.
@@ -11,7 +20,7 @@ pub fn perturb_gain_db(gain_db: &mut [f64], percent: f64, seed: u64) {
     if percent <= 0.0 {
         return;
     }
-    let normal = Normal::new(0.0, percent / 100.0).expect("finite σ");
+    let normal = normal(percent / 100.0);
     let mut rng = StdRng::seed_from_u64(seed);
     for g in gain_db {
         let e: f64 = normal.sample(&mut rng);
@@ -26,7 +35,7 @@ pub fn perturb_complex(gain_db: &mut [f64], phase_rad: &mut [f64], percent: f64,
     if percent <= 0.0 {
         return;
     }
-    let normal = Normal::new(0.0, percent / 100.0).expect("finite σ");
+    let normal = normal(percent / 100.0);
     let mut rng = StdRng::seed_from_u64(seed);
     for (g, ph) in gain_db.iter_mut().zip(phase_rad.iter_mut()) {
         let (re, im): (f64, f64) = (1.0 + normal.sample(&mut rng), normal.sample(&mut rng));
@@ -41,7 +50,7 @@ pub fn perturb_by_rms(values: &mut [f64], percent: f64, seed: u64) {
         return;
     }
     let rms = (values.iter().map(|v| v * v).sum::<f64>() / values.len() as f64).sqrt();
-    let normal = Normal::new(0.0, percent / 100.0 * rms).expect("finite σ");
+    let normal = normal(percent / 100.0 * rms);
     let mut rng = StdRng::seed_from_u64(seed);
     for v in values {
         *v += normal.sample(&mut rng);
@@ -54,7 +63,7 @@ pub fn perturb_relative(values: &mut [f64], percent: f64, seed: u64) {
     if percent <= 0.0 {
         return;
     }
-    let normal = Normal::new(0.0, percent / 100.0).expect("finite σ");
+    let normal = normal(percent / 100.0);
     let mut rng = StdRng::seed_from_u64(seed);
     for v in values {
         *v *= 1.0 + normal.sample(&mut rng);
@@ -67,7 +76,7 @@ pub fn perturb_absolute(values: &mut [f64], sigma: f64, seed: u64) {
     if sigma <= 0.0 {
         return;
     }
-    let normal = Normal::new(0.0, sigma).expect("finite σ");
+    let normal = normal(sigma);
     let mut rng = StdRng::seed_from_u64(seed);
     for v in values {
         *v += normal.sample(&mut rng);

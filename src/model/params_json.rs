@@ -132,7 +132,11 @@ impl Form {
 
     /// The value of a field with a default (its registry `unused` value).
     fn optional(&self, name: &'static str, given: Option<f64>) -> f64 {
-        given.unwrap_or_else(|| spec(name).expect("registered").unused)
+        given.unwrap_or_else(|| {
+            spec(name)
+                .expect("the file form names registered parameters")
+                .unused
+        })
     }
 
     /// An optional field as written: present where it applies and differs from its

@@ -141,6 +141,8 @@ impl Sweep {
 
     /// The `# config` line's JSON.
     pub fn config(&self) -> String {
+        // Invariant: serde_json fails only on a map with keys other than strings or a
+        // Serialize impl that errs; a sweep has derived impls and string-keyed maps.
         serde_json::to_string(self).expect("a sweep serialises")
     }
 

@@ -121,6 +121,8 @@ pub fn header(config: &str, shard: Option<Shard>, columns: &[String]) -> String 
         h.push_str(&format!("# shard {s}\n"));
     }
     let mut w = csv::Writer::from_writer(Vec::new());
+    // Invariant: one record written to a Vec cannot fail (no I/O, no other record's
+    // length to differ from), and CSV of Strings is UTF-8.
     w.write_record(columns).expect("writing to memory");
     h.push_str(&String::from_utf8(w.into_inner().expect("memory")).expect("UTF-8 names"));
     h

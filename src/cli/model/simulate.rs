@@ -330,7 +330,7 @@ fn drive<W: Write>(
             sim.run_open_loop(&mut input, duration, rec)
         }
         InputSpec::File(_) => {
-            let (t, q) = recorded.expect("read before the run");
+            let (t, q) = recorded.expect("run() reads an --input file before the run");
             sim.run_open_loop(&mut Samples::new(t, q), duration, rec)
         }
         InputSpec::None => sim.run_open_loop(&mut NoTorque, duration, rec),

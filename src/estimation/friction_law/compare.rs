@@ -94,7 +94,8 @@ pub fn fit_all(speed: &[f64], effort: &[f64]) -> Result<Comparison, MapProblem> 
     // always fitted, and the floor keeps every cost positive.
     let selection = information::compare_nested(figures, nesting)
         .expect("the Coulomb law is fitted to every checked map, at a positive cost");
-    let selected = Law::from_name(&selection.candidates[0].label).expect("a law's name");
+    let selected = Law::from_name(&selection.candidates[0].label)
+        .expect("the candidates are labelled with the laws' names");
     Ok(Comparison {
         fits,
         refused,

@@ -331,7 +331,7 @@ pub(crate) fn detect_period(u: &[f64]) -> Result<usize, PeriodicError> {
     }
     let mut lag = (start..=n / 2)
         .find(|&t| rho[t] >= 0.9 * best)
-        .expect("the maximum is in range");
+        .expect("rho = best ≥ 0.9·best at the maximum, which is in range");
     while lag < n / 2 && rho[lag + 1] > rho[lag] {
         lag += 1;
     }

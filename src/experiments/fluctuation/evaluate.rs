@@ -68,7 +68,7 @@ pub fn ratio(exp: &Experiment) -> Result<f64, FluctuationError> {
     let ratio = match (m.conditions.ratio, m.mechanism.as_deref()) {
         (Some(r), _) => r,
         (None, Some(name)) if presets::load(name).is_ok() => {
-            presets::load(name).expect("checked").ratio()
+            presets::load(name).expect("the guard loaded it").ratio()
         }
         (None, mechanism) => {
             return Err(FluctuationError::NoRatio {
@@ -206,7 +206,7 @@ fn mean_spectrum(passes: &[Pass]) -> Spectrum {
                 .cmp(&b.psd.len())
                 .then(a.order[1].total_cmp(&b.order[1]).reverse())
         })
-        .expect("at least one pass");
+        .expect("at least one pass: evaluate refuses a record without");
     let same: Vec<&Spectrum> = passes
         .iter()
         .map(|p| &p.spectrum)

@@ -289,7 +289,7 @@ pub(crate) fn kept_runs(bins: &[Bin]) -> Vec<Vec<(f64, f64)>> {
                 runs.push(Vec::new());
             }
             runs.last_mut()
-                .expect("pushed")
+                .expect("pushed when the run opened")
                 .push((b.frequency_hz, b.gain_db));
         }
         open = b.kept;

@@ -360,7 +360,7 @@ fn multisine_spec(test: &RecordTest, period: f64) -> Option<MultisineSpec> {
 /// One period of a multisine test at unit RMS, sampled every `period` s — which must
 /// divide its period.
 fn multisine_samples(test: &RecordTest, period: f64) -> Result<Vec<f64>, RecordError> {
-    let spec = multisine_spec(test, period).expect("a multisine test");
+    let spec = multisine_spec(test, period).expect("called for a multisine test only");
     let n = spec.samples_per_period as f64 * period;
     let period_s = test.duration() / spec.periods as f64;
     check(
@@ -414,7 +414,7 @@ impl<'a> Sampler<'a> {
                 0.0
             },
             table_quantum: p.controller.table_encoder_resolution,
-            noise: Normal::new(0.0, test.table_noise_rad).expect("σ ≥ 0"),
+            noise: Normal::new(0.0, test.table_noise_rad).expect("validate checked σ finite"),
             rng: rand::rngs::StdRng::seed_from_u64(test.seed),
             record: Record {
                 time: Vec::with_capacity(samples),

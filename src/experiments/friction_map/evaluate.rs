@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use crate::estimation::friction_law::{fit_all, Comparison, Law};
+use crate::estimation::friction_law::{fit_all, Comparison, Law, MapProblem};
 use crate::io::experiment_file::{Axis, FrictionMap};
 
 /// A map's evaluation.
@@ -54,11 +54,11 @@ impl MapEvaluation {
     }
 }
 
-/// Evaluates `map`; the message of a map no law can be fitted to (one direction, a
-/// single speed, efforts of one sign) otherwise.
-pub fn evaluate(map: &FrictionMap) -> Result<MapEvaluation, String> {
+/// Evaluates `map`; why no law can be fitted to it (one direction, a single speed,
+/// efforts of one sign) otherwise.
+pub fn evaluate(map: &FrictionMap) -> Result<MapEvaluation, MapProblem> {
     let map = map.sorted();
-    let laws = fit_all(&map.speed, &map.effort).map_err(|e| e.to_string())?;
+    let laws = fit_all(&map.speed, &map.effort)?;
     let residuals = &laws
         .fit(laws.selected)
         .expect("the selected law is fitted")

@@ -53,10 +53,12 @@ pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limit
     let n = x0.len();
     let result = match method {
         Method::Lsq => {
-            let ls = BacktrackingLineSearch::new(ArmijoCondition::new(1e-4).expect("0 < c < 1"));
+            let ls = BacktrackingLineSearch::new(
+                ArmijoCondition::new(1e-4).expect("c = 1e-4 lies in 0 < c < 1"),
+            );
             let solver = GaussNewtonLS::new(ls)
                 .with_tolerance(1e-10)
-                .expect("positive");
+                .expect("the tolerance 1e-10 is positive");
             Executor::new(problem, solver)
                 .configure(|s| s.param(x0.clone()).max_iters(limits.max_iters))
                 .add_observer(count(), ObserverMode::Always)
@@ -80,7 +82,7 @@ pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limit
             }
             let solver = NelderMead::new(simplex)
                 .with_sd_tolerance(1e-8)
-                .expect("positive");
+                .expect("the tolerance 1e-8 is positive");
             let problem = SimplexStart {
                 problem,
                 left: AtomicUsize::new(n + 1),

@@ -97,7 +97,9 @@ pub fn read(path: &Path) -> Result<Recording, FormatError> {
     let header = header::read(&mut lines, path, &mut quirks, &mut notes)?;
     let table = rows::read(&mut lines, &header, path, &mut quirks)?;
     check_count(&header, &table, path, &mut notes)?;
-    let first_line = table.first_line.expect("rows found, checked above");
+    let first_line = table
+        .first_line
+        .expect("check_count refuses a file without rows");
     notes.extend(period_note(&header, &table.times, first_line));
     notes.extend(quirks.into_notes());
 

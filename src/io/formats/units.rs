@@ -132,17 +132,43 @@ pub fn lookup(text: &str) -> Option<Unit> {
     None
 }
 
+/// Why a unit as `--map` writes it is refused: each message quotes the text given.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum UnitError {
+    #[error("`{text}`: write the nominal as %(VALUE UNIT), e.g. %(9.84 mN·m)")]
+    NominalNotWritten { text: String },
+    #[error(
+        "`{text}`: write the resolution as inc(COUNT/UNIT), e.g. inc(4096/rev) or inc(1000/mm)"
+    )]
+    ResolutionNotWritten { text: String },
+    #[error("`{text}`: increments per {}, an angle or a length expected", quantity.name())]
+    IncrementsPerWhat { text: String, quantity: Quantity },
+    #[error(
+        "`{text}`: per cent of what? Write the nominal value: %(VALUE UNIT), e.g. %(9.84 mN·m)"
+    )]
+    PercentWithoutNominal { text: String },
+    #[error(
+        "`{text}`: increments need the encoder's resolution: inc(COUNT/UNIT), e.g. inc(4096/rev)"
+    )]
+    IncrementsWithoutResolution { text: String },
+    /// A unit inside `%(…)` or `inc(…)` that is not a physical one.
+    #[error("`{whole}`: unknown unit `{inner}` inside; accepted: {}", accepted())]
+    UnknownInside { whole: String, inner: String },
+    #[error("unknown unit `{text}`; accepted: {}", accepted())]
+    Unknown { text: String },
+}
+
 /// A unit as `--map` writes it: a plain unit ([`lookup`]), `%(NOMINAL UNIT)` — per
 /// cent of a nominal value, e.g. `%(9.84 mN·m)` for a drive's torque in per cent of
 /// its nominal torque — or `inc(N/UNIT)` — encoder increments, N per UNIT of angle or
 /// length, e.g. `inc(4096/rev)`, `inc(1000/mm)`. Returns the quantity measured and
 /// SI per unit written.
-pub fn parse(text: &str) -> Result<Unit, String> {
+pub fn parse(text: &str) -> Result<Unit, UnitError> {
     let text = text.trim();
     if let Some(inner) = bracketed(text, "%") {
-        let (value, unit) = split_number(inner).ok_or_else(|| {
-            format!("`{text}`: write the nominal as %(VALUE UNIT), e.g. %(9.84 mN·m)")
-        })?;
+        let (value, unit) = split_number(inner)
+            .ok_or_else(|| UnitError::NominalNotWritten { text: text.into() })?;
         let nominal = physical(unit, text)?;
         return Ok(Unit {
             symbol: "%",
@@ -155,13 +181,13 @@ pub fn parse(text: &str) -> Result<Unit, String> {
             .split_once('/')
             .and_then(|(n, u)| Some((n.trim().parse::<f64>().ok()?, u)))
             .filter(|(n, _)| n.is_finite() && *n > 0.0)
-            .ok_or_else(|| format!("`{text}`: write the resolution as inc(COUNT/UNIT), e.g. inc(4096/rev) or inc(1000/mm)"))?;
+            .ok_or_else(|| UnitError::ResolutionNotWritten { text: text.into() })?;
         let per = physical(unit, text)?;
         if !matches!(per.quantity, Quantity::Angle | Quantity::Length) {
-            return Err(format!(
-                "`{text}`: increments per {}, an angle or a length expected",
-                per.quantity.name()
-            ));
+            return Err(UnitError::IncrementsPerWhat {
+                text: text.into(),
+                quantity: per.quantity,
+            });
         }
         return Ok(Unit {
             symbol: "inc",
@@ -170,14 +196,14 @@ pub fn parse(text: &str) -> Result<Unit, String> {
         });
     }
     match lookup(text) {
-        Some(u) if u.quantity == Quantity::Percent => Err(format!(
-            "`{text}`: per cent of what? Write the nominal value: %(VALUE UNIT), e.g. %(9.84 mN·m)"
-        )),
-        Some(u) if u.quantity == Quantity::Increments => Err(format!(
-            "`{text}`: increments need the encoder's resolution: inc(COUNT/UNIT), e.g. inc(4096/rev)"
-        )),
+        Some(u) if u.quantity == Quantity::Percent => {
+            Err(UnitError::PercentWithoutNominal { text: text.into() })
+        }
+        Some(u) if u.quantity == Quantity::Increments => {
+            Err(UnitError::IncrementsWithoutResolution { text: text.into() })
+        }
         Some(u) => Ok(u),
-        None => Err(format!("unknown unit `{text}`; accepted: {}", accepted())),
+        None => Err(UnitError::Unknown { text: text.into() }),
     }
 }
 
@@ -207,7 +233,7 @@ fn split_number(text: &str) -> Option<(f64, &str)> {
 }
 
 /// A plain physical unit inside a `%(…)` or `inc(…)`.
-fn physical(text: &str, whole: &str) -> Result<Unit, String> {
+fn physical(text: &str, whole: &str) -> Result<Unit, UnitError> {
     match lookup(text) {
         Some(u)
             if !matches!(
@@ -217,11 +243,10 @@ fn physical(text: &str, whole: &str) -> Result<Unit, String> {
         {
             Ok(u)
         }
-        _ => Err(format!(
-            "`{whole}`: unknown unit `{}` inside; accepted: {}",
-            text.trim(),
-            accepted()
-        )),
+        _ => Err(UnitError::UnknownInside {
+            whole: whole.into(),
+            inner: text.trim().into(),
+        }),
     }
 }
 
@@ -262,13 +287,17 @@ mod tests {
         let length = parse("inc(1000 / mm)").unwrap();
         assert_eq!(length.quantity, Quantity::Length);
         assert!((length.si - 1e-6).abs() < 1e-21);
-        assert!(parse("%").unwrap_err().contains("per cent of what"));
-        assert!(parse("inc").unwrap_err().contains("resolution"));
-        assert!(parse("inc(4096/V)")
-            .unwrap_err()
-            .contains("angle or a length"));
-        assert!(parse("%(0 N)").is_err());
-        assert!(parse("furlong").unwrap_err().contains("accepted"));
+        let message = |text: &str| parse(text).unwrap_err().to_string();
+        assert!(message("%").contains("per cent of what"));
+        assert!(message("inc").contains("resolution"));
+        assert!(message("inc(4096/V)").contains("angle or a length"));
+        assert_eq!(
+            parse("%(0 N)"),
+            Err(UnitError::NominalNotWritten {
+                text: "%(0 N)".into()
+            })
+        );
+        assert!(message("furlong").contains("accepted"));
     }
 
     #[test]

@@ -7,7 +7,7 @@
 //! Channel names are matched exactly as the file spells them, and may themselves hold
 //! `*` or `:`: a map whose whole right-hand side names a channel takes it whole.
 
-use crate::io::formats::units::{self, Unit};
+use crate::io::formats::units::{self, Unit, UnitError};
 use crate::io::formats::{Channel, Recording};
 
 /// One `--map` as written, split.
@@ -24,19 +24,34 @@ pub struct MapSpec {
     pub unit: Option<String>,
 }
 
+/// Why a `--map` is not `ROLE=CHANNEL[*SCALE][:UNIT]`: each message quotes it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum MapSpecError {
+    #[error("`{text}`: write ROLE=CHANNEL[*SCALE][:UNIT]")]
+    NoEquals { text: String },
+    #[error("`{text}`: the role `{role}` is not a name (letters, digits, _)")]
+    RoleNotAName { text: String, role: String },
+    #[error("`{text}`: no channel named after `=`")]
+    NoChannel { text: String },
+    #[error("`{text}`: the scale must be a finite number other than 0")]
+    BadScale { text: String },
+}
+
 /// Splits `ROLE=CHANNEL[*SCALE][:UNIT]`; the channel is looked up later ([`resolve`]).
-pub fn parse(text: &str) -> Result<MapSpec, String> {
+pub fn parse(text: &str) -> Result<MapSpec, MapSpecError> {
     let (role, right) = text
         .split_once('=')
-        .ok_or_else(|| format!("`{text}`: write ROLE=CHANNEL[*SCALE][:UNIT]"))?;
+        .ok_or_else(|| MapSpecError::NoEquals { text: text.into() })?;
     let role = role.trim();
     if role.is_empty() || !role.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-        return Err(format!(
-            "`{text}`: the role `{role}` is not a name (letters, digits, _)"
-        ));
+        return Err(MapSpecError::RoleNotAName {
+            text: text.into(),
+            role: role.into(),
+        });
     }
     if right.trim().is_empty() {
-        return Err(format!("`{text}`: no channel named after `=`"));
+        return Err(MapSpecError::NoChannel { text: text.into() });
     }
     let (rest, unit) = match right.rsplit_once(':') {
         Some((rest, unit)) if units::parse(unit).is_ok() || looks_like_unit(unit) => {
@@ -47,11 +62,7 @@ pub fn parse(text: &str) -> Result<MapSpec, String> {
     let (channel, scale) = match rest.rsplit_once('*') {
         Some((channel, scale)) => match scale.trim().parse::<f64>() {
             Ok(s) if s.is_finite() && s != 0.0 => (channel, s),
-            Ok(_) => {
-                return Err(format!(
-                    "`{text}`: the scale must be a finite number other than 0"
-                ))
-            }
+            Ok(_) => return Err(MapSpecError::BadScale { text: text.into() }),
             Err(_) => (rest, 1.0),
         },
         None => (rest, 1.0),
@@ -88,9 +99,40 @@ pub struct Resolved<'a> {
     pub factor: f64,
 }
 
+/// Why a map cannot be resolved against the recordings: each message starts with the
+/// map as given.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ResolveError {
+    /// Neither CHANNEL nor the whole right-hand side is a channel; `present` lists the
+    /// recordings' channels.
+    #[error("{given}: no channel `{channel}`; the file has {}", listed(present))]
+    NoChannel {
+        given: String,
+        channel: String,
+        present: Vec<String>,
+    },
+    #[error(
+        "{given}: `{channel}` is a channel of several of the files: import one file per experiment"
+    )]
+    SeveralFiles { given: String, channel: String },
+    #[error("{given}: the channel `{channel}` has no unit in its file: add one, e.g. {role}={channel}:UNIT")]
+    NoUnit {
+        given: String,
+        channel: String,
+        role: String,
+    },
+    /// The unit (the map's, else the channel's label) is refused.
+    #[error("{given}: {source}")]
+    Unit { given: String, source: UnitError },
+}
+
 /// Looks the map's channel up in `recordings` (CHANNEL as split, else the whole
 /// right-hand side), and its unit: the map's, else the channel's own label.
-pub fn resolve<'a>(spec: &MapSpec, recordings: &[&'a Recording]) -> Result<Resolved<'a>, String> {
+pub fn resolve<'a>(
+    spec: &MapSpec,
+    recordings: &[&'a Recording],
+) -> Result<Resolved<'a>, ResolveError> {
     let (spec, (file, channel)) = match (
         find(recordings, &spec.channel),
         find(recordings, &spec.right),
@@ -108,19 +150,23 @@ pub fn resolve<'a>(spec: &MapSpec, recordings: &[&'a Recording]) -> Result<Resol
         (None, None) => return Err(missing(spec, recordings)),
     };
     if files_with(recordings, &spec.channel) > 1 {
-        return Err(format!(
-            "{}: `{}` is a channel of several of the files: import one file per experiment",
-            spec.given, spec.channel
-        ));
+        return Err(ResolveError::SeveralFiles {
+            given: spec.given,
+            channel: spec.channel,
+        });
     }
     let unit_text = spec.unit.clone().unwrap_or_else(|| channel.unit.clone());
     if unit_text.trim().is_empty() {
-        return Err(format!(
-            "{}: the channel `{}` has no unit in its file: add one, e.g. {}={}:UNIT",
-            spec.given, spec.channel, spec.role, spec.channel
-        ));
+        return Err(ResolveError::NoUnit {
+            given: spec.given,
+            channel: spec.channel,
+            role: spec.role,
+        });
     }
-    let unit = units::parse(&unit_text).map_err(|e| format!("{}: {e}", spec.given))?;
+    let unit = units::parse(&unit_text).map_err(|source| ResolveError::Unit {
+        given: spec.given.clone(),
+        source,
+    })?;
     let factor = spec.scale * unit.si;
     Ok(Resolved {
         spec,
@@ -148,22 +194,29 @@ fn find<'a>(recordings: &[&'a Recording], name: &str) -> Option<(usize, &'a Chan
         .find_map(|(i, r)| r.channels.iter().find(|c| c.name == name).map(|c| (i, c)))
 }
 
-/// The message for a channel not found: the ones there are.
-fn missing(spec: &MapSpec, recordings: &[&Recording]) -> String {
-    let names: Vec<String> = recordings
-        .iter()
-        .flat_map(|r| r.channels.iter().map(|c| format!("`{}`", c.name)))
-        .collect();
-    format!(
-        "{}: no channel `{}`; the file has {}",
-        spec.given,
-        spec.channel,
-        if names.is_empty() {
-            "none".to_string()
-        } else {
-            names.join(", ")
-        }
-    )
+/// The error for a channel not found: the ones there are.
+fn missing(spec: &MapSpec, recordings: &[&Recording]) -> ResolveError {
+    ResolveError::NoChannel {
+        given: spec.given.clone(),
+        channel: spec.channel.clone(),
+        present: recordings
+            .iter()
+            .flat_map(|r| r.channels.iter().map(|c| c.name.clone()))
+            .collect(),
+    }
+}
+
+/// The channels' names quoted, for a message: `none` when there are none.
+fn listed(names: &[String]) -> String {
+    if names.is_empty() {
+        "none".to_string()
+    } else {
+        names
+            .iter()
+            .map(|n| format!("`{n}`"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
 }
 
 #[cfg(test)]
@@ -205,12 +258,18 @@ mod tests {
 
     #[test]
     fn refuses_what_is_not_a_map() {
-        assert!(parse("vir").unwrap_err().contains("ROLE=CHANNEL"));
+        assert!(parse("vir")
+            .unwrap_err()
+            .to_string()
+            .contains("ROLE=CHANNEL"));
         assert!(parse("=vir").is_err());
         assert!(parse("effort=").is_err());
-        assert!(parse("effort=vir*0:N")
-            .unwrap_err()
-            .contains("other than 0"));
+        assert_eq!(
+            parse("effort=vir*0:N"),
+            Err(MapSpecError::BadScale {
+                text: "effort=vir*0:N".into()
+            })
+        );
         assert!(parse("effort=vir*inf:N").is_err());
     }
 
@@ -220,13 +279,16 @@ mod tests {
         let r = resolve(&parse("x=a*b:c").unwrap(), &recs.iter().collect::<Vec<_>>()).unwrap();
         assert_eq!(r.channel.name, "a*b:c");
         assert_eq!(r.factor, 1.0);
-        let e = resolve(&parse("x=q").unwrap(), &recs.iter().collect::<Vec<_>>()).unwrap_err();
+        let e = resolve(&parse("x=q").unwrap(), &recs.iter().collect::<Vec<_>>())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("no unit"), "{e}");
         let e = resolve(
             &parse("x=nope:m").unwrap(),
             &recs.iter().collect::<Vec<_>>(),
         )
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("`a*b:c`") && e.contains("`q`"), "{e}");
     }
 
@@ -236,7 +298,9 @@ mod tests {
             recording(&[("speed", "rpm")]),
             recording(&[("speed", "rpm")]),
         ];
-        let e = resolve(&parse("x=speed").unwrap(), &recs.iter().collect::<Vec<_>>()).unwrap_err();
+        let e = resolve(&parse("x=speed").unwrap(), &recs.iter().collect::<Vec<_>>())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("several of the files"), "{e}");
     }
 

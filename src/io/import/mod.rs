@@ -157,7 +157,10 @@ fn resolve<'a>(
     recordings: &[&'a Recording],
 ) -> Result<Resolved<'a>, ImportError> {
     let resolved = match mapping::resolve(spec, recordings) {
-        Err(e) if role.quantities == [Quantity::Number] && !e.contains("no channel") => {
+        Err(e)
+            if role.quantities == [Quantity::Number]
+                && !matches!(e, mapping::ResolveError::NoChannel { .. }) =>
+        {
             let bare = MapSpec {
                 unit: Some("1".into()),
                 ..spec.clone()
