@@ -15,6 +15,8 @@
 //! - [`friction_law`]: Coulomb and Stribeck laws, symmetric or not, fitted to a
 //!   friction map (each constant-speed run's mean speed and effort), with standard
 //!   errors and the law the data support;
+//! - [`least_squares`]: the Levenberg–Marquardt solver every nonlinear least-squares
+//!   fit takes its damped step from (the friction laws, the identification's search);
 //! - [`information`]: AIC, AICc, BIC, Akaike weights and nested F-tests of fits of the
 //!   same data, from plain figures.
 
@@ -22,6 +24,7 @@ pub mod extrema;
 pub mod friction_law;
 pub mod information;
 pub mod inverse_dynamics;
+pub mod least_squares;
 pub mod local_mode_fit;
 pub mod peaks;
 pub mod periodic;

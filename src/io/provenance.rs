@@ -37,7 +37,7 @@ impl Provenance {
         }
         Ok(Provenance {
             command: quoted(&args),
-            version: crate::VERSION.to_string(),
+            version: crate::version::VERSION.to_string(),
             inputs: inputs
                 .iter()
                 .map(|p| {

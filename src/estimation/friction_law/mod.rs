@@ -19,7 +19,7 @@
 //!
 //! Each law is fitted to the runs' mean efforts by unweighted least squares: the
 //! Coulomb laws by linear least squares (`linear.rs`), the Stribeck laws by
-//! Levenberg–Marquardt ([`levenberg_marquardt`]) in scaled coordinates from two
+//! Levenberg–Marquardt ([`crate::estimation::least_squares`]) in scaled coordinates from two
 //! starts (`stribeck.rs`). A law is fitted only to more runs than it has parameters,
 //! and a Stribeck law only to at least 3 distinct speeds per direction. Standard
 //! errors: s² = SSR/(n − k), cov = s²·(JᵀJ)⁻¹ with J the Jacobian of the residuals
@@ -30,7 +30,6 @@
 mod compare;
 mod covariance;
 mod law;
-pub mod levenberg_marquardt;
 mod linear;
 mod map;
 mod note;

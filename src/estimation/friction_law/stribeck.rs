@@ -19,9 +19,9 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::law::{Law, Quantity};
-use super::levenberg_marquardt::{self as lm, Problem};
 use super::linear;
 use super::map::{distinct_speeds, Direction};
+use crate::estimation::least_squares::{self as lm, Problem};
 
 /// The starting values of delta.
 pub const DELTA_STARTS: [f64; 2] = [1.0, 2.0];

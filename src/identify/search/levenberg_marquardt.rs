@@ -9,8 +9,8 @@
 //! docs/identification.md.)
 //!
 //! Each iteration solves (JᵀJ + λ·D)·h = −Jᵀr, D = diag(JᵀJ) floored (Marquardt's
-//! scaling; the damped step of the friction laws' solver,
-//! [`crate::estimation::friction_law::levenberg_marquardt`]), for [`TRIALS`] dampings λ and 10λ at once, and takes the trial of
+//! scaling; the damped step of the one least-squares solver,
+//! [`crate::estimation::least_squares`], which fits the friction laws), for [`TRIALS`] dampings λ and 10λ at once, and takes the trial of
 //! lower cost if it lowers the cost; λ then becomes a tenth of the damping that won.
 //! If neither does, λ rises [`GROWTH`]-fold and the batch is tried again. It stops:
 //! - converged, when a step lowered the cost by less than [`COST_TOLERANCE`] of it;
@@ -20,7 +20,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::estimation::friction_law::levenberg_marquardt::{damped_step, damping};
+use crate::estimation::least_squares::{damped_step, damping};
 use crate::identify::result::termination::Termination;
 use crate::identify::search::problem::{Problem, SearchJacobian};
 use crate::objectives::{sum_of_squares, ObjectiveError};

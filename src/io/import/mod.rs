@@ -688,7 +688,7 @@ fn manifest(
             "map": request.maps.iter().map(|m| m.given.clone()).collect::<Vec<_>>(),
             "conditions": request.conditions_given,
             "findings": findings,
-            "rtid": crate::VERSION,
+            "rtid": crate::version::VERSION,
         }),
     );
     Ok(m)

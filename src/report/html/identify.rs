@@ -53,7 +53,7 @@ fn summary(r: &IdentifyResult) -> String {
         ("evaluations", r.evaluations.to_string()),
         ("wall time", format!("{:.2} s", r.wall_time_s)),
         ("termination", r.termination.0.to_string()),
-        ("report by", format!("rtid {}", crate::VERSION)),
+        ("report by", format!("rtid {}", crate::version::VERSION)),
     ]);
     if r.interrupted {
         pairs.push((

@@ -56,7 +56,7 @@ pub fn page(title: &str, sections: &[Section]) -> String {
          <style>{CSS}</style>\n</head>\n<body>\n<header>\n<h1>{t}</h1>\n\
          <p class=\"meta\">Written by rtid {version}; {n} section{s}.</p>\n</header>\n",
         t = escape(title),
-        version = escape(crate::VERSION),
+        version = escape(crate::version::VERSION),
         n = sections.len(),
         s = if sections.len() == 1 { "" } else { "s" },
     );

@@ -1,5 +1,8 @@
-//! A small Levenberg–Marquardt least-squares solver with an analytic Jacobian, for a
-//! handful of parameters (K. Madsen, H. B. Nielsen, O. Tingleff, *Methods for
+//! The Levenberg–Marquardt least-squares solver: its damped step, which every
+//! least-squares fit of rtid takes, and the whole solver with an analytic Jacobian for
+//! a handful of parameters (the friction laws' fits); the identification's search
+//! (`identify/search/levenberg_marquardt.rs`) takes the same step with
+//! finite-difference Jacobians and trial dampings in parallel (K. Madsen, H. B. Nielsen, O. Tingleff, *Methods for
 //! Non-Linear Least Squares Problems*, 2nd ed., DTU 2004, §3.2, with Marquardt's
 //! scaling of the damping by the diagonal of JᵀJ).
 //!
