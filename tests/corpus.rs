@@ -5,11 +5,11 @@
 //! with exit 0 and finite output, or with a clear error: one line `error: …` (exit 1)
 //! naming the culprit, or clap's usage error naming the option (exit 2).
 
-mod support;
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+
+use crate::support;
 
 const LIMIT: Duration = Duration::from_secs(60);
 

@@ -9,10 +9,6 @@
 //! in one line. (`tests/corpus.rs` runs a fixed set of such files through `import
 //! --list`; this explores at random.)
 
-mod support;
-
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::mpsc;
@@ -22,6 +18,9 @@ use proptest::prelude::*;
 use rtid::io::experiment_file;
 use rtid::io::formats::{detect, Abscissa, Recording, Samples};
 
+use crate::alloc_watch::largest_allocation;
+use crate::support;
+
 /// The largest single allocation a reader may make: what the largest fixture (626 kB)
 /// legitimately needs is a few MB (its doubles, grown by doubling); a size taken from a
 /// header without a check against the file's bytes is 10⁸ samples, 800 MB.
@@ -29,43 +28,6 @@ const ALLOCATION_LIMIT: usize = 64 << 20;
 
 /// A reader that takes longer than this on a file under 1 MB hangs.
 const TIME_LIMIT: Duration = Duration::from_secs(30);
-
-struct Watching;
-
-thread_local! {
-    /// Whether this thread's allocations are watched (a reader's thread).
-    static WATCHED: Cell<bool> = const { Cell::new(false) };
-    /// The largest single allocation this thread asked for while watched.
-    static LARGEST: Cell<usize> = const { Cell::new(0) };
-}
-
-fn watch(size: usize) {
-    if WATCHED.with(Cell::get) {
-        LARGEST.with(|l| l.set(l.get().max(size)));
-    }
-}
-
-// SAFETY: forwards every call to the system allocator unchanged; only records sizes.
-unsafe impl GlobalAlloc for Watching {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        watch(layout.size());
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        watch(layout.size());
-        unsafe { System.alloc_zeroed(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        watch(new_size);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Watching = Watching;
 
 fn fixture(relative: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -256,14 +218,9 @@ fn read_watched(path: &Path) -> Result<Read, String> {
     let (send, receive) = mpsc::channel();
     let owned = path.to_path_buf();
     let worker = std::thread::spawn(move || {
-        WATCHED.with(|w| w.set(true));
-        LARGEST.with(|l| l.set(0));
-        let result = detect::read(&owned, None).map_err(|e| e.to_string());
-        WATCHED.with(|w| w.set(false));
-        let _ = send.send(Read {
-            result,
-            largest: LARGEST.with(Cell::get),
-        });
+        let (result, largest) =
+            largest_allocation(|| detect::read(&owned, None).map_err(|e| e.to_string()));
+        let _ = send.send(Read { result, largest });
     });
     match receive.recv_timeout(TIME_LIMIT) {
         Ok(read) => Ok(read),

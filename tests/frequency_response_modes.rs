@@ -7,8 +7,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-mod cli_support;
-use cli_support::{ok, rtid};
+use crate::cli_support::{ok, rtid};
 
 /// The two-mass preset (fixtures/presets/two-mass.json): Jt 2e-4 kg·m², Kw 23 N·m/rad,
 /// Ciw 1.92e-3 and Ct 1e-4 N·m·s/rad. The table's equation with the motor angle

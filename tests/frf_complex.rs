@@ -22,8 +22,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-mod cli_support;
-use cli_support::{err, ok, rtid};
+use crate::cli_support::{self, err, ok, rtid};
 
 /// The settings that make each preset's drive linear.
 const WORM_LINEAR: &[&str] = &[

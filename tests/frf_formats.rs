@@ -14,8 +14,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-mod cli_support;
-use cli_support::{ok, root, rtid};
+use crate::cli_support::{ok, root, rtid};
 
 /// The UFF's complex channel: its ID line 1.
 const CHANNEL: &str = "worm table/motor";

@@ -7,8 +7,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-mod cli_support;
-use cli_support::{err, ok, rtid};
+use crate::cli_support::{err, ok, rtid};
 
 /// The direct drive's table with a Stribeck law and a load: Coulomb 1.5 N·m, static
 /// 2.0 N·m, Stribeck speed 0.2 rad/s, δ = 1, viscous 0.3 N·m·s/rad, Tload 0.3 N·m.

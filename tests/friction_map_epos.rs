@@ -20,8 +20,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-mod cli_support;
-use cli_support::{ok, root, rtid};
+use crate::cli_support::{ok, root, rtid};
 
 /// `rtid evaluate --json` of the map of one drive's steady-state runs.
 fn evaluated(drive: &str, dir: &Path) -> Value {

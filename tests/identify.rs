@@ -2,8 +2,6 @@
 //! experiments (fixtures/), multi-start, identifiability warnings, the interrupt path.
 //! The true values come from the fixtures (`support`), the presets that made them.
 
-mod support;
-
 use rtid::estimation::peaks::of_linear_response as linear_peaks;
 use rtid::identify::{
     identify, Bound, Config, ExperimentSpec, FidelityChoice, Identified, Method, Monitor, Warning,
@@ -11,7 +9,8 @@ use rtid::identify::{
 use rtid::io::experiment_file::{Data, Experiment, Kind, Manifest};
 use rtid::model::{presets, Params};
 use rtid::objectives::ObjectiveKind;
-use support::{off, values, Fixture};
+
+use crate::support::{self, off, values, Fixture};
 
 fn config(experiments: Vec<ExperimentSpec>, base: Params, fit: &[&str]) -> Config {
     Config::new(experiments, base, fit)

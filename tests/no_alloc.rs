@@ -1,46 +1,13 @@
-//! The stepping loop allocates nothing: a counting global allocator watches a long
-//! open- and closed-loop run of each preset.
-
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+//! The stepping loop allocates nothing: the test binary's global allocator
+//! (`alloc_watch`) counts a thread's allocations over a long open- and closed-loop run
+//! of each preset.
 
 use rtid::input::{Move, Sine};
 use rtid::model::presets;
 use rtid::recorder::NullRecorder;
 use rtid::sim::Simulation;
 
-struct Counting;
-
-thread_local! {
-    /// Allocations made by this thread (tests run in parallel threads).
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(|c| c.get())
-}
-
-fn count() {
-    ALLOCATIONS.with(|c| c.set(c.get() + 1));
-}
-
-// SAFETY: forwards every call to the system allocator unchanged; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count();
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+use crate::alloc_watch::allocations;
 
 #[test]
 fn the_counter_counts() {

@@ -1,11 +1,11 @@
 //! One peak finder for every caller: for the same parameters, a sweep's resonance
 //! output and an identification's resonance objective report the same resonances.
 
-mod support;
-
 use rtid::objectives::resonance::ResonanceMatch;
 use rtid::objectives::Fidelity;
 use rtid::sweep::{Evaluator, Output, TestLength};
+
+use crate::support;
 
 #[test]
 fn a_sweep_and_an_identification_report_the_same_resonance() {

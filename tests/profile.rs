@@ -2,15 +2,14 @@
 //! agree with the standard errors where the cost is a quadratic bowl, open sides that
 //! name the family of equally good fits where the data cannot pin a parameter.
 
-mod support;
-
 use std::collections::BTreeMap;
 
 use rtid::identify::intervals::profile::{self, Request};
 use rtid::identify::result::profile::{Profile, Variance};
 use rtid::identify::{identify, Config, FidelityChoice, Identified, Monitor, Warning};
 use rtid::model::{presets, Params};
-use support::{off, Fixture};
+
+use crate::support::{self, off, Fixture};
 
 /// The fit of `config`, then the profiles of `names`.
 fn fit_and_profile(

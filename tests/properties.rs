@@ -7,13 +7,13 @@
 //! binary on a fixed corpus; the option parsing's properties are in the binary's own
 //! tests, `src/cli/properties.rs`.)
 
-mod support;
-
 use std::path::{Path, PathBuf};
 
 use proptest::prelude::*;
 use rtid::io::{experiment_file, params_file, torque_file};
 use rtid::sweep::{self, spec, stream};
+
+use crate::support;
 
 /// The first `lines` lines of a fixture file, as text.
 fn fixture(relative: &str, lines: usize) -> String {

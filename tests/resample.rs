@@ -4,12 +4,11 @@
 //! few residuals are refused. (Its agreement with σ²(JᵀJ)⁻¹ on a smooth cost with
 //! white errors is tested in src/identify/intervals/resample.rs.)
 
-mod support;
-
 use rtid::identify::intervals::resample::{self, Request};
 use rtid::identify::result::resampling::Resampling;
 use rtid::identify::{identify, Config, FidelityChoice, Identified, Monitor};
-use support::{off, Fixture};
+
+use crate::support::{self, off, Fixture};
 
 /// The fit of `config`, then its bootstrap with `replicates` replicates.
 fn fit_and_resample(config: &Config, replicates: usize) -> (Identified, Resampling) {

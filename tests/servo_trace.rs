@@ -7,8 +7,6 @@
 //! record as converted in shared/data/emps) and fixtures/real/emps/axis.json (the
 //! published model as an rtid parameter file).
 
-mod support;
-
 use std::path::PathBuf;
 
 use rtid::controller::{Controller, Gains};
@@ -20,6 +18,8 @@ use rtid::experiments::torque_curve::idim_fit;
 use rtid::experiments::torque_curve::{self, TorqueTest};
 use rtid::io::experiment_file::{self, Data};
 use rtid::model::{presets, Params};
+
+use crate::support;
 
 fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
