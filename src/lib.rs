@@ -26,7 +26,7 @@
 //!   [`fluctuation`], [`friction_map`], [`servo_trace`] (each: `run`, the record ↔
 //!   file, `evaluate`);
 //! - **identification**: [`identify`] from a [`IdentifyConfig`] of
-//!   [`ExperimentSpec`]s, watched by a [`Monitor`], into an [`Identified`] with its
+//!   [`ExperimentSpec`]s (the model by [`FidelityChoice`]), watched by a [`Monitor`], into an [`Identified`] with its
 //!   [`IdentifyResult`] (values, standard errors, correlations, [`Warning`]s),
 //!   [`IdentifyError`];
 //! - **sweeps**: [`Sweep`], [`run_sweep`] with [`SweepOptions`] into a
@@ -120,8 +120,8 @@ pub use experiments::{
 
 // Identification.
 pub use identify::{
-    identify, Config as IdentifyConfig, ExperimentSpec, Identified, IdentifyError, IdentifyResult,
-    Monitor, Warning,
+    identify, Config as IdentifyConfig, ExperimentSpec, FidelityChoice, Identified, IdentifyError,
+    IdentifyResult, Monitor, Warning,
 };
 
 // Sweeps.
