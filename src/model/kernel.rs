@@ -763,6 +763,7 @@ fn axpy<const L: usize>(y: &States<L>, a: Lanes<L>, k: &States<L>) -> States<L> 
 /// the stop of sliding bodies whose velocity reversed (friction/clamp.rs). Stage values
 /// are locals, not fields, so the compiler can keep them in registers.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn rk4<const L: usize, const SPUR: bool, F: FrictionLaw>(
     d: &Drive,
     law: &F,

@@ -38,7 +38,7 @@ pub static DEFINITION: Definition = Definition {
     default_weight: |exp, stage| (stage == Stage::Search && fits_whole_curve(exp)).then_some(1.0),
     build: |source, fidelity| Ok(Box::new(GainCurve::of(source, fidelity, |_| true)?)),
     first_estimate: None,
-    describe: describe,
+    describe,
 };
 
 /// The measured gain within ±[`GRID_BAND`] of each resonance: the peaks' shape,
@@ -59,7 +59,7 @@ pub static NEAR_PEAKS: Definition = Definition {
     },
     build: near_peaks,
     first_estimate: None,
-    describe: describe,
+    describe,
 };
 
 fn near_peaks(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, SetupError> {

@@ -51,7 +51,7 @@ pub static DEFINITION: Definition = Definition {
     },
     build,
     first_estimate: None,
-    describe: describe,
+    describe,
 };
 
 fn build(source: &Source<'_>, fidelity: Fidelity) -> Result<Box<dyn Objective>, SetupError> {

@@ -41,7 +41,7 @@ pub static DEFINITION: Definition = Definition {
     },
     build,
     first_estimate: None,
-    describe: describe,
+    describe,
 };
 
 /// The drive stiffnesses: Kw, and Kg where there is a spur stage.

@@ -37,7 +37,7 @@ pub static DEFINITION: Definition = Definition {
     default_weight: |exp, _| (exp.manifest.kind == Kind::ServoTrace).then_some(1.0),
     build,
     first_estimate: Some(inverse_dynamics_start),
-    describe: describe,
+    describe,
 };
 
 fn determines(p: &Params) -> Vec<&'static str> {

@@ -35,7 +35,7 @@ pub static DEFINITION: Definition = Definition {
     default_weight: |exp, _| (exp.manifest.kind == Kind::TorqueCurve).then_some(1.0),
     build,
     first_estimate: None,
-    describe: describe,
+    describe,
 };
 
 fn build(

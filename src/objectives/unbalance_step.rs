@@ -47,7 +47,7 @@ pub static DEFINITION: Definition = Definition {
     default_weight: |exp, _| (exp.manifest.kind == Kind::Unbalance).then_some(1.0),
     build,
     first_estimate: None,
-    describe: describe,
+    describe,
 };
 
 fn build(
