@@ -11,6 +11,9 @@ use crate::objectives::{Objective, Smoothness};
 pub const LEVEL: f64 = 0.95;
 /// χ²₁ at [`LEVEL`]: the likelihood-ratio statistic at an interval's end.
 pub const THRESHOLD: f64 = 3.841_458_820_694_124;
+/// The two-sided normal quantile at [`LEVEL`].
+pub(super) const Z: f64 = 1.959_963_984_540_054;
+
 /// What is profiled and how each point is fitted.
 pub struct Request<'a> {
     /// The fit's result and identified parameter set.

@@ -33,10 +33,8 @@ use crate::identify::space::{Bound, ParamSpace};
 use crate::model::Params;
 use crate::objectives::{Objective, ObjectiveError};
 
-/// The confidence level of the intervals.
-pub const LEVEL: f64 = 0.95;
-/// The two-sided normal quantile at [`LEVEL`].
-const Z: f64 = 1.959_963_984_540_054;
+pub use super::request::LEVEL;
+use super::request::Z;
 /// Fewer finished replicates than this give no interval.
 pub const MIN_REPLICATES: usize = 5;
 

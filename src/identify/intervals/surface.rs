@@ -30,7 +30,7 @@ use nalgebra::{DMatrix, DVector};
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use rayon::prelude::*;
 
-use super::request::{Request, LEVEL, THRESHOLD};
+use super::request::{Request, LEVEL, THRESHOLD, Z};
 use crate::identify::intervals::resample::block_length;
 use crate::identify::result::profile::{Profile, Surface, Variance};
 use crate::identify::space::Bound;
@@ -48,8 +48,6 @@ const ROUGHNESS_MARGIN: f64 = 4.0;
 const ROUNDS: usize = 3;
 /// Resamplings of the design's residuals behind the minimum's uncertainty.
 const RESAMPLES: usize = 400;
-/// Normal quantile at [`LEVEL`].
-const Z: f64 = 1.959_963_984_540_054;
 /// Points of the plotted profile curve.
 const CURVE_POINTS: usize = 61;
 /// The curve reaches a quarter beyond where the statistic is this (five times the

@@ -82,17 +82,4 @@ impl DriveFriction {
     pub fn sliding(&self, body: usize, speed: f64) -> f64 {
         with_law!(self, law => law.sliding(body, speed))
     }
-
-    /// The level body `body` at rest must exceed to break away, N·m (N).
-    pub fn breakaway(&self, body: usize) -> f64 {
-        with_law!(self, law => law.breakaway(body))
-    }
-
-    /// The law's name: `coulomb`, `stribeck`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            DriveFriction::Coulomb(_) => "coulomb",
-            DriveFriction::Stribeck(_) => "stribeck",
-        }
-    }
 }
