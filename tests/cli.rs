@@ -849,6 +849,36 @@ fn a_reader_that_closes_the_pipe_early_is_not_an_error() {
     );
 }
 
+/// `rtid evaluate` writes plots only where `--plot` asks: the committed SVGs beside a
+/// shipped record are never rewritten by evaluating it with other parameters.
+#[test]
+fn evaluate_writes_no_plot_unless_asked() {
+    let dir = tempdir();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/real/emps");
+    for f in ["emps_estimation.json", "emps_estimation.csv", "axis.json"] {
+        std::fs::copy(root.join(f), dir.path().join(f)).unwrap();
+    }
+    std::fs::write(dir.path().join("emps_estimation.svg"), "committed").unwrap();
+    let listing = || {
+        let mut names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        names.sort();
+        names
+    };
+    let before = listing();
+    let args = ["evaluate", "emps_estimation.json", "--params", "axis.json"];
+    let text = rtid_ok(&args, dir.path());
+    assert!(text.contains("replayed on the model"), "{text}");
+    assert_eq!(listing(), before);
+    let svg = std::fs::read_to_string(dir.path().join("emps_estimation.svg")).unwrap();
+    assert_eq!(svg, "committed");
+    // Asked, the plots go where --plot says.
+    rtid_ok(&[&args[..], &["--plot", "out.svg"]].concat(), dir.path());
+    assert!(dir.path().join("out-effort.svg").exists());
+}
+
 /// The EMPS estimation record evaluated as a new user would: the friction law by
 /// IDIM-LS, and the trace replayed on the published model (fixtures/real/emps) to the
 /// published simulation error (2.10 µm RMS, 12.6 µm max, 2.41 N RMS; Janot et al.
@@ -966,7 +996,10 @@ fn evaluate_reports_a_linear_positioning_run_in_micrometres() {
     let b = v["axis"]["B"].as_f64().unwrap();
     assert!((b - 2.2).abs() < 1e-9, "B = x̄↑ − x̄↓ = 2.2 µm: {b}");
     assert_eq!(v["targets"][2]["target_mm"], 200.0);
-    let text = rtid_ok(&["evaluate", "laser.json"], dir.path());
+    let text = rtid_ok(
+        &["evaluate", "laser.json", "--plot", "laser.svg"],
+        dir.path(),
+    );
     assert!(
         text.contains("ISO 230-2 evaluation, µm") && text.contains("target mm"),
         "{text}"

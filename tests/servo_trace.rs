@@ -17,7 +17,9 @@ use rtid::experiments::servo_trace::{
 use rtid::experiments::torque_curve::idim_fit;
 use rtid::experiments::torque_curve::{self, TorqueTest};
 use rtid::io::experiment_file::{self, Data};
+use rtid::model::modes::max_rate;
 use rtid::model::{presets, Params};
+use rtid::sim::{default_step, STEP_ACCURACY};
 
 use crate::support;
 
@@ -140,6 +142,36 @@ fn a_virtual_trace_of_the_worm_preset_replays_with_zero_error() {
         other.force_rms > 0.0 && other.position_max > 0.0,
         "{other:?}"
     );
+}
+
+/// A drive clock of 4 ms read from a record as 0.0039999999 s is a multiple of no
+/// decimal step near the accurate one: the step divides it evenly instead (before,
+/// the search went down to 1e-11 s and a 10 s replay ran for hours). The virtual
+/// trace at that period replays exactly, in a fraction of a second.
+#[test]
+fn a_recorded_control_period_is_divided_evenly_not_by_a_vanishing_step() {
+    let mut p = presets::load("direct-drive").unwrap();
+    p.controller.tc = 0.0039999999;
+    let dt = default_step(&p).unwrap();
+    let steps = (p.controller.tc / dt).round();
+    assert!((steps * dt - p.controller.tc).abs() <= 1e-9 * p.controller.tc);
+    // Accurate, and no smaller than half the ladder's largest accurate step (1e-5 s
+    // at most: a rigid direct drive has no fast mode).
+    let rate = max_rate(&p).unwrap();
+    let accurate = (STEP_ACCURACY / rate).min(1e-5);
+    assert!(
+        rate * dt <= STEP_ACCURACY && dt >= 0.5 * accurate,
+        "dt = {dt:e} s against {accurate:e} s"
+    );
+    let to = |target, speed| MoveTo { target, speed };
+    let moves = TrapezoidalMoves {
+        moves: vec![to(0.5, 1.0), to(-0.2, 0.5)],
+        acceleration: 10.0,
+        dwell_s: 0.1,
+    };
+    let trace = virtual_trace(&p, &moves, None).unwrap();
+    let e = simulation_error(&trace, &replay(&p, &trace).unwrap()).unwrap();
+    assert_eq!((e.position_max, e.force_rms), (0.0, 0.0));
 }
 
 #[test]

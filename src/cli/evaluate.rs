@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use anyhow::bail;
 
 use crate::cli::common::model_args::ModelArgs;
+use crate::cli::common::plot::Plot;
 use crate::cli::experiment::{
     fluctuation, frequency_response, frequency_response_time, friction_map, positioning,
     servo_trace, torque_curve,
@@ -13,7 +14,9 @@ use rtid::io::experiment_file::{self, Kind};
 
 pub const LONG_ABOUT: &str = "\
 Evaluates an experiment file (a JSON manifest with its CSV, docs/experiment-files.md), \
-measured on a real table or written by `rtid experiment`, and writes a plot beside it.
+measured on a real table or written by `rtid experiment`; with --plot FILE.svg, writes \
+its plots (the first at FILE.svg, the others beside it: FILE-effort.svg, …). Without \
+--plot nothing is written: evaluating never touches the files beside the input.
 
 Kinds evaluated:
   frequency_response   the resonances: local maxima of the gain, located by parabolic \
@@ -69,7 +72,9 @@ pub struct Args {
     /// progress bar; accepted like every command's `--quiet`, for scripts).
     #[arg(long)]
     pub quiet: bool,
-    /// Where to write the plot (default: beside the manifest, FILE.svg).
+    /// Write the plots: the first at FILE.svg, the others beside it with a suffix
+    /// (FILE-effort.svg, FILE_phase.svg, …). None without it. A plot is never written
+    /// over an input of the command.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
     #[command(flatten)]
@@ -81,14 +86,13 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let exp = experiment_file::read(&a.file)?;
-    let plot = a
-        .plot
-        .clone()
-        .unwrap_or_else(|| a.file.with_extension("svg"));
     let mut inputs: Vec<&std::path::Path> = vec![&a.file];
     inputs.extend(exp.data_path.as_deref());
     inputs.extend(a.model.params.as_deref());
-    crate::cli::common::inputs::refuse_overwrite("--plot", &plot, &inputs)?;
+    let plot = match &a.plot {
+        Some(path) => Plot::at(path.clone(), &inputs)?,
+        None => Plot::none(),
+    };
     report(&a, &exp, &plot).map_err(|e| {
         // Every error names the file evaluated.
         let file = a.file.display().to_string();
@@ -100,12 +104,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     })
 }
 
-/// The evaluation of `exp`, printed, with its plot at `plot`.
-fn report(
-    a: &Args,
-    exp: &experiment_file::Experiment,
-    plot: &std::path::Path,
-) -> anyhow::Result<()> {
+/// The evaluation of `exp`, printed, with its plots where `plot` says.
+fn report(a: &Args, exp: &experiment_file::Experiment, plot: &Plot) -> anyhow::Result<()> {
     match exp.manifest.kind {
         Kind::Positioning => positioning::report(exp, plot, a.json),
         Kind::FrequencyResponse => frequency_response::report(exp, plot, a.json),

@@ -1,8 +1,9 @@
 //! What every command shares: the mechanism's arguments ([`model_args`]), reading
-//! input files ([`inputs`]), progress bars ([`progress`]) and the Ctrl-C handler
+//! input files ([`inputs`]), where plots go ([`plot`]), progress bars ([`progress`]) and the Ctrl-C handler
 //! ([`interrupt`]).
 
 pub mod inputs;
 pub mod interrupt;
 pub mod model_args;
+pub mod plot;
 pub mod progress;

@@ -1,6 +1,7 @@
 //! `rtid experiment fluctuation` and the evaluation of fluctuation and unbalance files.
 
-use std::path::{Path, PathBuf};
+use crate::cli::common::plot::Plot;
+use std::path::Path;
 
 use anyhow::bail;
 
@@ -145,17 +146,9 @@ pub fn run_test(
     )
 }
 
-/// `FILE.svg` → `FILE-spectrum.svg`.
-fn spectrum_path(plot: &Path) -> PathBuf {
-    let stem = plot
-        .file_stem()
-        .map_or("plot".into(), |s| s.to_string_lossy());
-    plot.with_file_name(format!("{stem}-spectrum.svg"))
-}
-
 /// Evaluates a fluctuation or unbalance experiment: printed (table or JSON), the
 /// deviation plot written to `plot` and the spectrum beside it (`…-spectrum.svg`).
-pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
+pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
     let kind = exp.manifest.kind;
     let e = fluctuation::evaluate_experiment(exp).map_err(|e| match e {
         fluctuation::FluctuationError::NoRatio { .. } => anyhow::anyhow!("{e}"),
@@ -167,13 +160,18 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
     } else {
         "rotational fluctuation"
     };
-    report::fluctuation::deviation(&e, &format!("{mechanism}: {what}")).write(plot)?;
-    report::fluctuation::spectrum(
-        &e,
-        &format!("{mechanism}: power spectrum of the {what}"),
-        200.0,
-    )
-    .write(&spectrum_path(plot))?;
+    plot.write(
+        &report::fluctuation::deviation(&e, &format!("{mechanism}: {what}")),
+        "",
+    )?;
+    plot.write(
+        &report::fluctuation::spectrum(
+            &e,
+            &format!("{mechanism}: power spectrum of the {what}"),
+            200.0,
+        ),
+        "-spectrum",
+    )?;
     print(&e, kind, json, &exp.path)
 }
 

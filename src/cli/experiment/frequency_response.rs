@@ -1,6 +1,7 @@
 //! `rtid experiment frequency-response` and the evaluation of frequency-response files.
 
-use std::path::{Path, PathBuf};
+use crate::cli::common::plot::Plot;
+use std::path::PathBuf;
 
 use anyhow::{bail, Context};
 
@@ -266,7 +267,7 @@ fn warn_about_backlash(points: &[Point]) {
 /// gain plot written to `plot` (with the linear curve when the file has one). With a
 /// phase, also each resonance's modal parameters ([`modal::modes`]) and the phase and
 /// Nyquist plots beside `plot` (`STEM_phase.svg`, `STEM_nyquist.svg`).
-pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
+pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
     let Data::FrequencyResponse {
         frequency_hz,
         gain_db,
@@ -283,8 +284,10 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
     let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
     let title = format!("{mechanism}: frequency response (table / motor × ratio)");
     let linear = extra.get("linear_gain_db").map(Vec::as_slice);
-    rtid::report::frequency_response::gain(frequency_hz, gain_db, linear, &peaks, &title)
-        .write(plot)?;
+    plot.write(
+        &rtid::report::frequency_response::gain(frequency_hz, gain_db, linear, &peaks, &title),
+        "",
+    )?;
     let complex = complex_evaluation(exp, plot)?;
     if json {
         let mut value = serde_json::json!({
@@ -297,8 +300,10 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
             value["modes"] = rtid::io::json::value(&c.modes)?;
             value["response"] = c.form.response.name().into();
             value["noise_stated"] = c.noise_stated.into();
-            value["phase_plot"] = rtid::io::json::value(&c.plots[0])?;
-            value["nyquist_plot"] = rtid::io::json::value(&c.plots[1])?;
+            if let [Some(phase), Some(nyquist)] = &c.plots {
+                value["phase_plot"] = rtid::io::json::value(phase)?;
+                value["nyquist_plot"] = rtid::io::json::value(nyquist)?;
+            }
         }
         println!("{}", rtid::io::json::pretty(&value)?);
     } else {
@@ -330,14 +335,15 @@ struct ComplexEvaluation {
     form: ResponseForm,
     modes: Vec<modal::Mode>,
     noise_stated: bool,
-    plots: [PathBuf; 2],
+    /// The phase and Nyquist plots, where plots are written.
+    plots: [Option<PathBuf>; 2],
 }
 
 /// The modes of the file's complex response (the drive's ratio, as
 /// [`measured::complex_points`] gives it) and its phase and Nyquist plots beside
 /// `plot`; `None` without a phase, or where no line is resolved (every line flagged
 /// below the table encoder's resolution: the warnings say so).
-fn complex_evaluation(exp: &Experiment, plot: &Path) -> anyhow::Result<Option<ComplexEvaluation>> {
+fn complex_evaluation(exp: &Experiment, plot: &Plot) -> anyhow::Result<Option<ComplexEvaluation>> {
     let Some(mut c) = measured::complex_points(exp, |_| true) else {
         return Ok(None);
     };
@@ -357,40 +363,23 @@ fn complex_evaluation(exp: &Experiment, plot: &Path) -> anyhow::Result<Option<Co
         *v = order.iter().map(|&k| v[k]).collect();
     }
     let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
-    let plots = [sibling(plot, "phase"), sibling(plot, "nyquist")];
-    let mut inputs: Vec<&Path> = vec![&exp.path];
-    inputs.extend(exp.data_path.as_deref());
-    for p in &plots {
-        crate::cli::common::inputs::refuse_overwrite("the plot", p, &inputs)?;
-    }
-    let figures = &rtid::report::frequency_response::phase_and_nyquist(
+    let [phase, nyquist] = rtid::report::frequency_response::phase_and_nyquist(
         &c.frequency_hz,
         &c.ln_gain,
         &c.phase_rad,
         &format!("{mechanism}: {ratio}"),
         unit,
     );
-    for (figure, path) in figures.iter().zip(&plots) {
-        figure.write(path)?;
-    }
+    let plots = [
+        plot.write(&phase, "_phase")?,
+        plot.write(&nyquist, "_nyquist")?,
+    ];
     Ok(Some(ComplexEvaluation {
         form,
         modes,
         noise_stated: c.sigma_ln.is_some() || c.sigma_phase.is_some(),
         plots,
     }))
-}
-
-/// `plot` with `_SUFFIX` added to its stem.
-fn sibling(plot: &Path, suffix: &str) -> PathBuf {
-    let stem = plot.file_stem().map_or_else(
-        || "frequency_response".into(),
-        |s| s.to_string_lossy().into_owned(),
-    );
-    let ext = plot
-        .extension()
-        .map_or_else(|| "svg".into(), |e| e.to_string_lossy().into_owned());
-    plot.with_file_name(format!("{stem}_{suffix}.{ext}"))
 }
 
 /// The modes as a table.
@@ -438,9 +427,7 @@ fn print_modes(c: &ComplexEvaluation) {
              when the model explains the band)"
         }
     );
-    println!(
-        "  plots: {}, {}",
-        c.plots[0].display(),
-        c.plots[1].display()
-    );
+    if let [Some(phase), Some(nyquist)] = &c.plots {
+        println!("  plots: {}, {}", phase.display(), nyquist.display());
+    }
 }

@@ -1,7 +1,8 @@
 //! `rtid experiment frequency-response-time` and the evaluation of
 //! `frequency_response_time` files (raw torque and angles over time).
 
-use std::path::{Path, PathBuf};
+use crate::cli::common::plot::Plot;
+use std::path::Path;
 
 use anyhow::bail;
 
@@ -173,7 +174,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     experiment_file::write(&path, &manifest, &record::to_data(&rec))?;
     report_with(
         &experiment_file::read(&path)?,
-        &a.common.out.join(format!("{stem}.svg")),
+        &Plot::at(a.common.out.join(format!("{stem}.svg")), &[])?,
         a.common.json,
         &a.estimate.options(),
     )
@@ -271,19 +272,11 @@ impl Args {
     }
 }
 
-/// `FILE.svg` → `FILE-coherence.svg`.
-fn coherence_path(plot: &Path) -> PathBuf {
-    let stem = plot
-        .file_stem()
-        .map_or("plot".into(), |s| s.to_string_lossy());
-    plot.with_file_name(format!("{stem}-coherence.svg"))
-}
-
 /// Evaluates a `frequency_response_time` experiment: printed (table or JSON), the gain
 /// plot written to `plot` and, for H1, the coherence beside it (`…-coherence.svg`).
 pub fn report_with(
     exp: &Experiment,
-    plot: &Path,
+    plot: &Plot,
     json: bool,
     opts: &EstimateOptions,
 ) -> anyhow::Result<()> {
@@ -314,11 +307,11 @@ pub fn report_with(
     Ok(())
 }
 
-fn plot_evaluation(e: &Evaluation, mechanism: &str, plot: &Path) -> anyhow::Result<()> {
+fn plot_evaluation(e: &Evaluation, mechanism: &str, plot: &Plot) -> anyhow::Result<()> {
     let (gain, coherence) = rtid::report::frequency_response_time::figures(e, mechanism);
-    gain.write(plot)?;
+    plot.write(&gain, "")?;
     if let Some(c) = coherence {
-        c.write(&coherence_path(plot))?;
+        plot.write(&c, "-coherence")?;
     }
     Ok(())
 }

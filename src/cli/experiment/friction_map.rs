@@ -1,6 +1,6 @@
 //! `rtid experiment friction-map` and the evaluation of friction-map files.
 
-use std::path::Path;
+use crate::cli::common::plot::Plot;
 
 use anyhow::Context;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
@@ -213,17 +213,18 @@ fn manifest(p: &Params, test: &MapTest, a: &Args) -> Manifest {
 
 /// Evaluates a friction-map experiment: runs and laws printed (table or JSON), the map
 /// with its laws written to `plot` and the residuals beside it (`STEM-residuals.svg`).
-pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
+pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
     let Data::FrictionMap(map) = &exp.data else {
         anyhow::bail!("{}: not a friction map", exp.path.display());
     };
     let e =
         friction_map::evaluate(map).map_err(|m| anyhow::anyhow!("{}: {m}", exp.path.display()))?;
     let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("axis");
-    figures::map(&e, &format!("{mechanism}: friction map")).write(plot)?;
-    let stem = plot.file_stem().unwrap_or_default().to_string_lossy();
-    figures::residuals(&e, &format!("{mechanism}: friction map, residuals"))
-        .write(&plot.with_file_name(format!("{stem}-residuals.svg")))?;
+    plot.write(&figures::map(&e, &format!("{mechanism}: friction map")), "")?;
+    plot.write(
+        &figures::residuals(&e, &format!("{mechanism}: friction map, residuals")),
+        "-residuals",
+    )?;
     if json {
         let mut value = rtid::io::json::value(&e).context("the evaluation as JSON")?;
         value["kind"] = serde_json::json!("friction_map");

@@ -13,6 +13,7 @@ pub mod servo_trace;
 pub mod torque_curve;
 pub mod unbalance;
 
+use crate::cli::common::plot::Plot;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
@@ -72,8 +73,8 @@ pub struct Common {
 }
 
 /// How a test reports an experiment file: print the evaluation (table or JSON) and
-/// write the plot to the given path.
-pub type Report = fn(&Experiment, &Path, bool) -> anyhow::Result<()>;
+/// write the plots where [`Plot`] says.
+pub type Report = fn(&Experiment, &Plot, bool) -> anyhow::Result<()>;
 
 impl Common {
     /// Writes the test's experiment file as `STEM.json` + `STEM.csv` in the output
@@ -95,9 +96,11 @@ impl Common {
         }
         manifest.data = Some(format!("{stem}.csv"));
         experiment_file::write(&path, &manifest, data)?;
+        let plot = self.out.join(format!("{stem}.svg"));
+        let inputs: Vec<&Path> = self.model.params.iter().map(PathBuf::as_path).collect();
         report(
             &experiment_file::read(&path)?,
-            &self.out.join(format!("{stem}.svg")),
+            &Plot::at(plot, &inputs)?,
             self.json,
         )
     }

@@ -1,5 +1,6 @@
 //! `rtid experiment positioning` and the evaluation of positioning files.
 
+use crate::cli::common::plot::Plot;
 use std::path::Path;
 
 use anyhow::bail;
@@ -196,7 +197,7 @@ fn run_positioning(a: &Args, p: &Params, test: positioning::PositioningTest) -> 
 /// Evaluates a positioning experiment: ISO 230-2 statistics printed (table or
 /// JSON) in the axis's units (arc-seconds, or µm on a linear axis), and the Fig. 10
 /// plot written to `plot`.
-pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
+pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
     let Some(readings) = positioning::from_data(&exp.data) else {
         bail!("{}: not a positioning experiment", exp.path.display());
     };
@@ -207,7 +208,10 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
         "{}: ISO 230-2 positioning",
         exp.manifest.mechanism.as_deref().unwrap_or("table")
     );
-    rtid::report::positioning::deviations(&report, &title, units).write(plot)?;
+    plot.write(
+        &rtid::report::positioning::deviations(&report, &title, units),
+        "",
+    )?;
     print_positioning(&report, units, json, &exp.path)
 }
 

@@ -2,7 +2,7 @@
 //! a servo trace: the friction law by inverse dynamics (IDIM-LS) and, with a model,
 //! the trace replayed and the benchmark's simulation error.
 
-use std::path::Path;
+use crate::cli::common::plot::Plot;
 
 use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
@@ -155,7 +155,7 @@ struct TraceReport {
 /// Evaluates the trace `exp`; replays it on `model` when one is given.
 pub fn report(
     exp: &Experiment,
-    plot: &Path,
+    plot: &Plot,
     json: bool,
     model: Option<Params>,
 ) -> anyhow::Result<()> {
@@ -176,10 +176,11 @@ pub fn report(
         Some(r) => Some(simulation_error(&trace, r).with_context(|| source.clone())?),
         None => None,
     };
-    figures::following_error(&trace, run.as_ref(), file.axis).write(plot)?;
-    let stem = plot.file_stem().unwrap_or_default().to_string_lossy();
-    figures::effort(&trace, run.as_ref(), file.axis)
-        .write(&plot.with_file_name(format!("{stem}-effort.svg")))?;
+    plot.write(
+        &figures::following_error(&trace, run.as_ref(), file.axis),
+        "",
+    )?;
+    plot.write(&figures::effort(&trace, run.as_ref(), file.axis), "-effort")?;
     let report = TraceReport {
         kind: "servo_trace",
         source,

@@ -1,6 +1,6 @@
 //! `rtid experiment torque-curve` and the evaluation of torque-curve files.
 
-use std::path::Path;
+use crate::cli::common::plot::Plot;
 
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use rtid::experiments::torque_curve::TorqueReport;
@@ -143,7 +143,7 @@ fn run_torque_curve(a: &Args, p: &Params, test: TorqueTest) -> anyhow::Result<()
 /// Evaluates a torque-curve experiment: RMS, peak and friction printed (table or
 /// JSON); torque over time written to `plot`, and, when the file has the table angle,
 /// torque over angle beside it (`STEM-vs-angle.svg`).
-pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
+pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
     let Some(curve) = torque_curve::from_data(&exp.data) else {
         anyhow::bail!("{}: not a torque curve", exp.path.display());
     };
@@ -153,10 +153,9 @@ pub fn report(exp: &Experiment, plot: &Path, json: bool) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("{}: {e}", exp.path.display()))?;
     let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
     let title = format!("{mechanism}: motor torque");
-    figures::over_time(&curve, &report, &title).write(plot)?;
+    plot.write(&figures::over_time(&curve, &report, &title), "")?;
     if let Some(figure) = figures::over_angle(&curve, &title) {
-        let stem = plot.file_stem().unwrap_or_default().to_string_lossy();
-        figure.write(&plot.with_file_name(format!("{stem}-vs-angle.svg")))?;
+        plot.write(&figure, "-vs-angle")?;
     }
     if json {
         let mut value = rtid::io::json::value(&report)?;
