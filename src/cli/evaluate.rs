@@ -79,6 +79,8 @@ pub struct Args {
     pub plot: Option<PathBuf>,
     #[command(flatten)]
     pub estimate: frequency_response_time::EstimateArgs,
+    #[command(flatten)]
+    pub idim: servo_trace::IdimArgs,
     /// The model a servo trace is replayed on (servo traces only; optional).
     #[command(flatten)]
     pub model: ModelArgs,
@@ -113,7 +115,7 @@ fn report(a: &Args, exp: &experiment_file::Experiment, plot: &Plot) -> anyhow::R
         Kind::Fluctuation | Kind::Unbalance => fluctuation::report(exp, plot, a.json),
         Kind::ServoTrace => {
             let model = a.model.given().then(|| a.model.load()).transpose()?;
-            servo_trace::report(exp, plot, a.json, model)
+            servo_trace::report(exp, plot, a.json, model, &a.idim)
         }
         Kind::FrequencyResponseTime => {
             frequency_response_time::report_with(exp, plot, a.json, &a.estimate.options())

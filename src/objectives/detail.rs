@@ -29,6 +29,10 @@ pub enum Detail {
         force_rms: f64,
         position_rms: f64,
         position_max: f64,
+        /// The span (largest − smallest) of the recorded position, m or rad: what the
+        /// position error is judged against.
+        #[serde(default)]
+        position_span: f64,
     },
     /// A complex frequency response: the RMS errors of gain (dB) and phase (deg), the
     /// delay fitted with the model where the file's delay is unknown, s, and where it

@@ -124,6 +124,20 @@ impl TraceResidual {
     }
 }
 
+/// Largest − smallest of `x` (0 when empty).
+fn span(x: &[f64]) -> f64 {
+    let (lo, hi) = x
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    if hi >= lo {
+        hi - lo
+    } else {
+        0.0
+    }
+}
+
 fn rms(x: &[f64]) -> f64 {
     (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64).sqrt()
 }
@@ -176,6 +190,7 @@ impl Objective for TraceResidual {
             position_rms: rms(position) * self.position_scale,
             position_max: position.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
                 * self.position_scale,
+            position_span: span(&self.trace.position),
         })
     }
 }
@@ -186,6 +201,7 @@ fn describe(d: &Detail) -> Option<String> {
         force_rms,
         position_rms,
         position_max,
+        ..
     } = d
     else {
         return None;
@@ -233,6 +249,7 @@ mod tests {
             force_rms,
             position_rms,
             position_max,
+            position_span,
         }) = o.detail(&crate::model::presets::load("direct-drive").unwrap(), &r)
         else {
             panic!("a trace detail")
@@ -240,5 +257,7 @@ mod tests {
         assert!((force_rms - want.force_rms).abs() < 1e-12);
         assert!((position_rms - want.position_rms).abs() < 1e-12);
         assert!((position_max - want.position_max).abs() < 1e-12);
+        assert_eq!(position_span, 0.0, "the record stood still");
+        assert_eq!(span(&[0.5, -1.0, 2.0]), 3.0);
     }
 }

@@ -17,6 +17,60 @@ use rtid::model::Params;
 use rtid::report::servo_trace as figures;
 
 use super::{check, Common};
+
+/// How IDIM-LS treats a servo trace in `rtid evaluate` (defaults: the EMPS
+/// benchmark's design carried to the record's sampling rate).
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct IdimArgs {
+    /// Servo traces (IDIM-LS): cut-off of the zero-phase Butterworth low-pass on the
+    /// position before it is differentiated, Hz. Default: a tenth of the sampling rate
+    /// (100 Hz at 1 kHz).
+    #[arg(long, value_name = "HZ", help_heading = "Servo traces (IDIM-LS)")]
+    pub cutoff_hz: Option<f64>,
+    /// Servo traces: keep every K-th row after the decimation filter (1: every row, no
+    /// decimation filter). Default 10.
+    #[arg(long, value_name = "K", help_heading = "Servo traces (IDIM-LS)")]
+    pub decimation: Option<usize>,
+    /// Servo traces: seconds dropped at each end of the record (the filters' start and
+    /// end transients). Default: 200 samples (0.2 s at 1 kHz, 0.8 s at 250 Hz).
+    #[arg(long, value_name = "SECONDS", help_heading = "Servo traces (IDIM-LS)")]
+    pub trim_s: Option<f64>,
+    /// Servo traces: rows whose filtered speed is below this are left out (their
+    /// friction's sign is in doubt), rad/s on a rotary axis, m/s on a linear one.
+    /// Default 0.001.
+    #[arg(long, value_name = "SPEED", help_heading = "Servo traces (IDIM-LS)")]
+    pub min_speed: Option<f64>,
+}
+
+impl IdimArgs {
+    /// The settings for a record sampled every `period_s`: the defaults
+    /// ([`IdimSettings::for_sample_period`]) with what was given.
+    pub fn settings(&self, period_s: f64) -> anyhow::Result<IdimSettings> {
+        let mut s = IdimSettings::for_sample_period(period_s);
+        for (option, value) in [
+            ("--cutoff-hz", self.cutoff_hz),
+            ("--trim-s", self.trim_s),
+            ("--min-speed", self.min_speed),
+        ] {
+            if value.is_some_and(|v| !v.is_finite() || v < 0.0) {
+                bail!(
+                    "{option} {}: must be a finite number ≥ 0",
+                    value.unwrap_or_default()
+                );
+            }
+        }
+        if self.decimation == Some(0) {
+            bail!("--decimation 0: must be at least 1 (1: no decimation)");
+        }
+        s.cutoff_hz = self.cutoff_hz.unwrap_or(s.cutoff_hz);
+        s.decimation = self.decimation.unwrap_or(s.decimation);
+        s.min_speed = self.min_speed.unwrap_or(s.min_speed);
+        if let Some(t) = self.trim_s {
+            s.trim = (t / period_s).round() as usize;
+        }
+        Ok(s)
+    }
+}
 use crate::cli::common::progress;
 
 pub const LONG_ABOUT: &str = "\
@@ -133,7 +187,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let data = Data::ServoTrace(trace.to_file(p.axis, unit));
     a.common
         .write_and_report("servo_trace", manifest, &data, |exp, plot, json| {
-            report(exp, plot, json, None)
+            report(exp, plot, json, None, &IdimArgs::default())
         })
 }
 
@@ -147,6 +201,12 @@ struct TraceReport {
     sample_period_s: f64,
     /// M, Fv, Fc, OF of F = M·a + Fv·v + Fc·sign(v) + OF (OF = −Tload).
     inverse_dynamics: IdimFit,
+    /// Where they are: `motor` (the positions divided by `ratio`) or `as_recorded`
+    /// (the effort over the loop encoder's position: on a geared axis neither the
+    /// motor's frame nor the table's).
+    frame: &'static str,
+    /// Table turns per motor turn the positions were divided by.
+    ratio: Option<f64>,
     /// The trace replayed on `--preset`/`--params`: position in m or rad, force in N
     /// or N·m.
     simulation_error: Option<Misfit>,
@@ -158,6 +218,7 @@ pub fn report(
     plot: &Plot,
     json: bool,
     model: Option<Params>,
+    idim: &IdimArgs,
 ) -> anyhow::Result<()> {
     let Data::ServoTrace(file) = &exp.data else {
         bail!("{}: not a servo trace", exp.path.display());
@@ -165,9 +226,13 @@ pub fn report(
     let source = exp.path.display().to_string();
     let trace = ServoTrace::from_file(file);
     let sample_period_s = trace.check().with_context(|| source.clone())?;
-    let fit = trace
-        .fit_friction(&IdimSettings::for_sample_period(sample_period_s))
-        .with_context(|| format!("{source}: inverse dynamics"))?;
+    let ratio = frame_ratio(exp, model.as_ref())?;
+    let settings = idim.settings(sample_period_s)?;
+    let fit = match ratio {
+        Some(r) => trace.fit_friction_at_motor(r, &settings),
+        None => trace.fit_friction(&settings),
+    }
+    .with_context(|| format!("{source}: inverse dynamics"))?;
     let run = match &model {
         Some(p) => Some(replayed(p, &trace, file.axis, &source)?),
         None => None,
@@ -188,6 +253,12 @@ pub fn report(
         samples: trace.len(),
         sample_period_s,
         inverse_dynamics: fit,
+        frame: if ratio.is_some() {
+            "motor"
+        } else {
+            "as_recorded"
+        },
+        ratio,
         simulation_error: misfit,
     };
     if json {
@@ -196,6 +267,22 @@ pub fn report(
         print_report(&report);
     }
     Ok(())
+}
+
+/// The ratio that takes the trace's (table-side) positions to the motor:
+/// `conditions.ratio`, else the model's when it is geared; none for a direct or
+/// ungeared axis, or when neither says.
+fn frame_ratio(exp: &Experiment, model: Option<&Params>) -> anyhow::Result<Option<f64>> {
+    if let Some(r) = exp.manifest.conditions.ratio {
+        if !(r.is_finite() && r > 0.0) {
+            bail!(
+                "{}: `conditions.ratio` is {r}: it must be positive (table turns per motor turn, Rg·Rw)",
+                exp.path.display()
+            );
+        }
+        return Ok(Some(r));
+    }
+    Ok(model.map(Params::ratio).filter(|&r| r != 1.0))
 }
 
 /// The trace replayed on `p`, which must be of the trace's axis.
@@ -227,10 +314,17 @@ fn print_report(r: &TraceReport) {
     };
     let mut t = Table::new();
     t.load_preset(UTF8_FULL_CONDENSED);
+    let frame = match r.ratio {
+        Some(ratio) => format!(
+            "at the motor (positions ÷ ratio, 1:{})",
+            (1e6 / ratio).round() / 1e6
+        ),
+        None => "as recorded".to_string(),
+    };
     t.set_header([
-        "F = M·a + Fv·v + Fc·sign(v) + OF (IDIM-LS)",
-        "value",
-        "± std. error",
+        format!("F = M·a + Fv·v + Fc·sign(v) + OF (IDIM-LS), {frame}"),
+        "value".to_string(),
+        "± std. error".to_string(),
     ]);
     for (name, e) in [
         (inertia.to_string(), f.inertia),
@@ -245,9 +339,25 @@ fn print_report(r: &TraceReport) {
         ]);
     }
     println!("{t}");
+    if r.ratio.is_none() && r.axis == Axis::Rotary {
+        println!(
+            "(as recorded: the effort over the loop encoder's position, in the table's frame; \
+             on a geared axis these are in neither frame — give conditions.ratio, --preset or \
+             --params to have them at the motor)"
+        );
+    }
+    let s = &f.settings;
     println!(
-        "IDIM-LS: position low-passed at {} Hz (order {}, zero phase), decimated by {}, {} rows, residual {:.4} {force} RMS; standard errors assume a white residual (lower bounds)",
-        f.settings.cutoff_hz, f.settings.filter_order, f.settings.decimation, f.rows, f.residual_rms
+        "IDIM-LS: position low-passed at {:.4} Hz (--cutoff-hz; order {}, zero phase), decimated by {} (--decimation), {} samples ({:.3} s, --trim-s) dropped at each end, {} rows below {} {position}/s left out (--min-speed), {} rows; residual {:.4} {force} RMS; standard errors assume a white residual (lower bounds)",
+        s.cutoff_hz,
+        s.filter_order,
+        s.decimation,
+        s.trim,
+        s.trim as f64 * f.sample_period_s,
+        f.slow_rows,
+        rtid::names::Num(s.min_speed),
+        f.rows,
+        f.residual_rms
     );
     match &r.simulation_error {
         Some(m) => {

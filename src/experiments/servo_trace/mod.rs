@@ -193,12 +193,32 @@ impl ServoTrace {
     }
 
     /// The friction law F = M·a + Fv·v + Fc·sign(v) + offset fitted to the loop
-    /// encoder's position and the force (inverse_dynamics.rs).
+    /// encoder's position and the force (inverse_dynamics.rs). On a geared axis
+    /// these are in neither frame (the motor's torque over the table's acceleration):
+    /// [`ServoTrace::fit_friction_at_motor`] gives them at the motor.
     pub fn fit_friction(&self, settings: &IdimSettings) -> Result<IdimFit, FitError> {
         let period = self.check()?;
         Ok(inverse_dynamics::identify(
             period,
             &self.position,
+            &self.force,
+            settings,
+        )?)
+    }
+
+    /// [`ServoTrace::fit_friction`] with the position taken to the motor side,
+    /// divided by `ratio` (table turns per motor turn, Rg·Rw): J, Fv, Fc and the
+    /// offset at the motor, the speed threshold in motor rad/s.
+    pub fn fit_friction_at_motor(
+        &self,
+        ratio: f64,
+        settings: &IdimSettings,
+    ) -> Result<IdimFit, FitError> {
+        let period = self.check()?;
+        let motor: Vec<f64> = self.position.iter().map(|x| x / ratio).collect();
+        Ok(inverse_dynamics::identify(
+            period,
+            &motor,
             &self.force,
             settings,
         )?)

@@ -45,6 +45,7 @@ pub fn assess(
     let residuals = residual_report(joint, params, parts);
     warnings.extend(resonance_misses(&residuals));
     warnings.extend(phase_delays(&residuals));
+    warnings.extend(traces_not_followed(&residuals));
     let uncertainty = if interrupted {
         None
     } else {
@@ -152,6 +153,31 @@ fn residual_report(joint: &Joint, p: &Params, parts: Vec<Vec<f64>>) -> Vec<Exper
         .collect()
 }
 
+/// A replay whose position error's RMS exceeds this fraction of the record's span
+/// does not follow the record (EMPS's fit: 2 µm over 0.2 m, 1e-5).
+const NOT_FOLLOWED: f64 = 0.1;
+
+/// Servo traces whose replay at the result does not follow the record.
+fn traces_not_followed(residuals: &[ExperimentResidual]) -> Vec<Warning> {
+    residuals
+        .iter()
+        .filter_map(|r| match &r.detail {
+            Some(Detail::Trace {
+                position_rms,
+                position_span,
+                ..
+            }) if position_rms.is_nan() || *position_rms > NOT_FOLLOWED * position_span => {
+                Some(Warning::NotFollowed {
+                    source: r.source.clone(),
+                    position_rms: *position_rms,
+                    position_span: *position_span,
+                })
+            }
+            _ => None,
+        })
+        .collect()
+}
+
 /// Complex responses whose phase errors show a delay the manifest does not state.
 fn phase_delays(residuals: &[ExperimentResidual]) -> Vec<Warning> {
     residuals
@@ -183,4 +209,37 @@ fn resonance_misses(residuals: &[ExperimentResidual]) -> Vec<Warning> {
             _ => None,
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn trace(position_rms: f64, position_span: f64) -> ExperimentResidual {
+        ExperimentResidual {
+            source: "trace.json".into(),
+            objective: "servo_trace".into(),
+            weight: 1.0,
+            scale: String::new(),
+            residuals: vec![],
+            rms: 0.0,
+            detail: Some(Detail::Trace {
+                force_rms: 1.0,
+                position_rms,
+                position_max: position_rms,
+                position_span,
+            }),
+        }
+    }
+
+    /// EMPS's fit (2 µm over 0.2 m) follows; a replay 59 rad off a 1.5 rad record
+    /// does not, nor one whose error is NaN.
+    #[test]
+    fn a_replay_far_off_the_record_is_said_not_to_follow_it() {
+        assert!(traces_not_followed(&[trace(2e-6, 0.2)]).is_empty());
+        let off = traces_not_followed(&[trace(59.0, 1.5)]);
+        assert!(matches!(&off[..], [Warning::NotFollowed { .. }]), "{off:?}");
+        assert!(off[0].to_string().contains("does not follow"), "{}", off[0]);
+        assert_eq!(traces_not_followed(&[trace(f64::NAN, 1.5)]).len(), 1);
+    }
 }

@@ -30,6 +30,15 @@ pub(super) fn text(w: &Warning) -> String {
             source,
             max_miss_hz,
         } => resonance_miss(source, *max_miss_hz),
+        Warning::NotFollowed {
+            source,
+            position_rms,
+            position_span,
+        } => format!(
+            "{source}: the replay does not follow the record (position error {position_rms:.4e} \
+             RMS over a span of {position_span:.4e}, SI): the fitted values do not describe this \
+             drive — check the controller's settings, the loop and the frame (ratio)"
+        ),
         Warning::NoEffect { name } => {
             format!("{name} has no effect on the residuals: the data say nothing about it")
         }

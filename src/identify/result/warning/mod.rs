@@ -44,6 +44,13 @@ pub enum Warning {
     AtBound { name: String, side: Side },
     /// The fitted model misses measured resonances by more than 1 Hz.
     ResonanceMiss { source: String, max_miss_hz: f64 },
+    /// A servo trace's replay does not follow the record: its position error's RMS
+    /// is more than a tenth of the span the record's position covers (m or rad).
+    NotFollowed {
+        source: String,
+        position_rms: f64,
+        position_span: f64,
+    },
     /// The phase errors of a complex frequency response grow with frequency like a
     /// delay the manifest does not state (`delay_s`): removing it would halve them.
     PhaseDelay { source: String, delay_s: f64 },
@@ -110,6 +117,7 @@ impl Warning {
             Warning::DistinctSolution { .. } => "distinct_solution",
             Warning::AtBound { .. } => "at_bound",
             Warning::ResonanceMiss { .. } => "resonance_miss",
+            Warning::NotFollowed { .. } => "not_followed",
             Warning::PhaseDelay { .. } => "phase_delay",
             Warning::NoEffect { .. } => "no_effect",
             Warning::TooFewResiduals { .. } => "too_few_residuals",
