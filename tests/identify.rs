@@ -310,6 +310,42 @@ fn an_interrupted_search_still_writes_a_valid_result() {
     assert_eq!(v["termination"]["code"], "interrupted", "{text}");
 }
 
+/// Interrupted after n evaluations, for 24 moments from the first start's first
+/// evaluations to its last start's last, then resumed from the checkpoint: the
+/// parameters and cost of the run never interrupted, bit for bit (issue 37: a start
+/// interrupted with its cost still null used to continue from its last point, and
+/// ended elsewhere).
+#[test]
+fn a_resumed_identification_is_the_uninterrupted_one_from_every_moment() {
+    let Fixture { spec, truth } = support::worm_frequency_response();
+    let base = off(&truth, &[("Kw", 1.4), ("Kg", 0.7), ("Ciw", 3.0)]);
+    let mut c = config(vec![spec], base, &["Kw", "Kg", "Ciw"]);
+    c.fidelity = FidelityChoice::Linear;
+    c.search.starts = Some(3);
+    let whole = run(&c);
+    let total = whole.result.evaluations;
+    assert!(total > 48, "{total} evaluations");
+    let dir = tempfile::tempdir().unwrap();
+    let checkpoint = dir.path().join("fit.ck.json");
+    c.checkpoint = Some(checkpoint.clone());
+    for k in 1..=24 {
+        let n = k * (total - 1) / 25 + 1;
+        let _ = std::fs::remove_file(&checkpoint);
+        c.resume = false;
+        c.search.max_evaluations = Some(n);
+        let first = run(&c);
+        assert!(first.result.interrupted, "stopped after {n} of {total}");
+        c.resume = true;
+        c.search.max_evaluations = None;
+        let again = run(&c);
+        assert_eq!(
+            (&again.result.parameters, again.result.cost),
+            (&whole.result.parameters, whole.result.cost),
+            "resumed after {n} of {total} evaluations"
+        );
+    }
+}
+
 #[test]
 fn the_paper_worm_resonances_are_out_of_reach_of_kw_and_kg() {
     let Fixture { spec, truth } = support::paper_worm();

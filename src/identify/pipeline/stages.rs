@@ -66,16 +66,21 @@ pub fn run(
                 },
             };
             if stage.escalation {
-                let checks =
-                    escalation::check(config, &space.params(&best).map_err(ObjectiveError::from)?)?;
-                let verdict = escalation::verdict(&checks);
-                check = Some(checks);
+                let at = space.params(&best).map_err(ObjectiveError::from)?;
+                let checks = escalation::check(config, &at)?;
+                let assumed = escalation::assumed(&at, &space.names);
+                let verdict = escalation::verdict(&checks, &assumed);
                 // Resumed inside the stage: the decision was taken before.
                 match verdict {
                     Some(w) => notes.push(w),
-                    None if !inside => break,
+                    None if !inside => {
+                        notes.extend(escalation::stands(&checks, &assumed));
+                        check = Some(checks);
+                        break;
+                    }
                     None => {}
                 }
+                check = Some(checks);
             }
             let best = if stage.stage == Stage::Correction && !inside {
                 correction_start(config, stage, space, best, ran.as_ref(), monitor)?

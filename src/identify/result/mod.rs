@@ -58,6 +58,11 @@ pub struct NonlinearCheck {
     /// (empty otherwise).
     #[serde(default)]
     pub linear_hz: Vec<f64>,
+    /// The measured gain's noise, dB, estimated from the curve itself (the spread of
+    /// the second differences of the linear model's gain errors, median-based: a
+    /// smooth misfit has none); `None` on fewer than 20 lines.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise_db: Option<f64>,
 }
 
 /// The result of `rtid identify`.

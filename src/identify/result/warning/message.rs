@@ -63,11 +63,32 @@ pub(super) fn text(w: &Warning) -> String {
             max_miss_hz,
             max_miss_percent,
             linear_misfit_db,
-        } => escalated(
+            assumed,
+        } => {
+            escalated(
+                source,
+                (model_hz, measured_hz, linear_hz),
+                (*max_miss_hz, *max_miss_percent),
+                *linear_misfit_db,
+            ) + &assumed_note(assumed)
+        }
+        Warning::LinearStands {
             source,
-            (model_hz, measured_hz, linear_hz),
-            (*max_miss_hz, *max_miss_percent),
-            *linear_misfit_db,
+            linear_misfit_db,
+            noise_db,
+            max_miss_percent,
+            assumed,
+        } => format!(
+            "{source}: the linear fit explains the gain curve within its noise (misfit \
+             {linear_misfit_db:.3} dB RMS, the curve's own noise {noise_db:.3} dB), so it \
+             stands: the nonlinear test at its parameters{} moves the resonances by up to \
+             {max_miss_percent:.2} %, but these data do not show it (--model nonlinear \
+             corrects all the same)",
+            if assumed.is_empty() {
+                String::new()
+            } else {
+                format!(", with {assumed} assumed,")
+            }
         ),
         Warning::ProfileOpen {
             name,
@@ -153,6 +174,18 @@ fn escalated(
             format!("; the linear fit's own {} Hz", hz(linear_hz))
         }
     )
+}
+
+/// What a correction took as given, said after the escalation.
+fn assumed_note(assumed: &str) -> String {
+    if assumed.is_empty() {
+        String::new()
+    } else {
+        format!(
+            ". It assumes {assumed} as given: this record does not determine them (fit \
+             them with --fit, or state them with --set)"
+        )
+    }
 }
 
 fn hz(v: &[f64]) -> String {

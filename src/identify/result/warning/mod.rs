@@ -86,6 +86,20 @@ pub enum Warning {
         max_miss_hz: f64,
         max_miss_percent: f64,
         linear_misfit_db: f64,
+        /// The nonlinear parameters the correction takes as given (name = value, SI),
+        /// which this record does not determine.
+        #[serde(default)]
+        assumed: String,
+    },
+    /// `--model auto` kept the linear fit: it explains the gain curve within the
+    /// curve's own noise, so the nonlinear test's disagreement is not the data's.
+    LinearStands {
+        source: String,
+        linear_misfit_db: f64,
+        noise_db: f64,
+        max_miss_percent: f64,
+        /// The nonlinear parameters the test would have assumed.
+        assumed: String,
     },
     /// A profile stays below the 95 % level up to the parameter's bound on one side:
     /// the data bound it on the other side only; `family` are the other fitted
@@ -126,6 +140,7 @@ impl Warning {
             Warning::RoughCost => "rough_cost",
             Warning::EstimateUnused { .. } => "estimate_unused",
             Warning::Escalated { .. } => "escalated",
+            Warning::LinearStands { .. } => "linear_stands",
             Warning::ProfileOpen { .. } => "profile_open",
             Warning::ProfileBetterFit { .. } => "profile_better_fit",
         }
