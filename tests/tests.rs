@@ -34,6 +34,7 @@ mod friction_map;
 mod friction_map_epos;
 mod identify;
 mod import;
+mod import_matrices;
 mod inverse_dynamics;
 mod lanes;
 mod multisine_synthetic;

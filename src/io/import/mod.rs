@@ -10,8 +10,10 @@ mod friction_map;
 pub mod glitches;
 pub mod kinds;
 pub mod mapping;
+pub mod name_unit;
 pub mod plateaus;
 pub mod runs;
+mod suggest;
 
 use std::path::{Path, PathBuf};
 
@@ -610,6 +612,7 @@ fn findings(sources: &[Source], filled: &[Filled]) -> Vec<String> {
             out.push(format!("{}: {note}", s.path.display()));
         }
     }
+    out.extend(filled.iter().filter_map(|f| f.resolved.note.clone()));
     for f in filled {
         let file = &sources[f.resolved.file].path;
         out.extend(channel_findings(

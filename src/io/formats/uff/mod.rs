@@ -351,6 +351,7 @@ fn finish(collected: Collected) -> Result<Recording, Fault> {
         format: FORMAT,
         channels,
         notes,
+        groups: Vec::new(),
     })
 }
 
