@@ -35,6 +35,7 @@ mod friction_map_epos;
 mod identify;
 mod import;
 mod import_matrices;
+mod import_uff_none_labels;
 mod inverse_dynamics;
 mod lanes;
 mod multisine_synthetic;

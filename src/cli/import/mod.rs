@@ -23,14 +23,18 @@ First see what a file holds, without choosing anything:
   rtid import DATA_EMPS.mat --list
 lists each channel's name as the file spells it, its unit, number of samples, sample \
 period (or abscissa), first, last and mean value — after the scale factors and offsets \
-the file itself declares. --json prints the same as {\"channels\": [...], \"format\", \
+the file itself declares; a MAT-file's matrix once, with its shape and how its signals \
+are spelled (rec.q(i,:), i = 1…6). --filter TEXT lists only the names containing TEXT. \
+--json prints the same as {\"channels\": [...], \"format\", \
 \"notes\"} (an array of them for several files).
 
 Then map channels onto the roles of an experiment kind:
   rtid import FILE --kind KIND --map ROLE=CHANNEL[*SCALE][:UNIT] ... --out DIR
 Each role is taken from the named channel (exactly as --list spells it), multiplied by \
 SCALE (a number; *-1 flips a sign), in UNIT — the unit of CHANNEL×SCALE; without UNIT the \
-channel's own unit label. rtid converts to its SI columns. A computed role is a scaled \
+channel's own unit label, else the unit its name ends in (_deg, _nm = N·m, _deg_per_s …, \
+with a note). With no map for it, a frequency response's frf (a torque curve's effort) \
+takes the one channel that fits. rtid converts to its SI columns. A computed role is a scaled \
 channel: the force of a drive is its controller output (V) times the drive gain (N/V): \
 effort=vir*35.15:N.
 
@@ -178,13 +182,6 @@ fn read_all(files: &[PathBuf], format: Option<Format>) -> anyhow::Result<Vec<Sou
 
 fn request(a: &Args) -> anyhow::Result<import::Request> {
     let kind = a.kind.context("--kind is needed to write an experiment")?;
-    if a.map.is_empty() {
-        bail!(
-            "--map: no channel mapped; {} takes {} (rtid import FILE --list shows the channels)",
-            kind.name(),
-            kind.describe_roles()
-        );
-    }
     let maps = a
         .map
         .iter()
