@@ -34,6 +34,8 @@ mod friction_map;
 mod friction_map_epos;
 mod identify;
 mod import;
+mod import_matrices;
+mod import_uff_none_labels;
 mod inverse_dynamics;
 mod lanes;
 mod multisine_synthetic;

@@ -218,6 +218,7 @@ impl<'a> Table<'a> {
             format: "delimited",
             channels,
             notes: Vec::new(),
+            groups: Vec::new(),
         })
     }
 }

@@ -124,6 +124,7 @@ pub fn read(path: &Path) -> Result<Recording, FormatError> {
         format: "epos-studio",
         channels,
         notes,
+        groups: Vec::new(),
     })
 }
 

@@ -125,4 +125,39 @@ pub struct Recording {
     /// What the reader noticed and did not refuse (a skipped stray cell, a header
     /// property it does not use).
     pub notes: Vec<String>,
+    /// The arrays cut into several channels (a MAT-file's matrices), so that a
+    /// listing can show each once; empty for the other formats.
+    pub groups: Vec<Group>,
+}
+
+/// Channels cut from one array: a matrix's rows `name(i,:)` or columns `name(:,j)`
+/// (`name(:,j,k)` for an N-d array), 1-based as in MATLAB.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Group {
+    /// The array's name (`rec.act_pos_mot_deg`).
+    pub name: String,
+    /// Its dimensions (`[6, 2501]`).
+    pub shape: Vec<usize>,
+    /// True when each row is a signal (samples along the second dimension).
+    pub signals_in_rows: bool,
+    /// Its channels' indices in [`Recording::channels`].
+    pub channels: std::ops::Range<usize>,
+}
+
+impl Group {
+    /// How its channels are spelled: `rec.q(i,:), i = 1…6` or `M(:,j), j = 1…3`.
+    pub fn spelling(&self) -> String {
+        let n = self.channels.len();
+        match (self.signals_in_rows, self.shape.len()) {
+            (true, _) => format!("{}(i,:), i = 1…{n}", self.name),
+            (false, 2) => format!("{}(:,j), j = 1…{n}", self.name),
+            (false, _) => format!("{}(:,j,…)", self.name),
+        }
+    }
+
+    /// Its shape as MATLAB prints it (`6×2501`).
+    pub fn shape_text(&self) -> String {
+        let sizes: Vec<String> = self.shape.iter().map(|d| d.to_string()).collect();
+        sizes.join("×")
+    }
 }

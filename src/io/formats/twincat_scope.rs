@@ -137,6 +137,7 @@ pub fn read(path: &Path) -> Result<Recording, FormatError> {
         format: "twincat-scope",
         channels,
         notes,
+        groups: Vec::new(),
     })
 }
 

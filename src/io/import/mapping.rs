@@ -4,8 +4,11 @@
 //! (`effort=vir*35.15:N`: the controller output in volts times the drive gain in N/V
 //! is a force in newtons). Without UNIT the channel's own unit label is used.
 //!
-//! Channel names are matched exactly as the file spells them, and may themselves hold
-//! `*` or `:`: a map whose whole right-hand side names a channel takes it whole.
+//! Channel names are matched exactly as the file spells them (blanks inside a
+//! matrix's index aside: `rec.q(1, :)` is `rec.q(1,:)`), and may themselves hold `*`
+//! or `:`: a map whose whole right-hand side names a channel takes it whole. A channel
+//! without a unit label takes the unit its name ends in (`_deg`, `_nm`:
+//! [`super::name_unit`]), with a note.
 
 use crate::io::formats::units::{self, Unit, UnitError};
 use crate::io::formats::{Channel, Recording};
@@ -54,7 +57,9 @@ pub fn parse(text: &str) -> Result<MapSpec, MapSpecError> {
         return Err(MapSpecError::NoChannel { text: text.into() });
     }
     let (rest, unit) = match right.rsplit_once(':') {
-        Some((rest, unit)) if units::parse(unit).is_ok() || looks_like_unit(unit) => {
+        Some((rest, unit))
+            if balanced(unit) && (units::parse(unit).is_ok() || looks_like_unit(unit)) =>
+        {
             (rest, Some(unit.trim().to_string()))
         }
         _ => (right, None),
@@ -77,6 +82,23 @@ pub fn parse(text: &str) -> Result<MapSpec, MapSpecError> {
     })
 }
 
+/// Whether every `(` in `text` is closed and every `)` opened: `%(9.84 mN·m)` is,
+/// the `)*-1` after the `:` of `rec.q(1,:)*-1` is not (it is not a unit).
+fn balanced(text: &str) -> bool {
+    let mut depth = 0i32;
+    for c in text.chars() {
+        depth += match c {
+            '(' => 1,
+            ')' => -1,
+            _ => 0,
+        };
+        if depth < 0 {
+            return false;
+        }
+    }
+    depth == 0
+}
+
 /// A unit-shaped suffix (`%(…)`, `inc(…)`, a short word without spaces): taken as the
 /// unit even when it is not a known one, so that the message names the unit rather
 /// than a channel that does not exist.
@@ -97,6 +119,8 @@ pub struct Resolved<'a> {
     pub unit: Unit,
     /// SI per sample value: scale × unit.
     pub factor: f64,
+    /// Said of the resolution (a unit taken from the channel's name).
+    pub note: Option<String>,
 }
 
 /// Why a map cannot be resolved against the recordings: each message starts with the
@@ -104,19 +128,19 @@ pub struct Resolved<'a> {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum ResolveError {
-    /// Neither CHANNEL nor the whole right-hand side is a channel; `present` lists the
-    /// recordings' channels.
-    #[error("{given}: no channel `{channel}`; the file has {}", listed(present))]
+    /// Neither CHANNEL nor the whole right-hand side is a channel; `suggestion` gives
+    /// the closest names ([`super::suggest`]), starting with `; `.
+    #[error("{given}: no channel `{channel}`{suggestion}")]
     NoChannel {
         given: String,
         channel: String,
-        present: Vec<String>,
+        suggestion: String,
     },
     #[error(
         "{given}: `{channel}` is a channel of several of the files: import one file per experiment"
     )]
     SeveralFiles { given: String, channel: String },
-    #[error("{given}: the channel `{channel}` has no unit in its file: add one, e.g. {role}={channel}:UNIT")]
+    #[error("{given}: the channel `{channel}` has no unit in its file or its name: add one, e.g. {role}={channel}:UNIT")]
     NoUnit {
         given: String,
         channel: String,
@@ -155,14 +179,7 @@ pub fn resolve<'a>(
             channel: spec.channel,
         });
     }
-    let unit_text = spec.unit.clone().unwrap_or_else(|| channel.unit.clone());
-    if unit_text.trim().is_empty() {
-        return Err(ResolveError::NoUnit {
-            given: spec.given,
-            channel: spec.channel,
-            role: spec.role,
-        });
-    }
+    let (unit_text, note) = unit_of(&spec, channel)?;
     let unit = units::parse(&unit_text).map_err(|source| ResolveError::Unit {
         given: spec.given.clone(),
         source,
@@ -174,7 +191,34 @@ pub fn resolve<'a>(
         file,
         unit,
         factor,
+        note,
     })
+}
+
+/// The unit of a map: the map's, else the channel's label, else the unit the
+/// channel's name ends in (with a note saying so).
+fn unit_of(spec: &MapSpec, channel: &Channel) -> Result<(String, Option<String>), ResolveError> {
+    if let Some(unit) = &spec.unit {
+        return Ok((unit.clone(), None));
+    }
+    if !channel.unit.trim().is_empty() {
+        return Ok((channel.unit.clone(), None));
+    }
+    match super::name_unit::unit_in_name(&channel.name) {
+        Some(unit) => Ok((
+            unit.to_string(),
+            Some(format!(
+                "--map {}: `{}` has no unit in its file; its name says {unit}, taken \
+                 (give :UNIT in the map if it is not)",
+                spec.given, channel.name
+            )),
+        )),
+        None => Err(ResolveError::NoUnit {
+            given: spec.given.clone(),
+            channel: spec.channel.clone(),
+            role: spec.role.clone(),
+        }),
+    }
 }
 
 /// How many of the recordings have a channel named `name`.
@@ -185,37 +229,41 @@ fn files_with(recordings: &[&Recording], name: &str) -> usize {
         .count()
 }
 
-/// The channel named `name`, and its file's index: the first file that has one
-/// ([`resolve`] refuses a name several files share).
+/// The channel named `name` (blanks in a trailing index ignored), and its file's
+/// index: the first file that has one ([`resolve`] refuses a name several files
+/// share).
 fn find<'a>(recordings: &[&'a Recording], name: &str) -> Option<(usize, &'a Channel)> {
-    recordings
-        .iter()
-        .enumerate()
-        .find_map(|(i, r)| r.channels.iter().find(|c| c.name == name).map(|c| (i, c)))
+    let exact = |wanted: &str| {
+        recordings
+            .iter()
+            .enumerate()
+            .find_map(|(i, r)| r.channels.iter().find(|c| c.name == wanted).map(|c| (i, c)))
+    };
+    exact(name).or_else(|| {
+        let squeezed = squeeze_index(name)?;
+        exact(&squeezed)
+    })
 }
 
-/// The error for a channel not found: the ones there are.
+/// `rec.q( 1 , : )` as `rec.q(1,:)`: a trailing index without its blanks, if it had
+/// any.
+fn squeeze_index(name: &str) -> Option<String> {
+    let name = name.trim();
+    let base = super::suggest::base_name(name);
+    let index = &name[base.len()..];
+    if index.is_empty() || !index.contains(char::is_whitespace) {
+        return None;
+    }
+    let index: String = index.chars().filter(|c| !c.is_whitespace()).collect();
+    Some(format!("{base}{index}"))
+}
+
+/// The error for a channel not found: the closest there are.
 fn missing(spec: &MapSpec, recordings: &[&Recording]) -> ResolveError {
     ResolveError::NoChannel {
         given: spec.given.clone(),
         channel: spec.channel.clone(),
-        present: recordings
-            .iter()
-            .flat_map(|r| r.channels.iter().map(|c| c.name.clone()))
-            .collect(),
-    }
-}
-
-/// The channels' names quoted, for a message: `none` when there are none.
-fn listed(names: &[String]) -> String {
-    if names.is_empty() {
-        "none".to_string()
-    } else {
-        names
-            .iter()
-            .map(|n| format!("`{n}`"))
-            .collect::<Vec<_>>()
-            .join(", ")
+        suggestion: super::suggest::suggestion(spec.channel.trim(), recordings),
     }
 }
 
@@ -238,6 +286,7 @@ mod tests {
                 })
                 .collect(),
             notes: vec![],
+            groups: vec![],
         }
     }
 
@@ -290,6 +339,54 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("`a*b:c`") && e.contains("`q`"), "{e}");
+    }
+
+    #[test]
+    fn a_matrix_row_with_a_scale_keeps_its_index() {
+        let m = parse("position=rec.q(1,:)*-1").unwrap();
+        assert_eq!(
+            (m.channel.as_str(), m.scale, m.unit),
+            ("rec.q(1,:)", -1.0, None)
+        );
+        let m = parse("position=rec.q(:,2)*2:deg").unwrap();
+        assert_eq!((m.channel.as_str(), m.scale), ("rec.q(:,2)", 2.0));
+        assert_eq!(m.unit.as_deref(), Some("deg"));
+    }
+
+    #[test]
+    fn blanks_in_an_index_and_a_unit_in_the_name_are_understood() {
+        let recs = [recording(&[("rec.act_pos_mot_deg(1,:)", ""), ("t", "")])];
+        let recs: Vec<&Recording> = recs.iter().collect();
+        let r = resolve(
+            &parse("position=rec.act_pos_mot_deg( 1, : )").unwrap(),
+            &recs,
+        )
+        .unwrap();
+        assert_eq!(r.channel.name, "rec.act_pos_mot_deg(1,:)");
+        assert!((r.factor - std::f64::consts::PI / 180.0).abs() < 1e-18);
+        let note = r.note.expect("a note on the unit taken from the name");
+        assert!(note.contains("its name says deg"), "{note}");
+        let r = resolve(
+            &parse("position=rec.act_pos_mot_deg(1,:):rad").unwrap(),
+            &recs,
+        )
+        .unwrap();
+        assert_eq!((r.factor, r.note), (1.0, None));
+    }
+
+    #[test]
+    fn a_missing_channel_names_the_closest_few_not_thousands() {
+        let names: Vec<String> = (0..5000).map(|k| format!("sig_{k}")).collect();
+        let pairs: Vec<(&str, &str)> = names.iter().map(|n| (n.as_str(), "V")).collect();
+        let recs = [recording(&pairs)];
+        let e = resolve(
+            &parse("x=sig_12x").unwrap(),
+            &recs.iter().collect::<Vec<_>>(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.len() < 300, "{} bytes: {e}", e.len());
+        assert!(e.contains("`sig_12`") && e.contains("and 4995 more"), "{e}");
     }
 
     #[test]

@@ -6,12 +6,15 @@
 //! map is made of constant-speed runs instead, one per file or one per plateau of a
 //! stepped-speed record ([`runs`], [`plateaus`], `friction_map`).
 
+mod auto_map;
 mod friction_map;
 pub mod glitches;
 pub mod kinds;
 pub mod mapping;
+pub mod name_unit;
 pub mod plateaus;
 pub mod runs;
+mod suggest;
 
 use std::path::{Path, PathBuf};
 
@@ -76,6 +79,21 @@ pub fn build(sources: &[Source], request: &Request) -> Result<Imported, ImportEr
         return friction_map::build(sources, request);
     }
     let recordings: Vec<&Recording> = sources.iter().map(|s| &s.recording).collect();
+    let mut chosen = None;
+    let completed;
+    let request = match auto_map::complete(request.kind, &recordings, &request.maps)? {
+        Some((spec, note)) => {
+            chosen = Some(note);
+            let mut maps = request.maps.clone();
+            maps.push(spec);
+            completed = Request {
+                maps,
+                ..request.clone()
+            };
+            &completed
+        }
+        None => request,
+    };
     let filled = fill(&recordings, request)?;
     check_magnitudes(&filled, |file| &sources[file].path)?;
     let data = if request.kind == ImportKind::Positioning {
@@ -87,7 +105,8 @@ pub fn build(sources: &[Source], request: &Request) -> Result<Imported, ImportEr
         })?;
         assemble(request.kind, &filled, axis_values)?
     };
-    let findings = findings(sources, &filled);
+    let mut findings = findings(sources, &filled);
+    findings.splice(0..0, chosen);
     let manifest = manifest(sources, request, &findings)?;
     Ok(Imported {
         data,
@@ -124,7 +143,11 @@ fn fill<'a>(
             )));
         }
         let resolved = resolve(spec, role, recordings)?;
-        let (values, phase) = converted(&resolved, role)?;
+        let (values, phase) = if takes_abscissa(&resolved, role, &request.maps) {
+            (abscissa_in_si(&resolved, role)?, None)
+        } else {
+            converted(&resolved, role)?
+        };
         filled.push(Filled {
             role,
             resolved,
@@ -161,11 +184,16 @@ fn resolve<'a>(
             if role.quantities == [Quantity::Number]
                 && !matches!(e, mapping::ResolveError::NoChannel { .. }) =>
         {
-            let bare = MapSpec {
+            // A ratio, as CHANNEL[*SCALE] or, for a name holding `:`, the whole
+            // right-hand side.
+            let bare = |channel: &str, scale: f64| MapSpec {
                 unit: Some("1".into()),
+                channel: channel.into(),
+                scale,
                 ..spec.clone()
             };
-            mapping::resolve(&bare, recordings)
+            mapping::resolve(&bare(&spec.channel, spec.scale), recordings)
+                .or_else(|_| mapping::resolve(&bare(&spec.right, 1.0), recordings))
         }
         other => other,
     }
@@ -183,6 +211,36 @@ fn resolve<'a>(
         )));
     }
     Ok(resolved)
+}
+
+/// Whether a `time` or `frequency` map takes its channel's abscissa rather than its
+/// values: a complex channel (a frequency response's abscissa, its values not a
+/// frequency), or one another map takes too (`frf=H`, `frequency=H:Hz`: the
+/// abscissa of `H` in hertz, for a file whose units label says nothing).
+fn takes_abscissa(r: &Resolved, role: &Role, maps: &[MapSpec]) -> bool {
+    let name = &r.channel.name;
+    matches!(role.name, "time" | "frequency")
+        && !matches!(r.channel.abscissa, Abscissa::Index)
+        && (matches!(r.channel.samples, Samples::Complex { .. })
+            || maps
+                .iter()
+                .any(|m| m.role != role.name && (&m.channel == name || &m.right == name)))
+}
+
+/// The abscissa of the map's channel, in the map's unit, in SI.
+fn abscissa_in_si(r: &Resolved, role: &Role) -> Result<Vec<f64>, ImportError> {
+    let n = r.channel.samples.len();
+    let raw = match &r.channel.abscissa {
+        Abscissa::Uniform { start, step, .. } => (0..n).map(|i| start + i as f64 * step).collect(),
+        Abscissa::Values { values, .. } => values.clone(),
+        Abscissa::Index => {
+            return Err(ImportError(format!(
+                "--map {}: `{}` has no {} base in its file",
+                r.spec.given, r.channel.name, role.name
+            )))
+        }
+    };
+    Ok(raw.into_iter().map(|v| v * r.factor).collect())
 }
 
 /// The channel's samples in SI; a complex channel (only for `frf`) as magnitudes and
@@ -348,7 +406,11 @@ fn abscissa_values(channel: &Channel, axis_role: &str) -> Result<Vec<f64>, Impor
         .filter(|u| matches!(u.quantity, Quantity::Time | Quantity::Frequency))
         .ok_or_else(|| {
             ImportError(format!(
-                "`{}`: its abscissa's unit `{unit}` is not a time or frequency: map {axis_role}=CHANNEL:UNIT",
+                "`{}`: its abscissa's unit `{unit}` is not a time or frequency: give it, \
+                 e.g. --map '{axis_role}={}:{}' (the abscissa of `{}` in that unit)",
+                channel.name,
+                channel.name,
+                if axis_role == "time" { "s" } else { "Hz" },
                 channel.name
             ))
         })?
@@ -610,6 +672,7 @@ fn findings(sources: &[Source], filled: &[Filled]) -> Vec<String> {
             out.push(format!("{}: {note}", s.path.display()));
         }
     }
+    out.extend(filled.iter().filter_map(|f| f.resolved.note.clone()));
     for f in filled {
         let file = &sources[f.resolved.file].path;
         out.extend(channel_findings(

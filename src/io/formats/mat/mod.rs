@@ -14,8 +14,12 @@
 //! - a numeric array of any class (double, single, int8 … uint64, logical), its
 //!   values as `f64` (64-bit integers beyond ±2^53 are rounded, with a note): a
 //!   vector (N×1 or 1×N) or scalar (a drive constant) is one channel named as the
-//!   variable; an N×M matrix with both above 1 is one channel per column, named
-//!   `name(:,j)`, 1-based (`name(:,j,k)` for an N-d array);
+//!   variable; an N×M matrix with both above 1 is one channel per signal along its
+//!   samples' dimension — the one that is the length of a time base of the file (an
+//!   increasing vector) when just one is, else the longer (columns when square): a
+//!   robot's 6×2501 `rec.q` gives rows `rec.q(1,:)` … `rec.q(6,:)`, a 2501×6 matrix
+//!   columns `name(:,j)`, 1-based (`name(:,j,k)` for an N-d array); each array is a
+//!   [`Group`](super::Group) of the recording, so that a listing shows it once;
 //! - a complex array: [`Samples::Complex`](super::Samples::Complex);
 //! - a struct's fields, named `rec.qm`, nested `a.b.c`, element k (1-based, column
 //!   major) of a struct array `s(k).qm`.
@@ -66,7 +70,7 @@ use std::path::Path;
 
 use element::{Cursor, DataType, Element};
 use fault::{Fault, Origin, Problem};
-use found::Found;
+use found::{Finished, Found};
 
 use super::{FormatError, Location, Recording};
 
@@ -104,11 +108,12 @@ fn parse(path: &Path, bytes: &[u8], inflate_limit: u64) -> Result<Recording, For
         format: FORMAT,
         channels: found.channels,
         notes: found.notes,
+        groups: found.groups,
     })
 }
 
 /// Every variable after the header, in file order.
-fn variables(bytes: &[u8], inflate_limit: u64) -> Result<Found, Fault> {
+fn variables(bytes: &[u8], inflate_limit: u64) -> Result<Finished, Fault> {
     let order = header::byte_order(bytes)?;
     let mut cursor = Cursor::new(
         bytes,
@@ -121,7 +126,7 @@ fn variables(bytes: &[u8], inflate_limit: u64) -> Result<Found, Fault> {
     let mut budget = inflate_limit;
     while !cursor.is_at_end() {
         if cursor.rest().len() < 8 {
-            return end_padding(&cursor).map(|()| found);
+            return end_padding(&cursor).map(|()| found.finish());
         }
         let element = cursor.next_element()?;
         match element.data_type {
@@ -134,8 +139,7 @@ fn variables(bytes: &[u8], inflate_limit: u64) -> Result<Found, Fault> {
             )),
         }
     }
-    found.note_duplicates();
-    Ok(found)
+    Ok(found.finish())
 }
 
 /// Accepts fewer than 8 bytes at the end if they are zeros (padding).

@@ -118,11 +118,7 @@ pub fn note(name: &str, header: &Header58, binary: bool, start: usize) -> String
 /// spacing, then real part, then imaginary part for complex data).
 pub fn channel(name: String, header: &Header58, columns: Vec<Vec<f64>>) -> Channel {
     let form = &header.form;
-    let abscissa_unit = if unused(&header.abscissa.unit) {
-        String::new()
-    } else {
-        header.abscissa.unit.clone()
-    };
+    let abscissa_unit = abscissa_unit(&header.abscissa).0;
     let mut columns = columns.into_iter();
     let abscissa = if form.even {
         Abscissa::Uniform {
@@ -152,6 +148,26 @@ pub fn channel(name: String, header: &Header58, columns: Vec<Vec<f64>>) -> Chann
         samples,
         first_line: None,
     }
+}
+
+/// Record 8's units label, or, when it says nothing (blank or `NONE`, as pyuff writes
+/// by default), the unit its specific data type (field 1) implies — 17 time: `s`, 18
+/// frequency: `Hz` (the dataset 58 description's codes) — with the note to say so;
+/// empty when neither tells.
+pub fn abscissa_unit(axis: &Axis) -> (String, Option<String>) {
+    if !unused(&axis.unit) {
+        return (axis.unit.clone(), None);
+    }
+    let (unit, what) = match axis.specific_type {
+        17 => ("s", "time"),
+        18 => ("Hz", "frequency"),
+        _ => return (String::new(), None),
+    };
+    let note = format!(
+        "its abscissa's units label says nothing (`{}`); its data type {} ({what}) gives {unit}",
+        axis.unit, axis.specific_type
+    );
+    (unit.to_string(), Some(note))
 }
 
 /// The name of a function type (record 6 field 1) in the dataset 58 description.
@@ -221,6 +237,24 @@ mod tests {
             .map(direction)
             .collect();
         assert_eq!(got, ["S", "+X", "-Y", "+Z", "+RX", "-RZ", "7", "-9"]);
+    }
+
+    #[test]
+    fn an_abscissa_without_a_label_takes_its_data_types_unit() {
+        let typed = |specific_type: i64, unit: &str| Axis {
+            specific_type,
+            label: "NONE".into(),
+            unit: unit.into(),
+        };
+        assert_eq!(abscissa_unit(&typed(18, "NONE")).0, "Hz");
+        assert_eq!(abscissa_unit(&typed(17, "")).0, "s");
+        assert!(abscissa_unit(&typed(18, "NONE"))
+            .1
+            .unwrap()
+            .contains("data type 18"));
+        assert_eq!(abscissa_unit(&typed(18, "rad/s")), ("rad/s".into(), None));
+        assert_eq!(abscissa_unit(&typed(0, "NONE")), (String::new(), None));
+        assert_eq!(abscissa_unit(&typed(12, "NONE")), (String::new(), None));
     }
 
     #[test]

@@ -24,7 +24,9 @@
 //! - **abscissa**: even spacing (record 7 field 3 = 1) is
 //!   [`Abscissa::Uniform`](super::Abscissa::Uniform) from record 7's minimum and
 //!   increment, uneven spacing [`Abscissa::Values`](super::Abscissa::Values) from the
-//!   values stored with each point; its unit is record 8's units label.
+//!   values stored with each point; its unit is record 8's units label, or, when
+//!   that is blank or `NONE` (pyuff's default), the one record 8's specific data type
+//!   implies (17 time: `s`, 18 frequency: `Hz`), with a note.
 //! - **samples**: data types 2 and 4 (real) are
 //!   [`Samples::Real`](super::Samples::Real), 5 and 6 (complex)
 //!   [`Samples::Complex`](super::Samples::Complex); single precision is read from the
@@ -253,6 +255,9 @@ fn read_dataset58<R: BufRead>(
     collected
         .notes
         .push(channel::note(&name, &header, layout.is_some(), start));
+    if let (_, Some(note)) = channel::abscissa_unit(&header.abscissa) {
+        collected.notes.push(format!("{name}: {note}"));
+    }
     if tolerated != Tolerated::default() {
         collected.tolerated.push((name.clone(), tolerated));
     }
@@ -351,6 +356,7 @@ fn finish(collected: Collected) -> Result<Recording, Fault> {
         format: FORMAT,
         channels,
         notes,
+        groups: Vec::new(),
     })
 }
 

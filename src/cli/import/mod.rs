@@ -4,14 +4,14 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
-use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use serde_json::{json, Map, Value};
 
 use rtid::io::experiment_file::{self, Conditions};
 use rtid::io::formats::detect::{self, Format};
-use rtid::io::formats::{Abscissa, Channel, Recording, Samples};
 use rtid::io::import::kinds::ImportKind;
 use rtid::io::import::{self, mapping, Source};
+
+mod list;
 
 pub const LONG_ABOUT: &str = "\
 Reads the files labs export — MATLAB MAT-files (v5/v7), Beckhoff TwinCAT Scope View CSV, \
@@ -23,14 +23,18 @@ First see what a file holds, without choosing anything:
   rtid import DATA_EMPS.mat --list
 lists each channel's name as the file spells it, its unit, number of samples, sample \
 period (or abscissa), first, last and mean value — after the scale factors and offsets \
-the file itself declares. --json prints the same as {\"channels\": [...], \"format\", \
+the file itself declares; a MAT-file's matrix once, with its shape and how its signals \
+are spelled (rec.q(i,:), i = 1…6). --filter TEXT lists only the names containing TEXT. \
+--json prints the same as {\"channels\": [...], \"format\", \
 \"notes\"} (an array of them for several files).
 
 Then map channels onto the roles of an experiment kind:
   rtid import FILE --kind KIND --map ROLE=CHANNEL[*SCALE][:UNIT] ... --out DIR
 Each role is taken from the named channel (exactly as --list spells it), multiplied by \
 SCALE (a number; *-1 flips a sign), in UNIT — the unit of CHANNEL×SCALE; without UNIT the \
-channel's own unit label. rtid converts to its SI columns. A computed role is a scaled \
+channel's own unit label, else the unit its name ends in (_deg, _nm = N·m, _deg_per_s …, \
+with a note). With no map for it, a frequency response's frf (a torque curve's effort) \
+takes the one channel that fits. rtid converts to its SI columns. A computed role is a scaled \
 channel: the force of a drive is its controller output (V) times the drive gain (N/V): \
 effort=vir*35.15:N.
 
@@ -85,6 +89,10 @@ pub struct Args {
     /// mean) and write nothing.
     #[arg(long, conflicts_with_all = ["kind", "map", "out"])]
     pub list: bool,
+    /// With --list: only the channels (and matrices) whose names contain TEXT,
+    /// ignoring case; a matrix's signals are then listed one by one.
+    #[arg(long, value_name = "TEXT", conflicts_with_all = ["kind", "map", "out"])]
+    pub filter: Option<String>,
     /// The reader to use (default: recognised from the file's first bytes).
     #[arg(long, value_name = "FORMAT", value_parser = parse_format)]
     pub format: Option<Format>,
@@ -140,7 +148,7 @@ fn parse_kind(s: &str) -> Result<ImportKind, String> {
 pub fn run(a: Args) -> anyhow::Result<()> {
     let sources = read_all(&a.files, a.format)?;
     if a.list || a.kind.is_none() {
-        return list(&sources, a.json);
+        return list::list(&sources, a.filter.as_deref(), a.json);
     }
     let request = request(&a)?;
     let imported = import::build(&sources, &request)?;
@@ -174,13 +182,6 @@ fn read_all(files: &[PathBuf], format: Option<Format>) -> anyhow::Result<Vec<Sou
 
 fn request(a: &Args) -> anyhow::Result<import::Request> {
     let kind = a.kind.context("--kind is needed to write an experiment")?;
-    if a.map.is_empty() {
-        bail!(
-            "--map: no channel mapped; {} takes {} (rtid import FILE --list shows the channels)",
-            kind.name(),
-            kind.describe_roles()
-        );
-    }
     let maps = a
         .map
         .iter()
@@ -258,154 +259,4 @@ fn report(path: &Path, imported: &import::Imported, json: bool, quiet: bool) -> 
         }
     }
     Ok(())
-}
-
-/// `--list`: each file's channels.
-fn list(sources: &[Source], json: bool) -> anyhow::Result<()> {
-    if json {
-        let all: Vec<Value> = sources.iter().map(list_json).collect();
-        let out = if all.len() == 1 {
-            all[0].clone()
-        } else {
-            Value::Array(all)
-        };
-        println!("{}", rtid::io::json::pretty(&out)?);
-        return Ok(());
-    }
-    for s in sources {
-        println!(
-            "{} ({}, {} channels)",
-            s.path.display(),
-            s.recording.format,
-            s.recording.channels.len()
-        );
-        println!("{}", list_table(&s.recording));
-        for note in s.recording.notes.iter().chain(&glitch_notes(s)) {
-            println!("note: {note}");
-        }
-    }
-    Ok(())
-}
-
-/// Each channel's glitches (and gaps, in a channel in seconds), as `--list` says them.
-fn glitch_notes(s: &Source) -> Vec<String> {
-    s.recording
-        .channels
-        .iter()
-        .flat_map(|c| {
-            let is_time = rtid::io::formats::units::lookup(&c.unit)
-                .is_some_and(|u| u.quantity == rtid::io::formats::units::Quantity::Time);
-            import::channel_findings(&s.path, c, is_time)
-        })
-        .collect()
-}
-
-/// (first, last, mean) of a channel's samples (the magnitude of a complex one).
-fn stats(c: &Channel) -> (f64, f64, f64) {
-    fn of(mut v: impl ExactSizeIterator<Item = f64> + Clone) -> (f64, f64, f64) {
-        let n = v.len().max(1) as f64;
-        let mean = v.clone().sum::<f64>() / n;
-        let first = v.next().unwrap_or(f64::NAN);
-        (first, v.last().unwrap_or(first), mean)
-    }
-    match &c.samples {
-        Samples::Real(v) => of(v.iter().copied()),
-        Samples::Complex { re, im } => of(re.iter().zip(im).map(|(a, b)| a.hypot(*b))),
-    }
-}
-
-/// The sample period in s, where the abscissa is a time evenly spaced.
-fn sample_period_s(c: &Channel) -> Option<f64> {
-    use rtid::io::formats::units::{self, Quantity};
-    let time = |unit: &str| {
-        units::parse(unit)
-            .ok()
-            .filter(|u| u.quantity == Quantity::Time)
-    };
-    match &c.abscissa {
-        Abscissa::Uniform { step, unit, .. } => time(unit).map(|u| step * u.si),
-        Abscissa::Values { values, unit } => {
-            let u = time(unit)?;
-            let times: Vec<f64> = values.iter().map(|v| v * u.si).collect();
-            experiment_file::sample_period(&times)
-        }
-        Abscissa::Index => None,
-    }
-}
-
-/// The abscissa in words, given the sample period [`sample_period_s`] found.
-fn abscissa_text(c: &Channel, period: Option<f64>) -> String {
-    match (&c.abscissa, period) {
-        (_, Some(p)) => format!("{} s", rtid::names::Num(p)),
-        (Abscissa::Uniform { start, step, unit }, None) => format!("{start} + k·{step} {unit}"),
-        (Abscissa::Values { values, unit }, None) => match (values.first(), values.last()) {
-            (Some(a), Some(b)) => format!("{a} … {b} {unit}"),
-            _ => "—".into(),
-        },
-        (Abscissa::Index, None) => "sample index".into(),
-    }
-}
-
-fn list_json(s: &Source) -> Value {
-    let channels: Vec<Value> = s
-        .recording
-        .channels
-        .iter()
-        .map(|c| {
-            let (first, last, mean) = stats(c);
-            let mut o = json!({
-                "name": c.name,
-                "unit": c.unit,
-                "samples": c.samples.len(),
-            });
-            // An empty channel has no first, last or mean: left out, never null.
-            for (key, v) in [("first", first), ("last", last), ("mean", mean)] {
-                if v.is_finite() {
-                    o[key] = json!(v);
-                }
-            }
-            if matches!(c.samples, Samples::Complex { .. }) {
-                o["complex"] = json!(true);
-            }
-            match sample_period_s(c) {
-                Some(p) => o["sample_period_s"] = json!(p),
-                None => o["abscissa"] = json!(abscissa_text(c, None)),
-            }
-            o
-        })
-        .collect();
-    json!({
-        "file": s.path.display().to_string(),
-        "format": s.recording.format,
-        "channels": channels,
-        "notes": s.recording.notes.iter().chain(&glitch_notes(s)).collect::<Vec<_>>(),
-    })
-}
-
-fn list_table(r: &Recording) -> Table {
-    let mut t = Table::new();
-    t.load_preset(UTF8_FULL_CONDENSED);
-    t.set_header([
-        "channel",
-        "unit",
-        "samples",
-        "sample period / abscissa",
-        "first",
-        "last",
-        "mean",
-    ]);
-    for c in &r.channels {
-        let (first, last, mean) = stats(c);
-        let num = |v: f64| rtid::names::Num(v).to_string();
-        t.add_row([
-            c.name.clone(),
-            c.unit.clone(),
-            c.samples.len().to_string(),
-            abscissa_text(c, sample_period_s(c)),
-            num(first),
-            num(last),
-            num(mean),
-        ]);
-    }
-    t
 }
