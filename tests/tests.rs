@@ -32,6 +32,7 @@ mod frf_complex;
 mod frf_formats;
 mod friction_map;
 mod friction_map_epos;
+mod friction_map_runs;
 mod identify;
 mod import;
 mod import_matrices;

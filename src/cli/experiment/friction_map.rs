@@ -4,6 +4,7 @@ use crate::cli::common::plot::Plot;
 
 use anyhow::Context;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+use rtid::estimation::friction_law::LawFit;
 use rtid::experiments::friction_map::{self, MapEvaluation, MapTest};
 use rtid::io::experiment_file::{Axis, Data, Experiment, Kind, Manifest};
 use rtid::model::Params;
@@ -281,11 +282,8 @@ fn laws_table(e: &MapEvaluation) -> Table {
         "ΔAICc",
         "weight",
     ]);
-    for c in &e.laws.selection.candidates {
-        let Some(fit) = e.laws.fits.iter().find(|f| f.law.name() == c.label) else {
-            continue;
-        };
-        let parameters: Vec<String> = fit
+    let parameters = |fit: &LawFit| -> String {
+        let all: Vec<String> = fit
             .parameters
             .iter()
             .map(|p| match p.std_error {
@@ -293,12 +291,28 @@ fn laws_table(e: &MapEvaluation) -> Table {
                 None => format!("{} = {:.4e} (not determined)", p.name, p.value),
             })
             .collect();
+        all.join("\n")
+    };
+    for c in &e.laws.selection.candidates {
+        let Some(fit) = e.laws.fits.iter().find(|f| f.law.name() == c.label) else {
+            continue;
+        };
         t.add_row([
             fit.law.name().to_string(),
-            parameters.join("\n"),
+            parameters(fit),
             format!("{:.2e}", fit.residual_rms()),
             format!("{:.1}", c.delta),
             format!("{:.2}", c.weight),
+        ]);
+    }
+    // Laws the data do not determine, ranked apart (their notes say why).
+    for fit in e.laws.fits.iter().filter(|f| !f.determined) {
+        t.add_row([
+            format!("{} (not determined)", fit.law.name()),
+            parameters(fit),
+            format!("{:.2e}", fit.residual_rms()),
+            "not ranked".into(),
+            "".into(),
         ]);
     }
     for r in &e.laws.refused {
@@ -321,9 +335,27 @@ fn verdict(e: &MapEvaluation) -> String {
         selected.law.name(),
         e.laws.selection.criterion
     );
+    if let Some(m) = e.misfit.as_ref().filter(|m| m.is_far()) {
+        out += &format!(
+            "\nnote ({}): its residuals (RMS {:.2e}) are {:.0} times the runs' own scatter \
+             (RMS standard error of their means {:.2e}): the map holds more than the law \
+             describes (a shape none of the laws has, or runs that differ by more than \
+             their scatter says)",
+            selected.law.name(),
+            m.residual_rms,
+            m.ratio,
+            m.mean_std_error
+        );
+    }
     for fit in &e.laws.fits {
         for note in &fit.notes {
             out += &format!("\nnote ({}): {note}", fit.law.name());
+        }
+        if !fit.determined {
+            out += &format!(
+                "\nnote ({}): not determined by the data (see the notes above), ranked apart",
+                fit.law.name()
+            );
         }
     }
     out

@@ -41,7 +41,8 @@ pub struct Refused {
 /// The laws fitted to a map and their comparison.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Comparison {
-    /// The laws the data allow, in the order of [`Law::ALL`].
+    /// The laws the data allow, in the order of [`Law::ALL`] — those not determined
+    /// ([`LawFit::determined`]) too, ranked apart: they are not in `selection`.
     pub fits: Vec<LawFit>,
     /// The others.
     pub refused: Vec<Refused>,
@@ -82,6 +83,7 @@ pub fn fit_all(speed: &[f64], effort: &[f64]) -> Result<Comparison, MapProblem> 
     let cost_floor = (n * (COST_FLOOR * rms).powi(2)).max(f64::MIN_POSITIVE);
     let figures = fits
         .iter()
+        .filter(|f| f.determined)
         .map(|f| Figures {
             label: f.law.name().into(),
             fitted: f.law.parameters().iter().map(|s| s.to_string()).collect(),
@@ -91,7 +93,7 @@ pub fn fit_all(speed: &[f64], effort: &[f64]) -> Result<Comparison, MapProblem> 
         })
         .collect();
     // The map passed its checks, so Coulomb's law (3 parameters, at least 4 runs) is
-    // always fitted, and the floor keeps every cost positive.
+    // always fitted and determined (linear), and the floor keeps every cost positive.
     let selection = information::compare_nested(figures, nesting)
         .expect("the Coulomb law is fitted to every checked map, at a positive cost");
     let selected = Law::from_name(&selection.candidates[0].label)

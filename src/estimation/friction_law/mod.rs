@@ -26,6 +26,18 @@
 //! with respect to the reported parameters (`covariance.rs`); a parameter the data do
 //! not determine has none (`None`, with a [`Note`]), never a NaN. [`fit_all`] fits
 //! every law the data allow and ranks them by AICc ([`crate::estimation::information`]).
+//!
+//! **Bounds of a Stribeck law.** The fit itself is unconstrained; a Stribeck law is
+//! *determined* only when its fit converged and every parameter has a standard error,
+//! each rise Fs − Fc is positive beyond two standard errors (Fc ≤ Fs: the effort falls
+//! from a breakaway level Fs to Fc as the speed rises — a curve that rises towards Fc
+//! instead is not a Stribeck effect), each vs lies within the speeds of the runs of
+//! its direction(s) (lowest to highest |v|: outside them the rise is extrapolated),
+//! and delta lies within [`DELTA_RANGE`] = [0.5, 3] (outside, the fit has found a
+//! step between two runs or a slope spread over all of them). Otherwise its
+//! [`Note`]s say why it is not determined, and it is ranked apart: it stays in the
+//! comparison's `fits`, with its parameters and notes, but not in the AICc ranking, so
+//! an unconverged or degenerate law is never the one "the data support".
 
 mod compare;
 mod covariance;
@@ -44,7 +56,7 @@ use serde::Serialize;
 pub use compare::{fit_all, Comparison, Refused, COST_FLOOR};
 pub use law::Law;
 pub use map::{check_map, distinct_speeds, Direction, MapProblem};
-pub use note::Note;
+pub use note::{Note, DELTA_RANGE};
 
 /// The Stribeck laws need this many distinct speeds per direction: the rise's start,
 /// middle and end.
@@ -81,6 +93,11 @@ pub struct LawFit {
     pub iterations: usize,
     /// Whether the fit reached a minimum (always for the linear laws).
     pub converged: bool,
+    /// Whether the data determine the law: always for the linear laws; for a Stribeck
+    /// law, when its fit has no note (converged, every parameter with a standard error,
+    /// a rise Fs − Fc > 0 beyond two standard errors, vs within the runs' speeds, delta
+    /// within [`DELTA_RANGE`]). A law not determined is ranked apart ([`fit_all`]).
+    pub determined: bool,
     pub notes: Vec<Note>,
 }
 
@@ -190,6 +207,7 @@ pub fn fit(law: Law, speed: &[f64], effort: &[f64]) -> Result<LawFit, FitError> 
         evaluated,
         iterations,
         converged,
+        determined: !law.is_stribeck() || notes.is_empty(),
         notes,
     })
 }

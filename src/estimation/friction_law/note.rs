@@ -27,14 +27,31 @@ pub enum Note {
         std_error: Option<f64>,
     },
     /// The Stribeck speed lies outside the measured speeds of its direction(s): the
-    /// rise is extrapolated.
+    /// rise is extrapolated, and the law not determined.
     RiseOutsideSpeeds {
         parameter: String,
         value: f64,
         lowest: f64,
         highest: f64,
     },
+    /// Fs < Fc by more than two standard errors: the effort rises towards Fc at low
+    /// speed instead of falling from a breakaway level — not a Stribeck curve.
+    RiseNegative {
+        difference: String,
+        value: f64,
+        std_error: f64,
+    },
+    /// The exponent delta lies outside [`DELTA_RANGE`]: the curve is a step (large
+    /// delta) or a slow logarithm-like slope (small delta), not a Stribeck rise the
+    /// runs resolve.
+    ExponentOutside { value: f64, lower: f64, upper: f64 },
 }
+
+/// The range of the Stribeck exponent delta a determined law may have: the shapes
+/// the literature fits to measured maps (Armstrong-Hélouvry et al. 1994 §2.1: 0.5 to
+/// 2; Gaussian 2) with room to 3. Outside it the fit has found a step between two runs
+/// or a slope spread over every speed, which the runs do not resolve.
+pub const DELTA_RANGE: (f64, f64) = (0.5, 3.0);
 
 impl fmt::Display for Note {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -69,7 +86,25 @@ impl fmt::Display for Note {
             } => write!(
                 f,
                 "{parameter} = {value:.3e} lies outside the measured speeds \
-                 ({lowest:.3e} to {highest:.3e}): the rise is extrapolated"
+                 ({lowest:.3e} to {highest:.3e}): the rise is extrapolated, not determined"
+            ),
+            Note::RiseNegative {
+                difference,
+                value,
+                std_error,
+            } => write!(
+                f,
+                "{difference} = {value:.3e} ± {std_error:.3e} < 0: the effort rises towards \
+                 Fc at low speed, not a Stribeck curve (Fs ≥ Fc); not determined"
+            ),
+            Note::ExponentOutside {
+                value,
+                lower,
+                upper,
+            } => write!(
+                f,
+                "delta = {value:.3e} lies outside [{lower}, {upper}]: a step between two runs \
+                 or a slope over all of them, not a rise the runs resolve; not determined"
             ),
         }
     }
@@ -105,16 +140,29 @@ pub(super) fn notes(
         Law::StribeckAsymmetric => &[(1, 0, 2, span[0]), (5, 4, 6, span[1])],
         Law::Coulomb | Law::CoulombAsymmetric => &[],
     };
+    let mut shown = false;
     for &(fs, fc, vs, (lowest, highest)) in rises {
         let value = values[fs] - values[fc];
+        let difference = format!("{} − {}", names[fs], names[fc]);
         let std_error = covariance.std_error_of_difference(fs, fc);
-        if !matches!(std_error, Some(se) if value.abs() > 2.0 * se) {
+        let Some(se) = std_error.filter(|se| value.abs() > 2.0 * se) else {
             out.push(Note::RiseNotShown {
-                difference: format!("{} − {}", names[fs], names[fc]),
+                difference,
                 value,
                 std_error,
             });
-        } else if !(lowest..=highest).contains(&values[vs]) {
+            continue;
+        };
+        if value < 0.0 {
+            out.push(Note::RiseNegative {
+                difference,
+                value,
+                std_error: se,
+            });
+            continue;
+        }
+        shown = true;
+        if !(lowest..=highest).contains(&values[vs]) {
             out.push(Note::RiseOutsideSpeeds {
                 parameter: names[vs].to_string(),
                 value: values[vs],
@@ -122,6 +170,15 @@ pub(super) fn notes(
                 highest,
             });
         }
+    }
+    let delta = values[names.iter().position(|&n| n == "delta").unwrap_or(0)];
+    let (lower, upper) = DELTA_RANGE;
+    if shown && !(lower..=upper).contains(&delta) {
+        out.push(Note::ExponentOutside {
+            value: delta,
+            lower,
+            upper,
+        });
     }
     out
 }

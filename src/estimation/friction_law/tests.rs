@@ -311,3 +311,79 @@ fn maps_that_cannot_be_fitted_are_refused_by_name() {
     ));
     assert!(fit_all(&[1.0, 2.0], &[1.0, 2.0]).is_err());
 }
+
+/// A map with the character of the shared worm drive's (60:1, ±1 … ±200 rpm in 23
+/// steps each way): Coulomb friction with an offset, the efforts of the two slowest
+/// speeds of each direction 10 % higher (a rise no Stribeck curve of the runs
+/// resolves: two runs per direction), 3 % scatter.
+fn worm_like(seed: u64) -> (Vec<f64>, Vec<f64>) {
+    let rpm = [
+        1.0, 2.0, 4.0, 6.0, 8.0, 10.0, 13.0, 17.0, 20.0, 25.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0,
+        90.0, 100.0, 120.0, 140.0, 160.0, 180.0, 200.0,
+    ];
+    let law = [1.4e-3, 1.2e-5, -0.47e-3];
+    let mut rng = StdRng::seed_from_u64(seed);
+    let normal = Normal::new(0.0, 1.0).unwrap();
+    let mut speed = Vec::new();
+    let mut effort = Vec::new();
+    for sign in [-1.0, 1.0] {
+        for (k, r) in rpm.iter().enumerate() {
+            let v = sign * r * PI / 30.0;
+            let rise = if k < 2 { 1.1 } else { 1.0 };
+            let friction = (law[0] * sign + law[1] * v) * rise;
+            speed.push(v);
+            effort.push((friction + law[2]) * (1.0 + 0.03 * normal.sample(&mut rng)));
+        }
+    }
+    (speed, effort)
+}
+
+/// On worm-like maps every Stribeck fit either keeps its bounds — converged, Fs ≥ Fc
+/// beyond two standard errors, vs within its runs' speeds, delta in DELTA_RANGE, every
+/// standard error — or is not determined, says why, and is not ranked; the law
+/// selected is always determined.
+#[test]
+fn stribeck_laws_on_worm_like_maps_keep_their_bounds_or_are_not_determined() {
+    let (lower, upper) = DELTA_RANGE;
+    let mut undetermined = 0;
+    for seed in 1..=8 {
+        let (speed, effort) = worm_like(seed);
+        let c = fit_all(&speed, &effort).unwrap();
+        assert_finite(&c);
+        assert!(c.fit(c.selected).unwrap().determined, "seed {seed}");
+        for f in c.fits.iter().filter(|f| f.law.is_stribeck()) {
+            let ranked = c
+                .selection
+                .candidates
+                .iter()
+                .any(|k| k.label == f.law.name());
+            assert_eq!(ranked, f.determined, "seed {seed}: {f:#?}");
+            if !f.determined {
+                undetermined += 1;
+                assert!(!f.notes.is_empty(), "seed {seed}: {f:#?}");
+                continue;
+            }
+            assert!(f.converged && f.notes.is_empty(), "seed {seed}: {f:#?}");
+            assert!(f.parameters.iter().all(|p| p.std_error.is_some()));
+            let value = |name: &str| f.parameter(name).unwrap().value;
+            let delta = value("delta");
+            assert!((lower..=upper).contains(&delta), "seed {seed}: {f:#?}");
+            let pairs: &[(&str, &str, &str)] = match f.law {
+                Law::Stribeck => &[("Fs", "Fc", "vs")],
+                _ => &[
+                    ("Fs_pos", "Fc_pos", "vs_pos"),
+                    ("Fs_neg", "Fc_neg", "vs_neg"),
+                ],
+            };
+            for &(fs, fc, vs) in pairs {
+                assert!(value(fs) > value(fc), "seed {seed}: {f:#?}");
+                let vs = value(vs);
+                assert!((0.1..=21.0).contains(&vs), "seed {seed}: {f:#?}");
+            }
+        }
+    }
+    // The rise of two runs per direction is not a curve the runs resolve (a step
+    // between the second and third speed, or no rise beyond the scatter): every one
+    // of these fits is said not determined, as the real worm drive's two are.
+    assert_eq!(undetermined, 16, "{undetermined} of 16 not determined");
+}

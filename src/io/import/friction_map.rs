@@ -4,11 +4,20 @@
 //! several plateaus in turn — a stepped-speed record — gives one run per plateau
 //! ([`super::plateaus`]). The findings say, per run, the file, the samples averaged,
 //! the glitches dropped (each with its line) and the transient left out.
+//!
+//! A run at rest is not on the map: a run whose median speed is at most [`REST`]
+//! (a thousandth) of the fastest median speed among the map's candidate runs (its
+//! files, or the plateaus of its one file) — what a drive holding its position reads
+//! (the robot axis of `fixtures/real/kuka-kr300/` creeps at 0.04 to 0.07 % of its top
+//! speed before it starts; the slowest runs of the shared EPOS drives are at 0.5 to
+//! 1 % of their fastest). When no candidate of a stepped-speed record is a run, one
+//! error says why, counting the candidates refused for each reason.
 
 use std::ops::Range;
 
 use serde_json::{json, Value};
 
+use super::glitches::median;
 use super::plateaus::{plateaus, Segments};
 use super::runs::{self, short, Run, RunError};
 use super::{axis, channel_findings, check_magnitudes, fill, manifest, role, Filled};
@@ -47,6 +56,49 @@ struct Taken<'r, 'a> {
     run: Run,
 }
 
+/// A run's median speed at most this fraction of the fastest candidate's is at rest.
+pub const REST: f64 = 1e-3;
+
+/// Why a candidate is not a run.
+#[derive(Clone, Debug, PartialEq)]
+enum Refusal {
+    /// Its statistics say it has not settled or is not steady.
+    Run(RunError),
+    /// Its median speed is at most [`REST`] of the fastest candidate's.
+    Rest { median: f64, fastest: f64 },
+}
+
+impl Refusal {
+    /// The message, speeds in `unit`.
+    fn message(&self, unit: &str) -> String {
+        match self {
+            Refusal::Run(e @ RunError::Drifting { .. }) => format!("{e} (speeds in {unit})"),
+            Refusal::Run(e) => e.to_string(),
+            Refusal::Rest { median, fastest } => format!(
+                "at rest: median speed {} {unit}, at most {} of the fastest candidate's {} {unit} \
+                 (a run at rest is not on a friction map)",
+                short(*median),
+                REST,
+                short(*fastest)
+            ),
+        }
+    }
+
+    /// What the refused candidates of one kind share, for the summary.
+    fn kind(&self) -> &'static str {
+        match self {
+            Refusal::Run(RunError::SpeedChanges { .. }) => "change their speed within the run",
+            Refusal::Run(RunError::EffortDrifts { .. }) => {
+                "have an effort that drifts within the run"
+            }
+            Refusal::Run(RunError::Drifting { .. }) => "drift between their halves",
+            Refusal::Run(RunError::TooFew { .. }) => "have fewer than 10 samples once settled",
+            Refusal::Run(_) => "are not runs",
+            Refusal::Rest { .. } => "are at rest",
+        }
+    }
+}
+
 /// The friction map of `sources` (`request.kind` is `friction-map`).
 pub(super) fn build(sources: &[Source], request: &Request) -> Result<Imported, ImportError> {
     let records = sources
@@ -70,11 +122,13 @@ pub(super) fn build(sources: &[Source], request: &Request) -> Result<Imported, I
     match records.as_slice() {
         [only] => match plateaus(&only.role("speed").values) {
             s if s.plateaus.len() >= 2 => stepped(only, &s, &mut taken, &mut findings)?,
-            _ => taken.push(whole(only)?),
+            _ => taken.push(whole(only, 0.0)?),
         },
         _ => {
+            let whole_range = |r: &Record| 0..r.role("speed").values.len();
+            let fastest = fastest(records.iter().map(|r| (r, whole_range(r))));
             for r in &records {
-                taken.push(whole(r)?);
+                taken.push(whole(r, fastest)?);
             }
         }
     }
@@ -137,10 +191,11 @@ fn record<'a>(source: &'a Source, request: &Request) -> Result<Record<'a>, Impor
     Ok(r)
 }
 
-/// The whole record as one run.
-fn whole<'r, 'a>(r: &'r Record<'a>) -> Result<Taken<'r, 'a>, ImportError> {
+/// The whole record as one run, the fastest candidate's median speed `fastest`.
+fn whole<'r, 'a>(r: &'r Record<'a>, fastest: f64) -> Result<Taken<'r, 'a>, ImportError> {
     let range = 0..r.role("speed").values.len();
-    let run = statistics(r, range.clone()).map_err(|e| r.error(e))?;
+    let run = statistics(r, range.clone(), fastest)
+        .map_err(|e| r.error(e.message(speed_unit(r.axis))))?;
     Ok(Taken {
         record: r,
         range,
@@ -148,17 +203,29 @@ fn whole<'r, 'a>(r: &'r Record<'a>) -> Result<Taken<'r, 'a>, ImportError> {
     })
 }
 
-/// The run over `range`, refused when it has not settled or is at rest.
-fn statistics(r: &Record, range: Range<usize>) -> Result<Run, String> {
+/// The largest |median speed| of the candidates (record, range).
+fn fastest<'r, 'a: 'r>(candidates: impl Iterator<Item = (&'r Record<'a>, Range<usize>)>) -> f64 {
+    candidates
+        .map(|(r, range)| median_speed(r, range).abs())
+        .fold(0.0, f64::max)
+}
+
+fn median_speed(r: &Record, range: Range<usize>) -> f64 {
+    median(&mut r.role("speed").values[range].to_vec())
+}
+
+/// The run over `range`, refused when it is at rest ([`REST`] of `fastest`) or has
+/// not settled or is not steady ([`runs::statistics`]).
+fn statistics(r: &Record, range: Range<usize>, fastest: f64) -> Result<Run, Refusal> {
+    let median = median_speed(r, range.clone());
+    if median.abs() <= REST * fastest || median == 0.0 {
+        return Err(Refusal::Rest { median, fastest });
+    }
     let speed = &r.role("speed").values[range.clone()];
     let effort = &r.role("effort").values[range];
-    let unit = speed_unit(r.axis);
-    let run = runs::statistics(speed, effort).map_err(|e| match e {
-        RunError::Drifting { .. } => format!("{e} (speeds in {unit})"),
-        _ => e.to_string(),
-    })?;
-    if run.reference == 0.0 || run.speed == 0.0 {
-        return Err("at rest (median speed 0): a run at rest is not on a friction map".to_string());
+    let run = runs::statistics(speed, effort).map_err(Refusal::Run)?;
+    if run.speed == 0.0 {
+        return Err(Refusal::Rest { median, fastest });
     }
     Ok(run)
 }
@@ -172,18 +239,25 @@ fn stepped<'r, 'a>(
     findings: &mut Vec<String>,
 ) -> Result<(), ImportError> {
     let mut refused = Vec::new();
+    let mut reasons = Vec::new();
+    let fastest = fastest(segments.plateaus.iter().map(|p| (r, p.clone())));
+    let unit = speed_unit(r.axis);
     for p in &segments.plateaus {
-        match statistics(r, p.clone()) {
+        match statistics(r, p.clone(), fastest) {
             Ok(run) => taken.push(Taken {
                 record: r,
                 range: p.clone(),
                 run,
             }),
-            Err(e) => refused.push(format!(
-                "{}, {}: a plateau not taken as a run: {e}",
-                r.file(),
-                span(r, p.clone())
-            )),
+            Err(e) => {
+                refused.push(format!(
+                    "{}, {}: a plateau not taken as a run: {}",
+                    r.file(),
+                    span(r, p.clone()),
+                    e.message(unit)
+                ));
+                reasons.push(e);
+            }
         }
     }
     let spans = |ranges: &mut dyn Iterator<Item = Range<usize>>| {
@@ -201,15 +275,63 @@ fn stepped<'r, 'a>(
         spans(&mut segments.transitions.iter().cloned()),
     ));
     if taken.is_empty() {
-        return Err(ImportError(format!(
-            "{}: none of its {} plateaus is a run: {}",
-            r.file(),
-            segments.plateaus.len(),
-            refused.join("; ")
-        )));
+        return Err(r.error(none_taken(&reasons)));
     }
     findings.extend(refused);
     Ok(())
+}
+
+/// Why none of the candidates `reasons` (one each) of a stepped-speed record is a run:
+/// how many were refused for each reason, with the range of the figure that refused
+/// them.
+fn none_taken(reasons: &[Refusal]) -> String {
+    let mut kinds: Vec<&'static str> = reasons.iter().map(Refusal::kind).collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    let parts: Vec<String> = kinds
+        .iter()
+        .map(|&kind| {
+            let of_kind: Vec<&Refusal> = reasons.iter().filter(|x| x.kind() == kind).collect();
+            let figures: Vec<f64> = of_kind.iter().filter_map(|x| figure(x)).collect();
+            let range = match (
+                figures.iter().copied().reduce(f64::min),
+                figures.iter().copied().reduce(f64::max),
+            ) {
+                (Some(lo), Some(hi)) if lo == hi => format!(" ({})", short(lo)),
+                (Some(lo), Some(hi)) => format!(" ({} to {})", short(lo), short(hi)),
+                _ => String::new(),
+            };
+            let what = match of_kind[0] {
+                Refusal::Run(RunError::SpeedChanges { .. }) => " % of its mean",
+                Refusal::Run(RunError::EffortDrifts { .. }) => " times its scatter",
+                Refusal::Rest { .. } => " of the fastest candidate's speed",
+                _ => "",
+            };
+            let range = range.replace(')', &format!("{what})"));
+            format!("{} {kind}{range}", of_kind.len())
+        })
+        .collect();
+    format!(
+        "no constant-speed run: of its {} candidate plateaus (at least {} samples within 5 % of \
+         one speed), {}; a friction map is made of runs that hold their speed",
+        reasons.len(),
+        runs::MIN_SAMPLES,
+        parts.join(", ")
+    )
+}
+
+/// The figure of a refusal the summary ranges over: the speed's change in % of its
+/// mean, the effort's drift in scatters, the median speed in fractions of the
+/// fastest.
+fn figure(refusal: &Refusal) -> Option<f64> {
+    match *refusal {
+        Refusal::Run(RunError::SpeedChanges { change, mean, .. }) => {
+            Some(100.0 * change / mean.abs())
+        }
+        Refusal::Run(RunError::EffortDrifts { change, scatter }) => Some(change / scatter),
+        Refusal::Rest { median, fastest } if fastest > 0.0 => Some(median.abs() / fastest),
+        _ => None,
+    }
 }
 
 /// The readers' notes and the gaps of mapped time bases, each naming its file.
