@@ -258,7 +258,7 @@ fn run_sweep(a: RunArgs) -> anyhow::Result<()> {
     }
     if let Some(shard) = a.shard {
         if a.json {
-            let v = serde_json::json!({"file": out, "shard": shard.to_string(), "run": report});
+            let v = serde_json::json!({"file": out, "shard": shard.to_string(), "run": rtid::io::json::value(&report)?});
             println!("{}", rtid::io::json::pretty(&v)?);
         } else {
             println!(
@@ -341,8 +341,8 @@ fn print(
         let v = serde_json::json!({
             "file": out,
             "method": sweep.method.name(),
-            "run": report,
-            "indices": indices,
+            "run": rtid::io::json::value(&report)?,
+            "indices": rtid::io::json::value(&indices)?,
             "files": files,
         });
         println!("{}", rtid::io::json::pretty(&v)?);

@@ -227,7 +227,8 @@ fn print_positioning(
         let mut targets = Vec::with_capacity(report.targets.len());
         for t in &report.targets {
             let mut v = rtid::io::json::value(&t.scaled(k))?;
-            v[format!("target_{}", u.target_key)] = serde_json::json!(t.target * u.target_per_si);
+            v[format!("target_{}", u.target_key)] =
+                rtid::io::json::value(&(t.target * u.target_per_si))?;
             targets.push(v);
         }
         let value = serde_json::json!({

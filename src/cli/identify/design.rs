@@ -98,7 +98,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "criterion": criterion,
             "noise": a.noise,
             "fit": a.fit,
-            "candidates": ranked,
+            "candidates": rtid::io::json::value(&ranked)?,
         });
         println!("{}", rtid::io::json::pretty(&out)?);
     } else {

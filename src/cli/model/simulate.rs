@@ -360,14 +360,17 @@ fn print_summary(a: &Args, sim: &Simulation, ratio: f64, wall: f64) -> anyhow::R
     let steps = (sim.time() / sim.dt()).round();
     let y = sim.state();
     if a.json {
+        // Through the finite check: json! writes a NaN as null, silently.
+        let final_state: std::collections::BTreeMap<&str, f64> =
+            STATE_NAMES.iter().copied().zip(y).collect();
         let summary = serde_json::json!({
             "output": a.out,
             "steps": steps,
-            "dt_s": sim.dt(),
-            "simulated_s": sim.time(),
-            "wall_time_s": wall,
-            "steps_per_s": steps / wall,
-            "final": STATE_NAMES.iter().zip(y).map(|(n, v)| (n.to_string(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
+            "dt_s": rtid::io::json::value(&sim.dt())?,
+            "simulated_s": rtid::io::json::value(&sim.time())?,
+            "wall_time_s": rtid::io::json::value(&wall)?,
+            "steps_per_s": rtid::io::json::value(&(steps / wall.max(1e-9)))?,
+            "final": rtid::io::json::value(&final_state)?,
         });
         println!("{}", rtid::io::json::pretty(&summary)?);
         return Ok(());

@@ -277,6 +277,24 @@ fn stepped<'r, 'a>(
     if taken.is_empty() {
         return Err(r.error(none_taken(&reasons)));
     }
+    let positive = taken.iter().filter(|t| t.run.speed > 0.0).count();
+    if !reasons.is_empty() && (positive == 0 || positive == taken.len()) {
+        // A few stretches that pass among many that do not, all one way: not a map.
+        return Err(r.error(format!(
+            "{} of its {} candidate plateaus hold their speed, all in the {} direction \
+             (at {}): a friction map needs runs both ways; of the other {}, {}",
+            taken.len(),
+            taken.len() + reasons.len(),
+            if positive == 0 {
+                "negative"
+            } else {
+                "positive"
+            },
+            spans(&mut taken.iter().map(|t| t.range.clone())),
+            reasons.len(),
+            refusals(&reasons)
+        )));
+    }
     findings.extend(refused);
     Ok(())
 }
@@ -285,6 +303,18 @@ fn stepped<'r, 'a>(
 /// how many were refused for each reason, with the range of the figure that refused
 /// them.
 fn none_taken(reasons: &[Refusal]) -> String {
+    format!(
+        "no constant-speed run: of its {} candidate plateaus (at least {} samples within 5 % of \
+         one speed), {}; a friction map is made of runs that hold their speed",
+        reasons.len(),
+        runs::MIN_SAMPLES,
+        refusals(reasons)
+    )
+}
+
+/// How many candidates were refused for each reason, with the range of the figure
+/// that refused them.
+fn refusals(reasons: &[Refusal]) -> String {
     let mut kinds: Vec<&'static str> = reasons.iter().map(Refusal::kind).collect();
     kinds.sort_unstable();
     kinds.dedup();
@@ -311,13 +341,7 @@ fn none_taken(reasons: &[Refusal]) -> String {
             format!("{} {kind}{range}", of_kind.len())
         })
         .collect();
-    format!(
-        "no constant-speed run: of its {} candidate plateaus (at least {} samples within 5 % of \
-         one speed), {}; a friction map is made of runs that hold their speed",
-        reasons.len(),
-        runs::MIN_SAMPLES,
-        parts.join(", ")
-    )
+    parts.join(", ")
 }
 
 /// The figure of a refusal the summary ranges over: the speed's change in % of its
