@@ -15,6 +15,30 @@ fn robot() -> PathBuf {
         .join("fixtures/formats/matlab/kuka/kuka_kr300_ff_a.mat")
 }
 
+/// `rtid import` of axis 1 as a servo trace into `out` (time, motor encoder,
+/// reference, torque; a blank inside one index), with `extra` arguments.
+fn import_axis_1(out: &std::path::Path, extra: &[&str]) -> Output {
+    let (robot, out) = (robot(), out.to_str().unwrap().to_string());
+    let mut args = vec![
+        "import",
+        robot.to_str().unwrap(),
+        "--kind",
+        "servo-trace",
+        "--map",
+        "time=rec.time_cont:s",
+        "--map",
+        "position=rec.act_pos_mot_deg(1,:)",
+        "--map",
+        "reference_position=rec.ref_pos_deg(1, :)",
+        "--map",
+        "effort=rec.act_torque_abs_nm(1,:)",
+        "--out",
+        &out,
+    ];
+    args.extend(extra);
+    rtid(&args)
+}
+
 fn rtid(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_rtid"))
         .args(args)
@@ -102,24 +126,10 @@ fn the_list_shows_each_matrix_once_and_filters() {
 fn a_row_maps_onto_a_servo_trace_with_its_unit_from_the_name() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("kuka");
-    let out = rtid(&[
-        "import",
-        robot().to_str().unwrap(),
-        "--kind",
-        "servo-trace",
-        "--map",
-        "time=rec.time_cont:s",
-        "--map",
-        "position=rec.act_pos_mot_deg(1,:)",
-        "--map",
-        "reference_position=rec.ref_pos_deg(1, :)",
-        "--map",
-        "table_position=rec.act_pos_se_deg(1,:)",
-        "--map",
-        "effort=rec.act_torque_abs_nm(1,:)",
-        "--out",
-        out_dir.to_str().unwrap(),
-    ]);
+    let out = import_axis_1(
+        &out_dir,
+        &["--map", "table_position=rec.act_pos_se_deg(1,:)"],
+    );
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(out.status.success(), "{stderr}");
     assert!(stderr.contains("its name says N·m"), "{stderr}");
@@ -181,25 +191,7 @@ fn the_robot_axis_at_the_motor_meets_the_authors_friction() {
     let out = dir.path().join("kuka");
     let u = 256.857_142_86;
     let ratio = format!("ratio={}", 1.0 / u);
-    let run = rtid(&[
-        "import",
-        robot().to_str().unwrap(),
-        "--kind",
-        "servo-trace",
-        "--map",
-        "time=rec.time_cont:s",
-        "--map",
-        "position=rec.act_pos_mot_deg(1,:)",
-        "--map",
-        "reference_position=rec.ref_pos_deg(1,:)",
-        "--map",
-        "effort=rec.act_torque_abs_nm(1,:)",
-        "--condition",
-        &ratio,
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let run = import_axis_1(&out, &["--condition", &ratio, "--quiet"]);
     assert!(
         run.status.success(),
         "{}",
