@@ -799,3 +799,45 @@ fn rtid_ok_json(dir: &Path) -> String {
     assert_eq!(run.code, Some(0), "{}", run.stderr);
     std::fs::read_to_string(dir.join("p.json")).unwrap()
 }
+
+/// Issue 37's frequency class: a response's lines at subnormal frequencies (1e-319 Hz:
+/// the modal fit's arithmetic crawled for minutes), at 0 or below, are refused when
+/// the file is read, naming the line and column; a line at 1e-6 Hz is still a
+/// frequency.
+#[test]
+fn frequencies_no_test_can_reach_are_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let manifest = std::fs::read_to_string(fixture("worm-gear/frequency_response.json")).unwrap();
+    let csv = std::fs::read_to_string(fixture("worm-gear/frequency_response.csv")).unwrap();
+    for (name, scale, culprit) in [
+        ("subnormal", 1e-320, Some("line 3, column `frequency_hz`")),
+        ("negative", -1.0, Some("line 3, column `frequency_hz`")),
+        ("slow", 1e-6, None),
+    ] {
+        let text: String = csv
+            .lines()
+            .map(|l| match l.split_once(',') {
+                Some((f, rest)) if f.parse::<f64>().is_ok() => {
+                    let f: f64 = f.parse().unwrap();
+                    // Negative frequencies ascending too: only the sign is wrong.
+                    let f = if scale < 0.0 { f - 1e4 } else { f * scale };
+                    format!("{f:e},{rest}\n")
+                }
+                _ => format!("{l}\n"),
+            })
+            .collect();
+        std::fs::write(d.join(format!("{name}.csv")), text).unwrap();
+        let m = manifest.replace("frequency_response.csv", &format!("{name}.csv"));
+        std::fs::write(d.join(format!("{name}.json")), m).unwrap();
+        let args = strings(&["evaluate", &format!("{name}.json"), "--json"]);
+        let run = rtid(&args, d);
+        match culprit {
+            Some(culprit) => {
+                assert_ne!(run.code, Some(0), "{name}: {}", run.stdout);
+                check(&args, &run, culprit);
+            }
+            None => check(&args, &run, ""),
+        }
+    }
+}

@@ -1,5 +1,5 @@
 //! A servo trace that never holds a speed, offered as a friction map: the KUKA KR300's
-//! axis 1 (fixtures/real/kuka-kr300/). Its stretches of 10 to 31 samples within 5 % of
+//! axis 1, row 1 of the lab's MAT-file (fixtures/formats/matlab/kuka/). Its stretches of 10 to 31 samples within 5 % of
 //! one speed mid-acceleration, and its standstill, are not runs (docs/import.md §2.1);
 //! before issue 37 they were taken as 51 runs and friction laws fitted to them.
 
@@ -8,17 +8,17 @@ use crate::cli_support::{err, root, rtid};
 #[test]
 fn a_robot_trace_gives_no_runs_mid_acceleration() {
     let dir = tempfile::tempdir().unwrap();
-    let csv = root().join("fixtures/real/kuka-kr300/axis1.csv");
+    let mat = root().join("fixtures/formats/matlab/kuka/kuka_kr300_ff_a.mat");
     let out = rtid(
         &[
             "import",
-            csv.to_str().unwrap(),
+            mat.to_str().unwrap(),
             "--kind",
             "friction-map",
             "--map",
-            "speed=velocity_deg_per_s:deg/s",
+            "speed=rec.act_vel_mot_deg_per_s(1,:):deg/s",
             "--map",
-            "effort=torque_nm:N·m",
+            "effort=rec.act_torque_abs_nm(1,:):N·m",
             "--out",
             "map",
         ],

@@ -263,7 +263,15 @@ impl Table {
                     format!("{x:e} is beyond ±1e15 in SI units: not a measurement (a unit slip?)");
                 return Err(self.cell(*line, col.index, message));
             }
-            if let (Order::Increasing, Some(p)) = (order, previous) {
+            if order == Order::Frequency && x * col.scale < MIN_FREQUENCY_HZ {
+                let message = format!(
+                    "{} Hz is below {MIN_FREQUENCY_HZ:e} Hz: a measured line is a positive \
+                     frequency a test can reach (a period under 11 days)",
+                    crate::names::Num(x * col.scale)
+                );
+                return Err(self.cell(*line, col.index, message));
+            }
+            if let (Order::Increasing | Order::Frequency, Some(p)) = (order, previous) {
                 if x <= p {
                     let message = format!("{x} does not increase (previous row {p})");
                     return Err(self.cell(*line, col.index, message));
@@ -308,11 +316,17 @@ impl Table {
     }
 }
 
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq)]
 enum Order {
     Any,
     Increasing,
+    /// Strictly increasing frequencies, each at least [`MIN_FREQUENCY_HZ`].
+    Frequency,
 }
+
+/// The lowest frequency a response's line may have, Hz: below, no drive test (and
+/// subnormal frequencies, 1e-319 Hz, sent the modal fit's arithmetic crawling).
+pub const MIN_FREQUENCY_HZ: f64 = 1e-6;
 
 /// The largest magnitude a record's value may have in SI units (s, rad, m, N·m, N, Hz,
 /// dB…), as for parameters: beyond, a typo or a unit slip. (Angles of ±1e308 made

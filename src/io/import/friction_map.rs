@@ -8,7 +8,7 @@
 //! A run at rest is not on the map: a run whose median speed is at most [`REST`]
 //! (a thousandth) of the fastest median speed among the map's candidate runs (its
 //! files, or the plateaus of its one file) — what a drive holding its position reads
-//! (the robot axis of `fixtures/real/kuka-kr300/` creeps at 0.04 to 0.07 % of its top
+//! (the robot axis of `fixtures/formats/matlab/kuka/`, row 1 creeps at 0.04 to 0.07 % of its top
 //! speed before it starts; the slowest runs of the shared EPOS drives are at 0.5 to
 //! 1 % of their fastest). When no candidate of a stepped-speed record is a run, one
 //! error says why, counting the candidates refused for each reason.

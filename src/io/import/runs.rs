@@ -38,7 +38,7 @@
 //!    Measured: the 108 steady-state runs of the shared EPOS drives (two lead screws,
 //!    one worm) change their speed by at most 0.31 of its scatter and their effort by
 //!    at most 2.0 times its scatter; the stretches of a robot axis's servo trace
-//!    (`fixtures/real/kuka-kr300/`) where its speed stays within 5 % for 10 to 30
+//!    (`fixtures/formats/matlab/kuka/`, row 1) where its speed stays within 5 % for 10 to 30
 //!    samples mid-acceleration change their speed by 26 to 82 times its scatter (and
 //!    its two speed peaks by 1.9 and 1.2, over 127 and 155 samples). Its creeping
 //!    approach to the end position (0.06 deg/s, 0.1 to 0.3 % of its top speed, 11 to

@@ -59,7 +59,7 @@ impl Table {
                 let (f, g) = (self.column("frequency_hz")?, self.column("gain_db")?);
                 let p = self.position(&["phase"])?;
                 Ok(Data::FrequencyResponse {
-                    frequency_hz: self.numbers(f, Increasing)?,
+                    frequency_hz: self.numbers(f, Order::Frequency)?,
                     gain_db: self.numbers(g, Any)?,
                     phase_rad: p.map(|p| self.numbers(p, Any)).transpose()?,
                     extra: self.extras(),
