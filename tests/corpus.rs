@@ -841,3 +841,59 @@ fn frequencies_no_test_can_reach_are_refused_at_once() {
         }
     }
 }
+
+/// Issue 37's size class: a frequency response of 400 000 lines of noise (19 MB;
+/// some 120 000 local maxima) is evaluated in seconds — each peak's modal fit works on
+/// its band's lines, found by bisection; it scanned every line per peak and took
+/// minutes.
+#[test]
+fn a_long_noisy_response_is_evaluated_in_seconds() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut uniform = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut text = String::from("frequency_hz,gain_db,phase_deg\n");
+    for k in 0..400_000 {
+        let f = 1.0 + k as f64 * 0.005;
+        text += &format!(
+            "{f},{},{}\n",
+            10.0 * uniform() - 5.0,
+            360.0 * uniform() - 180.0
+        );
+    }
+    std::fs::write(d.join("noisy.csv"), text).unwrap();
+    std::fs::write(
+        d.join("noisy.json"),
+        r#"{"kind": "frequency_response", "data": "noisy.csv"}"#,
+    )
+    .unwrap();
+    // Its report lists every maximum (megabytes): written to a file, not a pipe.
+    let report = std::fs::File::create(d.join("report.txt")).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rtid"))
+        .args(["evaluate", "noisy.json"])
+        .current_dir(d)
+        .stdout(report)
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        assert!(
+            started.elapsed() < LIMIT,
+            "evaluate hangs on a long noisy response"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(child.wait().unwrap().success());
+    let text = std::fs::read_to_string(d.join("report.txt")).unwrap();
+    assert!(
+        text.contains("modes (") && !text.contains("NaN"),
+        "{}",
+        &text[..500]
+    );
+}
