@@ -197,13 +197,7 @@ impl ServoTrace {
     /// these are in neither frame (the motor's torque over the table's acceleration):
     /// [`ServoTrace::fit_friction_at_motor`] gives them at the motor.
     pub fn fit_friction(&self, settings: &IdimSettings) -> Result<IdimFit, FitError> {
-        let period = self.check()?;
-        Ok(inverse_dynamics::identify(
-            period,
-            &self.position,
-            &self.force,
-            settings,
-        )?)
+        self.fit_on(&self.position, settings)
     }
 
     /// [`ServoTrace::fit_friction`] with the position taken to the motor side,
@@ -214,11 +208,16 @@ impl ServoTrace {
         ratio: f64,
         settings: &IdimSettings,
     ) -> Result<IdimFit, FitError> {
-        let period = self.check()?;
         let motor: Vec<f64> = self.position.iter().map(|x| x / ratio).collect();
+        self.fit_on(&motor, settings)
+    }
+
+    /// IDIM-LS of `position` (the trace's, in some frame) against the force.
+    fn fit_on(&self, position: &[f64], settings: &IdimSettings) -> Result<IdimFit, FitError> {
+        let period = self.check()?;
         Ok(inverse_dynamics::identify(
             period,
-            &motor,
+            position,
             &self.force,
             settings,
         )?)

@@ -38,6 +38,7 @@ use crate::identify::error::IdentifyError;
 use crate::identify::result::warning::Warning;
 use crate::identify::result::NonlinearCheck;
 use crate::io::experiment_file::Experiment;
+use crate::io::import::glitches::median;
 use crate::model::linear_response::{Channel, LinearResponse};
 use crate::model::Params;
 use crate::objectives::measured_peaks::measured_peaks;
@@ -152,9 +153,7 @@ pub fn noise_db(e: &[f64]) -> Option<f64> {
         .windows(3)
         .map(|w| (w[0] - 2.0 * w[1] + w[2]).abs())
         .collect();
-    d.sort_by(f64::total_cmp);
-    let median = d[d.len() / 2];
-    Some(1.4826 * median / 6f64.sqrt())
+    Some(1.4826 * median(&mut d) / 6f64.sqrt())
 }
 
 /// Whether the linear fit explains a check's curve within its noise.

@@ -70,17 +70,16 @@ pub fn run(
                 let checks = escalation::check(config, &at)?;
                 let assumed = escalation::assumed(&at, &space.names);
                 let verdict = escalation::verdict(&checks, &assumed);
+                if verdict.is_none() && !inside {
+                    notes.extend(escalation::stands(&checks, &assumed));
+                }
+                check = Some(checks);
                 // Resumed inside the stage: the decision was taken before.
                 match verdict {
                     Some(w) => notes.push(w),
-                    None if !inside => {
-                        notes.extend(escalation::stands(&checks, &assumed));
-                        check = Some(checks);
-                        break;
-                    }
+                    None if !inside => break,
                     None => {}
                 }
-                check = Some(checks);
             }
             let best = if stage.stage == Stage::Correction && !inside {
                 correction_start(config, stage, space, best, ran.as_ref(), monitor)?
