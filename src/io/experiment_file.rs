@@ -11,21 +11,19 @@
 mod conditions;
 mod data;
 mod friction_map;
+mod kind;
 mod response;
 mod sampling;
 mod table;
 #[cfg(test)]
 mod tests;
-#[cfg(test)]
-mod tests_friction_map;
-#[cfg(test)]
-mod tests_units;
 mod units;
 mod writer;
 
 pub use conditions::{Conditions, Excitation};
 pub use data::{Approaches, Data, ServoTrace, Signal, TimeRecord};
 pub use friction_map::FrictionMap;
+pub use kind::{Definition as KindDefinition, Kind, KINDS};
 pub use response::{Delay, Reference, Response, ResponseForm};
 pub use sampling::{check_uniform, sample_period, NonUniform, SAMPLING_TOLERANCE};
 pub use table::MAX_MAGNITUDE;
@@ -43,74 +41,6 @@ use serde_json::{Map, Value};
 /// conversion): columns a reader does not use but keeps, such as a virtual
 /// experiment's `contact_loss_drive`.
 pub type Columns = BTreeMap<String, Vec<f64>>;
-
-/// Which experiment a file holds (docs/experiments.md and docs/experiment-files.md).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Kind {
-    /// Open-loop gain (and optionally phase) over frequency.
-    FrequencyResponse,
-    /// Resonance peaks only, listed in the manifest (no CSV).
-    Resonance,
-    /// Motor torque over time during a commanded sinusoidal table motion.
-    TorqueCurve,
-    /// ISO 230-2 positioning runs: deviation per target, direction and run.
-    Positioning,
-    /// Table and motor angle over time at constant speed (rotational fluctuation).
-    Fluctuation,
-    /// As [`Kind::Fluctuation`], with an offset mass on a vertical table.
-    Unbalance,
-    /// Raw time series of a frequency-response test (motor torque or current, motor and
-    /// table angle, uniformly sampled), from which the gain curve is estimated.
-    FrequencyResponseTime,
-    /// A recorded closed-loop run: position command, the loop's encoder, the drive's
-    /// effort and the controller output over uniformly sampled time.
-    ServoTrace,
-    /// Constant-speed runs: each run's mean speed and mean effort at the motor, one row
-    /// per run (the friction map).
-    FrictionMap,
-}
-
-impl Kind {
-    /// Every kind, in the order of docs/experiment-files.md, then the kinds added since.
-    pub const ALL: [Kind; 9] = [
-        Kind::FrequencyResponse,
-        Kind::Resonance,
-        Kind::TorqueCurve,
-        Kind::Positioning,
-        Kind::Fluctuation,
-        Kind::Unbalance,
-        Kind::FrequencyResponseTime,
-        Kind::ServoTrace,
-        Kind::FrictionMap,
-    ];
-
-    /// The name used in manifests (`frequency_response`, …).
-    pub fn name(self) -> &'static str {
-        match self {
-            Kind::FrequencyResponse => "frequency_response",
-            Kind::Resonance => "resonance",
-            Kind::TorqueCurve => "torque_curve",
-            Kind::Positioning => "positioning",
-            Kind::Fluctuation => "fluctuation",
-            Kind::Unbalance => "unbalance",
-            Kind::FrequencyResponseTime => "frequency_response_time",
-            Kind::ServoTrace => "servo_trace",
-            Kind::FrictionMap => "friction_map",
-        }
-    }
-
-    /// Whether the experiment has a CSV data file (all kinds but `resonance`).
-    pub fn has_data_file(self) -> bool {
-        self != Kind::Resonance
-    }
-}
-
-impl fmt::Display for Kind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
 
 /// The sense in which a positioning target was approached (on a linear axis: the
 /// positive or negative direction of the axis).
@@ -366,7 +296,7 @@ pub fn read(path: &Path) -> Result<Experiment, ExperimentFileError> {
         }
     }
     let data_path = data_path(path, &manifest);
-    let data = table::Table::read(&data_path, path)?.data(manifest.kind)?;
+    let data = (manifest.kind.definition().read)(table::Table::read(&data_path, path)?)?;
     check_against_data(&manifest, &data).map_err(|m| manifest_error(path, &m))?;
     Ok(Experiment {
         manifest,

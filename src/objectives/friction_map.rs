@@ -15,6 +15,7 @@ use super::{Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::estimation::friction_law::{check_map, LawFit};
 use crate::experiments::friction_map::{evaluate, model_effort};
 use crate::io::experiment_file::{Data, FrictionMap, Kind};
+use crate::model::friction::{Body, SteadyFriction};
 use crate::model::{Drive, Params, Topology};
 
 /// The friction-map objective: the model's steady state, smooth and quick.
@@ -88,42 +89,38 @@ fn direct_fit_start(source: &Source<'_>, base: &Params) -> Result<Option<Estimat
 
 /// The model's parameters that reproduce `fit`, with every other body of `base` as
 /// it is (their Coulomb levels and dampings through the ratios; their own Stribeck
-/// rises, if any, are left out of the carry).
+/// rises, if any, are left out of the carry): the body's own law is the map's law
+/// less the others' odd part at the motor, the offset the load.
 fn carried(fit: &LawFit, base: &Params) -> Result<Vec<(String, f64)>, SetupError> {
-    let value = |name: &str| fit.parameter(name).map(|p| p.value);
-    let (level, damping, rise, speed) = if base.topology == Topology::DirectDrive {
-        ("ft", "Ct", "fst", "vst")
+    let Some((at_motor, offset)) = fit.steady() else {
+        return Ok(Vec::new());
+    };
+    let body = if base.topology == Topology::DirectDrive {
+        Body::Table
     } else {
-        ("fm", "Cm", "fsm", "vsm")
+        Body::Motor
     };
     // The other bodies alone: the own body's friction, damping and rise and the load
     // set to 0. Their odd part at the motor is L·sgn(ω) + S·ω.
     let mut others = base.clone();
-    for name in [level, damping, rise, "Tload"] {
-        others.set(name, 0.0)?;
-    }
+    others.set_steady(body, &SteadyFriction::NONE);
+    others.tload = 0.0;
     let d = Drive::new(&others)?;
     let odd = |w: f64| 0.5 * (model_effort(&d, w) - model_effort(&d, -w));
     let slope = odd(2.0) - odd(1.0);
     let others_level = odd(1.0) - slope;
-    let mut out = Vec::new();
-    if let Some(fc) = value("Fc") {
-        out.push((level.to_string(), fc - others_level));
-    }
-    if let Some(fv) = value("Fv") {
-        out.push((damping.to_string(), fv - slope));
-    }
-    if let Some(fo) = value("Fo") {
-        // The offset at the motor is −Rg·Rw·Tload.
-        out.push(("Tload".to_string(), -fo / d.ratio()));
-    }
-    if let (Some(fs), Some(fc), Some(vs), Some(delta)) =
-        (value("Fs"), value("Fc"), value("vs"), value("delta"))
-    {
-        out.push((rise.to_string(), fs - fc));
-        out.push((speed.to_string(), vs));
-        out.push(("stribeck_shape".to_string(), delta));
-    }
+    let own = SteadyFriction {
+        coulomb: at_motor.coulomb - others_level,
+        viscous: at_motor.viscous - slope,
+        ..at_motor
+    };
+    let mut out: Vec<(String, f64)> = own
+        .named(body)
+        .into_iter()
+        .map(|(name, value)| (name.to_string(), value))
+        .collect();
+    // The offset at the motor is −Rg·Rw·Tload.
+    out.insert(2, ("Tload".to_string(), -offset / d.ratio()));
     Ok(out)
 }
 

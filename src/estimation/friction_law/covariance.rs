@@ -22,7 +22,7 @@ const INVOLVED: f64 = 1e-12;
 
 /// The covariance of the reported parameters, where determined.
 #[derive(Clone, Debug)]
-pub(super) struct Covariance {
+pub struct Covariance {
     /// cov[(a, b)], N·m and rad/s units as the parameters' (0 where undetermined).
     matrix: DMatrix<f64>,
     /// Whether each parameter is determined by the data.

@@ -1,5 +1,5 @@
-//! The four laws as implemented: their parameters, values and gradients with respect
-//! to the reported parameters.
+//! The four laws rtid fits to a map ([`Law`]): their parameters, values and gradients
+//! with respect to the reported parameters.
 
 use std::fmt;
 
@@ -21,7 +21,7 @@ pub enum Law {
 
 /// What a parameter is, which sets its unit and how the fit scales it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Quantity {
+pub enum Quantity {
     /// An effort, N·m or N (Fc, Fs, Fo).
     Effort,
     /// A viscous coefficient, N·m·s/rad or N·s/m (Fv).
@@ -76,7 +76,7 @@ impl Law {
     }
 
     /// What each parameter is, in the order of the values.
-    pub(super) fn quantities(self) -> &'static [Quantity] {
+    pub fn quantities(self) -> &'static [Quantity] {
         use Quantity::{Effort as E, Exponent as X, Speed as S, Viscous as V};
         match self {
             Law::Coulomb => &[E, V, E],
@@ -103,7 +103,7 @@ impl Law {
 
     /// The derivatives of [`Law::evaluate`] at `v` with respect to each value, into
     /// `out` (as long as the values).
-    pub(super) fn gradient(self, values: &[f64], v: f64, out: &mut [f64]) {
+    pub fn gradient(self, values: &[f64], v: f64, out: &mut [f64]) {
         let p = values;
         let s = v.signum();
         out.fill(0.0);

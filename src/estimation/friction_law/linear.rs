@@ -1,14 +1,15 @@
-//! The laws linear in their parameters (`coulomb`, `coulomb_asymmetric`): ordinary
+//! The laws linear in their parameters (`coulomb`, `coulomb_asymmetric`, any
+//! [`MapLaw`] whose `is_linear` holds): ordinary
 //! least squares through the SVD of the regressor, whose rows are the law's gradient.
 
 use nalgebra::{DMatrix, DVector};
 
-use super::law::Law;
+use super::map_law::MapLaw;
 
 /// The least-squares values of a linear `law` over the runs (`speed`, `effort`) of a
 /// map that passed [`super::check_map`] (which makes the regressor full rank).
-pub(super) fn fit(law: Law, speed: &[f64], effort: &[f64]) -> Vec<f64> {
-    debug_assert!(!law.is_stribeck());
+pub(super) fn fit<L: MapLaw>(law: &L, speed: &[f64], effort: &[f64]) -> Vec<f64> {
+    debug_assert!(law.is_linear());
     let k = law.parameters().len();
     let zeros = vec![0.0; k];
     let mut row = vec![0.0; k];
@@ -36,6 +37,7 @@ pub(super) fn fit(law: Law, speed: &[f64], effort: &[f64]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::estimation::friction_law::Law;
 
     #[test]
     fn exact_linear_laws_are_recovered() {
@@ -45,7 +47,7 @@ mod tests {
             (Law::CoulombAsymmetric, vec![2e-3, 1e-4, 1.5e-3, 1.3e-4]),
         ] {
             let effort: Vec<f64> = speed.iter().map(|&v| law.evaluate(&values, v)).collect();
-            let got = fit(law, &speed, &effort);
+            let got = fit(&law, &speed, &effort);
             for (g, w) in got.iter().zip(&values) {
                 assert!((g - w).abs() < 1e-15, "{law}: {got:?}");
             }

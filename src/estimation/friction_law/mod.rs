@@ -39,11 +39,14 @@
 //! comparison's `fits`, with its parameters and notes, but not in the AICc ranking, so
 //! an unconverged or degenerate law is never the one "the data support".
 
+mod builtin;
 mod compare;
 mod covariance;
 mod law;
 mod linear;
 mod map;
+mod map_law;
+mod nonlinear;
 mod note;
 mod stribeck;
 
@@ -53,9 +56,13 @@ mod tests;
 use nalgebra::DMatrix;
 use serde::Serialize;
 
+use crate::model::friction::{Rise, SteadyFriction};
+
 pub use compare::{fit_all, Comparison, Refused, COST_FLOOR};
-pub use law::Law;
+pub use covariance::Covariance;
+pub use law::{Law, Quantity};
 pub use map::{check_map, distinct_speeds, Direction, MapProblem};
+pub use map_law::MapLaw;
 pub use note::{Note, DELTA_RANGE};
 
 /// The Stribeck laws need this many distinct speeds per direction: the rise's start,
@@ -73,10 +80,10 @@ pub struct Parameter {
     pub std_error: Option<f64>,
 }
 
-/// A law fitted to a map.
+/// A law fitted to a map: one of [`Law`] unless another [`MapLaw`] was fitted.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct LawFit {
-    pub law: Law,
+pub struct LawFit<L = Law> {
+    pub law: L,
     /// In the order of [`Law::parameters`].
     pub parameters: Vec<Parameter>,
     /// The sum of squared residuals, (N·m)² or N².
@@ -101,7 +108,7 @@ pub struct LawFit {
     pub notes: Vec<Note>,
 }
 
-impl LawFit {
+impl<L> LawFit<L> {
     /// The values, in the order of [`Law::parameters`].
     pub fn values(&self) -> Vec<f64> {
         self.parameters.iter().map(|p| p.value).collect()
@@ -118,6 +125,38 @@ impl LawFit {
     }
 }
 
+impl LawFit<Law> {
+    /// A symmetric law as the model states a body's friction, with the offset Fo
+    /// (N·m or N) apart: Fc the Coulomb level, Fv the viscous slope, Fs − Fc, vs and
+    /// delta the rise. `None` for the asymmetric laws, which no body of the model has.
+    pub fn steady(&self) -> Option<(SteadyFriction, f64)> {
+        let v = self.values();
+        match self.law {
+            Law::Coulomb => Some((
+                SteadyFriction {
+                    coulomb: v[0],
+                    viscous: v[1],
+                    rise: None,
+                },
+                v[2],
+            )),
+            Law::Stribeck => Some((
+                SteadyFriction {
+                    coulomb: v[0],
+                    viscous: v[4],
+                    rise: Some(Rise {
+                        rise: v[1] - v[0],
+                        speed: v[2],
+                        shape: v[3],
+                    }),
+                },
+                v[5],
+            )),
+            Law::CoulombAsymmetric | Law::StribeckAsymmetric => None,
+        }
+    }
+}
+
 /// Why a law is not fitted.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -125,13 +164,17 @@ pub enum FitError {
     #[error(transparent)]
     Map(#[from] MapProblem),
     #[error("{law}: {n} runs for {k} parameters: a law is fitted only to more runs than it has parameters")]
-    TooFewRuns { law: Law, n: usize, k: usize },
+    TooFewRuns {
+        law: &'static str,
+        n: usize,
+        k: usize,
+    },
     #[error(
-        "{law}: {distinct} distinct speeds in the {direction} direction: a Stribeck law \
-         needs at least {needed} per direction (the rise's start, middle and end)"
+        "{law}: {distinct} distinct speeds in the {direction} direction: the law \
+         needs at least {needed} per direction (its curve's start, middle and end)"
     )]
     TooFewSpeeds {
-        law: Law,
+        law: &'static str,
         direction: Direction,
         distinct: usize,
         needed: usize,
@@ -139,53 +182,46 @@ pub enum FitError {
 }
 
 /// Fits `law` to the runs' mean `speed` (rad/s or m/s) and mean `effort` (N·m or N),
-/// after [`check_map`].
-pub fn fit(law: Law, speed: &[f64], effort: &[f64]) -> Result<LawFit, FitError> {
+/// after [`check_map`]: any [`MapLaw`], the four of [`Law`] among them.
+pub fn fit<L: MapLaw>(law: L, speed: &[f64], effort: &[f64]) -> Result<LawFit<L>, FitError> {
     check_map(speed, effort)?;
     let (n, k) = (speed.len(), law.parameters().len());
     if n <= k {
-        return Err(FitError::TooFewRuns { law, n, k });
+        return Err(FitError::TooFewRuns {
+            law: law.name(),
+            n,
+            k,
+        });
     }
     let directions = [Direction::Positive, Direction::Negative];
     let speeds = directions.map(|d| distinct_speeds(speed, d));
-    if law.is_stribeck() {
-        for (direction, u) in directions.into_iter().zip(&speeds) {
-            if u.len() < STRIBECK_SPEEDS {
-                return Err(FitError::TooFewSpeeds {
-                    law,
-                    direction,
-                    distinct: u.len(),
-                    needed: STRIBECK_SPEEDS,
-                });
-            }
+    for (direction, u) in directions.into_iter().zip(&speeds) {
+        if u.len() < law.speeds_needed() {
+            return Err(FitError::TooFewSpeeds {
+                law: law.name(),
+                direction,
+                distinct: u.len(),
+                needed: law.speeds_needed(),
+            });
         }
     }
-    let (values, iterations, converged) = if law.is_stribeck() {
-        let f = stribeck::fit(law, speed, effort);
-        (f.values, f.iterations, f.converged)
+    let (values, iterations, converged) = if law.is_linear() {
+        (linear::fit(&law, speed, effort), 0, true)
     } else {
-        (linear::fit(law, speed, effort), 0, true)
+        let f = nonlinear::fit(&law, speed, effort);
+        (f.values, f.iterations, f.converged)
     };
     let evaluated: Vec<f64> = speed.iter().map(|&v| law.evaluate(&values, v)).collect();
     let residuals: Vec<f64> = effort.iter().zip(&evaluated).map(|(e, t)| e - t).collect();
     let ssr = residuals.iter().map(|r| r * r).sum();
-    let mut jacobian = DMatrix::zeros(n, k);
-    let mut row = vec![0.0; k];
-    for (i, &v) in speed.iter().enumerate() {
-        law.gradient(&values, v, &mut row);
-        for (j, &x) in row.iter().enumerate() {
-            jacobian[(i, j)] = x;
-        }
-    }
-    let covariance = covariance::Covariance::new(&jacobian, ssr);
+    let covariance = covariance::Covariance::new(&jacobian(&law, &values, speed), ssr);
     let span = speeds.map(|u| (u[0], u[u.len() - 1]));
-    let notes = note::notes(
-        law,
-        &values,
+    let mut notes = note::general(
+        law.parameters(),
         &covariance,
-        span,
         (!converged).then_some(iterations),
     );
+    notes.extend(law.checks(&values, &covariance, span));
     let parameters = law
         .parameters()
         .iter()
@@ -198,6 +234,7 @@ pub fn fit(law: Law, speed: &[f64], effort: &[f64]) -> Result<LawFit, FitError> 
         })
         .collect();
     Ok(LawFit {
+        determined: law.is_linear() || notes.is_empty(),
         law,
         parameters,
         ssr,
@@ -207,7 +244,20 @@ pub fn fit(law: Law, speed: &[f64], effort: &[f64]) -> Result<LawFit, FitError> 
         evaluated,
         iterations,
         converged,
-        determined: !law.is_stribeck() || notes.is_empty(),
         notes,
     })
+}
+
+/// The Jacobian of `law`'s efforts at `values` over the runs' speeds (runs × parameters).
+fn jacobian<L: MapLaw>(law: &L, values: &[f64], speed: &[f64]) -> DMatrix<f64> {
+    let k = values.len();
+    let mut jacobian = DMatrix::zeros(speed.len(), k);
+    let mut row = vec![0.0; k];
+    for (i, &v) in speed.iter().enumerate() {
+        law.gradient(values, v, &mut row);
+        for (j, &x) in row.iter().enumerate() {
+            jacobian[(i, j)] = x;
+        }
+    }
+    jacobian
 }

@@ -110,20 +110,17 @@ impl fmt::Display for Note {
     }
 }
 
-/// The notes on a fit of `law` with `values` over runs at `|speeds|` (per direction:
-/// lowest and highest, positive first), given its covariance.
-pub(super) fn notes(
-    law: Law,
-    values: &[f64],
+/// The notes every fit may have: it did not converge (`iterations` at the limit), or
+/// parameters `names` lack a standard error.
+pub(super) fn general(
+    names: &[&str],
     covariance: &Covariance,
-    span: [(f64, f64); 2],
     iterations: Option<usize>,
 ) -> Vec<Note> {
     let mut out = Vec::new();
     if let Some(iterations) = iterations {
         out.push(Note::NotConverged { iterations });
     }
-    let names = law.parameters();
     let undetermined: Vec<String> = (0..names.len())
         .filter(|&j| covariance.std_error(j).is_none())
         .map(|j| names[j].to_string())
@@ -133,6 +130,20 @@ pub(super) fn notes(
             parameters: undetermined,
         });
     }
+    out
+}
+
+/// A Stribeck law's own checks of a fit with `values` over runs at `|speeds|` (per
+/// direction: lowest and highest, positive first), given its covariance: the rise
+/// shown and positive, vs within the speeds, delta within [`DELTA_RANGE`].
+pub(super) fn stribeck_checks(
+    law: Law,
+    values: &[f64],
+    covariance: &Covariance,
+    span: [(f64, f64); 2],
+) -> Vec<Note> {
+    let mut out = Vec::new();
+    let names = law.parameters();
     // (Fs, Fc, vs) indices and the speeds their direction(s) cover.
     let both = (span[0].0.min(span[1].0), span[0].1.max(span[1].1));
     let rises: &[(usize, usize, usize, (f64, f64))] = match law {

@@ -248,7 +248,7 @@ fn laws_are_refused_with_too_few_runs_or_speeds() {
     assert_eq!(
         fit(Law::CoulombAsymmetric, &speed, &effort),
         Err(FitError::TooFewRuns {
-            law: Law::CoulombAsymmetric,
+            law: "coulomb_asymmetric",
             n: 4,
             k: 4
         })
@@ -264,8 +264,8 @@ fn laws_are_refused_with_too_few_runs_or_speeds() {
     let e = fit(Law::Stribeck, &speed, &effort).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "stribeck: 2 distinct speeds in the positive direction: a Stribeck law needs at \
-         least 3 per direction (the rise's start, middle and end)"
+        "stribeck: 2 distinct speeds in the positive direction: the law needs at least 3 \
+         per direction (its curve's start, middle and end)"
     );
     let c = fit_all(&speed, &effort).unwrap();
     let refused: Vec<Law> = c.refused.iter().map(|r| r.law).collect();
@@ -386,4 +386,97 @@ fn stribeck_laws_on_worm_like_maps_keep_their_bounds_or_are_not_determined() {
     // between the second and third speed, or no rise beyond the scatter): every one
     // of these fits is said not determined, as the real worm drive's two are.
     assert_eq!(undetermined, 16, "{undetermined} of 16 not determined");
+}
+
+/// Viscous friction that starts only beyond a speed `band`, with an offset:
+/// T = sgn(v)·c·max(|v| − band, 0) + Fo — a law outside [`Law`], nonlinear in `band`,
+/// written here as a new law would be: one [`MapLaw`] impl.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+struct DeadBandViscous;
+
+impl MapLaw for DeadBandViscous {
+    fn name(&self) -> &'static str {
+        "dead_band_viscous"
+    }
+
+    fn parameters(&self) -> &'static [&'static str] {
+        &["c", "band", "Fo"]
+    }
+
+    fn quantities(&self) -> &'static [Quantity] {
+        &[Quantity::Viscous, Quantity::Speed, Quantity::Effort]
+    }
+
+    fn evaluate(&self, p: &[f64], v: f64) -> f64 {
+        v.signum() * p[0] * (v.abs() - p[1]).max(0.0) + p[2]
+    }
+
+    fn gradient(&self, p: &[f64], v: f64, out: &mut [f64]) {
+        let beyond = v.abs() > p[1];
+        let excess = (v.abs() - p[1]).max(0.0);
+        out.copy_from_slice(&[
+            v.signum() * excess,
+            if beyond { -v.signum() * p[0] } else { 0.0 },
+            1.0,
+        ]);
+    }
+
+    fn is_linear(&self) -> bool {
+        false
+    }
+
+    fn speeds_needed(&self) -> usize {
+        3
+    }
+
+    fn starts(&self, speed: &[f64], effort: &[f64]) -> Vec<Vec<f64>> {
+        // The Coulomb law's slope, and a band at the lowest speed.
+        let c = linear::fit(&Law::Coulomb, speed, effort);
+        let lowest = speed.iter().map(|v| v.abs()).fold(f64::INFINITY, f64::min);
+        vec![vec![c[1], lowest, c[2]]]
+    }
+}
+
+#[test]
+fn a_law_written_outside_the_list_is_fitted_with_its_standard_errors() {
+    let truth = [2.0e-4, 2.5, 1.0e-4];
+    let mut rng = StdRng::seed_from_u64(11);
+    let normal = Normal::new(0.0, 1.0).unwrap();
+    let speed = speeds();
+    let effort: Vec<f64> = speed
+        .iter()
+        .map(|&v| DeadBandViscous.evaluate(&truth, v) + 2e-6 * normal.sample(&mut rng))
+        .collect();
+    let f = fit(DeadBandViscous, &speed, &effort).unwrap();
+    assert!(f.converged && f.determined, "{f:#?}");
+    assert_eq!(f.law, DeadBandViscous);
+    for (p, t) in f.parameters.iter().zip(truth) {
+        let se = p.std_error.unwrap();
+        assert!(
+            (p.value - t).abs() < 4.0 * se,
+            "{}: {} ± {se} vs {t}",
+            p.name,
+            p.value
+        );
+        assert!(se < 0.05 * t.abs(), "{}: ± {se}", p.name);
+    }
+    // Refused like any law where the map cannot carry it.
+    let two: Vec<f64> = speed
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v.signum() * (1 + i % 2) as f64)
+        .collect();
+    let refused = fit(DeadBandViscous, &two, &effort);
+    assert!(
+        matches!(
+            refused,
+            Err(FitError::TooFewSpeeds {
+                law: "dead_band_viscous",
+                distinct: 2,
+                needed: 3,
+                ..
+            })
+        ),
+        "{refused:?}"
+    );
 }

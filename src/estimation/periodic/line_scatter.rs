@@ -24,6 +24,8 @@
 //! median ignores while they are fewer than half of the window; elsewhere the bend
 //! adds to the estimate, which errs on the safe side.
 
+use crate::io::import::glitches::median;
+
 /// The line-to-line scatter of `y` over `x` (strictly increasing), one value per point,
 /// in the unit of `y`. Fewer than three points: zeros.
 pub fn scatter(x: &[f64], y: &[f64], half_window: usize) -> Vec<f64> {
@@ -50,16 +52,6 @@ pub fn scatter(x: &[f64], y: &[f64], half_window: usize) -> Vec<f64> {
             median(&mut window) / 0.6745
         })
         .collect()
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let m = v.len() / 2;
-    if v.len() % 2 == 1 {
-        v[m]
-    } else {
-        0.5 * (v[m - 1] + v[m])
-    }
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
-use super::response::{self, Delay, Reference, Response};
+use super::response::{Delay, Reference, Response};
 use super::{sample_period, Kind};
 use crate::model::params::LoopMode;
 
@@ -175,38 +175,13 @@ impl Conditions {
     /// (the ratio excepted: it depends on the mechanism).
     pub fn with_defaults(&self, kind: Kind) -> Conditions {
         let mut c = self.clone();
-        match kind {
-            Kind::FrequencyResponse => {
-                c.torque_amplitude_nm.get_or_insert(5.0);
-                c.preload_nm.get_or_insert(0.0);
-            }
-            Kind::Resonance | Kind::ServoTrace | Kind::FrictionMap => {}
-            Kind::TorqueCurve => {
-                c.amplitude_deg.get_or_insert(30.0);
-                c.period_s.get_or_insert(3.0);
-                c.loop_mode.get_or_insert(LoopMode::FullClosed);
-            }
-            Kind::Positioning => {
-                c.loop_mode.get_or_insert(LoopMode::SemiClosed);
-                c.dwell_s.get_or_insert(1.0);
-            }
-            Kind::Fluctuation | Kind::Unbalance => {
-                let speed = if kind == Kind::Fluctuation {
-                    180.0
-                } else {
-                    360.0
-                };
-                c.speed_deg_per_min.get_or_insert(speed);
-                c.loop_mode.get_or_insert(LoopMode::SemiClosed);
-            }
-            Kind::FrequencyResponseTime => c.record_defaults(),
-        }
+        (kind.definition().defaults)(&mut c);
         c
     }
 
     /// The excitation (stepped sine when frequencies are given, else broadband) and,
     /// for a multisine, one transient period and every line excited.
-    fn record_defaults(&mut self) {
+    pub(super) fn record_defaults(&mut self) {
         let stepped = self.frequencies_hz.is_some();
         let excitation = *self.excitation.get_or_insert(if stepped {
             Excitation::SteppedSine
@@ -243,8 +218,35 @@ impl Conditions {
     }
 }
 
+/// A frequency response: 5 N·m of torque, no preload.
+pub(super) fn frequency_response_defaults(c: &mut Conditions) {
+    c.torque_amplitude_nm.get_or_insert(5.0);
+    c.preload_nm.get_or_insert(0.0);
+}
+
+/// A torque curve: ±30° over 3 s, full-closed loop.
+pub(super) fn torque_curve_defaults(c: &mut Conditions) {
+    c.amplitude_deg.get_or_insert(30.0);
+    c.period_s.get_or_insert(3.0);
+    c.loop_mode.get_or_insert(LoopMode::FullClosed);
+}
+
+/// Positioning: semi-closed loop, 1 s dwell.
+pub(super) fn positioning_defaults(c: &mut Conditions) {
+    c.loop_mode.get_or_insert(LoopMode::SemiClosed);
+    c.dwell_s.get_or_insert(1.0);
+}
+
+/// Rotational fluctuation (180°/min) or unbalance (360°/min): `speed_deg_per_min`,
+/// semi-closed loop.
+pub(super) fn fluctuation_defaults(c: &mut Conditions, speed_deg_per_min: f64) {
+    c.speed_deg_per_min.get_or_insert(speed_deg_per_min);
+    c.loop_mode.get_or_insert(LoopMode::SemiClosed);
+}
+
 /// The conditions `kind` needs, checked on the manifest alone (JSON numbers are
-/// finite, so `<= 0` is the whole check of a positive value).
+/// finite, so `<= 0` is the whole check of a positive value): the band where one is
+/// given, then the kind's own checks.
 pub(super) fn check(kind: Kind, c: &Conditions) -> Result<(), String> {
     if let Some([lo, hi]) = c.band_hz {
         if !(lo >= 0.0 && lo < hi) {
@@ -253,18 +255,13 @@ pub(super) fn check(kind: Kind, c: &Conditions) -> Result<(), String> {
             ));
         }
     }
-    match kind {
-        Kind::FrequencyResponse => response::check(c),
-        Kind::FrequencyResponseTime => check_record(c),
-        Kind::ServoTrace => check_servo(c),
-        _ => Ok(()),
-    }
+    (kind.definition().check)(c)
 }
 
 /// A frequency-response record: a positive ratio where one is given; for a stepped
 /// sine the frequencies (positive) and the dwell (positive); for a multisine its
 /// period and lines.
-fn check_record(c: &Conditions) -> Result<(), String> {
+pub(super) fn check_record(c: &Conditions) -> Result<(), String> {
     let c = c.with_defaults(Kind::FrequencyResponseTime);
     if let Some(r) = c.ratio.filter(|r| *r <= 0.0) {
         return Err(format!(
@@ -358,7 +355,7 @@ fn check_multisine(c: &Conditions) -> Result<(), String> {
 }
 
 /// A servo trace: a nonzero drive gain and a positive loop period where given.
-fn check_servo(c: &Conditions) -> Result<(), String> {
+pub(super) fn check_servo(c: &Conditions) -> Result<(), String> {
     if c.drive_gain == Some(0.0) {
         return Err("`conditions.drive_gain` is 0: the drive gain must be nonzero".into());
     }

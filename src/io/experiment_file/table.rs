@@ -3,9 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod kinds;
-
-pub(super) use kinds::reserved;
+pub(super) mod kinds;
 
 use super::units::units_for;
 use super::{Axis, Columns, CommandUnit, ExperimentFileError as Error};

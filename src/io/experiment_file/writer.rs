@@ -174,7 +174,7 @@ fn check_columns(data: &Data, columns: &[(Cow<'_, str>, Cells<'_>)]) -> Result<(
         return Err("no rows".into());
     }
     let fixed = columns.len() - data.extra().map_or(0, |e| e.len());
-    let reserved = super::table::reserved(data.kind());
+    let reserved = (data.kind().definition().reserved)();
     for (i, (name, cells)) in columns.iter().enumerate() {
         if i >= fixed {
             if name.is_empty() || name.trim() != name || name.starts_with('#') {

@@ -197,7 +197,7 @@ const FRICTION_MAP: &[Role] = &[
 ];
 
 impl ImportKind {
-    pub const ALL: [ImportKind; 6] = [
+    pub const ALL: &'static [ImportKind] = &[
         ImportKind::ServoTrace,
         ImportKind::TorqueCurve,
         ImportKind::FrequencyResponse,
@@ -244,7 +244,7 @@ impl ImportKind {
     /// The kind spelled `name` (`servo-trace` or `servo_trace`).
     pub fn parse(name: &str) -> Option<ImportKind> {
         let name = name.replace('_', "-");
-        ImportKind::ALL.into_iter().find(|k| k.name() == name)
+        ImportKind::ALL.iter().copied().find(|k| k.name() == name)
     }
 
     /// The roles in words, for messages.

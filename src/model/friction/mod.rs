@@ -6,6 +6,9 @@
 //! - [`Stribeck`]: the Coulomb level plus a rise that falls off with speed (`fsm`,
 //!   `vsm`, … and `stribeck_shape`).
 //!
+//! What every layer shares of a body's law at steady speed — its Coulomb level,
+//! viscous slope and rise, by the registry's names — is [`SteadyFriction`].
+//!
 //! A drive's parameters compile into one [`DriveFriction`] (the Coulomb law unless a
 //! Stribeck rise is set), and the kernel is generic over the law: it runs each law's
 //! own path, chosen once per step outside the stepping loop, so the Coulomb path of
@@ -21,12 +24,14 @@
 
 pub(crate) mod clamp;
 mod coulomb;
+mod steady;
 mod stribeck;
 #[cfg(test)]
 mod tests;
 
 pub use clamp::Friction;
 pub use coulomb::Coulomb;
+pub use steady::{Body, BodyNames, Rise, SteadyFriction, SHAPE};
 pub use stribeck::Stribeck;
 
 use super::params::Params;

@@ -52,35 +52,29 @@ enum Input {
 }
 
 impl Table {
-    /// The typed data of `kind` (not resonance, which has no table).
-    pub(in crate::io::experiment_file) fn data(mut self, kind: Kind) -> Result<Data, Error> {
-        match kind {
-            Kind::FrequencyResponse => {
-                let (f, g) = (self.column("frequency_hz")?, self.column("gain_db")?);
-                let p = self.position(&["phase"])?;
-                Ok(Data::FrequencyResponse {
-                    frequency_hz: self.numbers(f, Order::Frequency)?,
-                    gain_db: self.numbers(g, Any)?,
-                    phase_rad: p.map(|p| self.numbers(p, Any)).transpose()?,
-                    extra: self.extras(),
-                })
-            }
-            Kind::Resonance => Err(Error::Manifest {
-                path: self.path,
-                message: "a resonance experiment has no data file".into(),
-            }),
-            Kind::TorqueCurve => self.torque_curve(),
-            Kind::Positioning => self.positioning(),
-            Kind::Fluctuation | Kind::Unbalance => self.fluctuation(kind),
-            Kind::FrequencyResponseTime => self.record(),
-            Kind::ServoTrace => self.servo_trace(),
-            Kind::FrictionMap => self.friction_map(),
-        }
+    /// Frequency, gain and optionally phase.
+    pub(in crate::io::experiment_file) fn frequency_response(mut self) -> Result<Data, Error> {
+        let (f, g) = (self.column("frequency_hz")?, self.column("gain_db")?);
+        let p = self.position(&["phase"])?;
+        Ok(Data::FrequencyResponse {
+            frequency_hz: self.numbers(f, Order::Frequency)?,
+            gain_db: self.numbers(g, Any)?,
+            phase_rad: p.map(|p| self.numbers(p, Any)).transpose()?,
+            extra: self.extras(),
+        })
+    }
+
+    /// A kind without a table (resonance): refused.
+    pub(in crate::io::experiment_file) fn no_table(self) -> Result<Data, Error> {
+        Err(Error::Manifest {
+            path: self.path,
+            message: "a resonance experiment has no data file".into(),
+        })
     }
 
     /// Time, the drive's torque or force and optionally the table's angle or position,
     /// all rotary or all linear.
-    fn torque_curve(mut self) -> Result<Data, Error> {
+    pub(in crate::io::experiment_file) fn torque_curve(mut self) -> Result<Data, Error> {
         let t = self.column("time_s")?;
         let effort = self.effort(&CURVE_EFFORT)?;
         let table = self.position(&TABLE)?;
@@ -108,7 +102,7 @@ impl Table {
     /// Target, direction, run, and deviation from a `deviation_*` column or else as
     /// `measured_*` − target, in angles or in lengths. With both, `deviation_*` is used
     /// and `measured_*` kept as an extra column.
-    fn positioning(mut self) -> Result<Data, Error> {
+    pub(in crate::io::experiment_file) fn positioning(mut self) -> Result<Data, Error> {
         let target = self.required_position(&["target"])?;
         let (d, r) = (self.column("direction")?, self.column("run")?);
         let (deviation, measured) = match self.position(&["deviation"])? {
@@ -203,7 +197,7 @@ impl Table {
 
     /// Time, motor-shaft angle and table angle (rotary only: docs/experiments.md (rotational fluctuation) evaluates
     /// θt − θm·Rg·Rw over the table angle).
-    fn fluctuation(mut self, kind: Kind) -> Result<Data, Error> {
+    pub(in crate::io::experiment_file) fn fluctuation(mut self, kind: Kind) -> Result<Data, Error> {
         let t = self.column("time_s")?;
         let m = self.required_position(&["motor_angle"])?;
         let a = self.required_position(&["table_angle"])?;
@@ -232,7 +226,7 @@ impl Table {
 
     /// A frequency-response record: uniform time, motor torque or current, motor
     /// angle, table (or load) angle.
-    fn record(mut self) -> Result<Data, Error> {
+    pub(in crate::io::experiment_file) fn record(mut self) -> Result<Data, Error> {
         let t = self.column("time_s")?;
         let (input, kind) = self.required_one_of(&RECORD_INPUT, "input")?;
         let m = self.required_position(&["motor_angle"])?;
@@ -264,7 +258,7 @@ impl Table {
 
     /// A servo trace: uniform time, reference and loop position, optional table
     /// position, effort, optional controller output and added signal.
-    fn servo_trace(mut self) -> Result<Data, Error> {
+    pub(in crate::io::experiment_file) fn servo_trace(mut self) -> Result<Data, Error> {
         let t = self.column("time_s")?;
         let reference = self.required_position(&["reference_position"])?;
         let position = self.required_position(&SERVO_LOOP)?;
@@ -304,7 +298,7 @@ impl Table {
     /// A friction map: each run's speed (non-zero, distinct) and effort, optionally
     /// their standard deviations and the counts of samples averaged, dropped and left
     /// out; all rotary or all linear. The rows come back in order of increasing speed.
-    fn friction_map(mut self) -> Result<Data, Error> {
+    pub(in crate::io::experiment_file) fn friction_map(mut self) -> Result<Data, Error> {
         let speed = self.speed(MAP_SPEEDS[0])?.ok_or_else(|| {
             let mut names = SPEED_UNITS
                 .iter()
@@ -389,52 +383,62 @@ impl Table {
     }
 }
 
-/// The column names the reader interprets for `kind`: an extra column must not take one.
-pub(in crate::io::experiment_file) fn reserved(kind: Kind) -> Vec<String> {
-    let (plain, positions): (Vec<&str>, Vec<&str>) = match kind {
-        Kind::FrequencyResponse => (vec!["frequency_hz", "gain_db"], vec!["phase"]),
-        Kind::Resonance => (vec![], vec![]),
-        Kind::TorqueCurve => (
-            vec!["time_s", CURVE_EFFORT[0].0, CURVE_EFFORT[1].0],
-            TABLE.to_vec(),
-        ),
-        Kind::Positioning => (vec!["direction", "run"], vec!["target", "deviation"]),
-        Kind::Fluctuation | Kind::Unbalance => (vec!["time_s"], vec!["motor_angle", "table_angle"]),
-        Kind::FrequencyResponseTime => {
-            let mut p = vec!["motor_angle"];
-            p.extend(RECORD_LOAD);
-            (vec!["time_s", RECORD_INPUT[0].0, RECORD_INPUT[1].0], p)
-        }
-        Kind::ServoTrace => {
-            let mut p = vec!["reference_position", "table_position"];
-            p.extend(SERVO_LOOP);
-            (vec!["time_s", SERVO_EFFORT[0].0, SERVO_EFFORT[1].0], p)
-        }
-        Kind::FrictionMap => {
-            let mut plain: Vec<&str> = MAP_EFFORT.iter().map(|(n, _)| *n).collect();
-            plain.extend(MAP_EFFORT_STD.iter().map(|(n, _)| *n));
-            plain.extend(MAP_COUNTS);
-            (plain, vec![])
-        }
-    };
-    let position_names = positions.into_iter().flat_map(|b| {
+/// A kind's reserved columns: `plain` names, and `positions` with each unit suffix.
+fn reserved(plain: &[&str], positions: &[&str]) -> Vec<String> {
+    let position_names = positions.iter().flat_map(|b| {
         units_for(b)
             .iter()
             .map(move |u| format!("{b}_{}", u.suffix))
     });
+    plain
+        .iter()
+        .map(|s| s.to_string())
+        .chain(position_names)
+        .collect()
+}
+
+/// The column names each kind's reader interprets: an extra column must not take one.
+pub(in crate::io::experiment_file) fn frequency_response() -> Vec<String> {
+    reserved(&["frequency_hz", "gain_db"], &["phase"])
+}
+
+pub(in crate::io::experiment_file) fn torque_curve() -> Vec<String> {
+    reserved(&["time_s", CURVE_EFFORT[0].0, CURVE_EFFORT[1].0], &TABLE)
+}
+
+pub(in crate::io::experiment_file) fn positioning() -> Vec<String> {
+    reserved(&["direction", "run"], &["target", "deviation"])
+}
+
+pub(in crate::io::experiment_file) fn fluctuation() -> Vec<String> {
+    reserved(&["time_s"], &["motor_angle", "table_angle"])
+}
+
+pub(in crate::io::experiment_file) fn record() -> Vec<String> {
+    let mut p = vec!["motor_angle"];
+    p.extend(RECORD_LOAD);
+    reserved(&["time_s", RECORD_INPUT[0].0, RECORD_INPUT[1].0], &p)
+}
+
+pub(in crate::io::experiment_file) fn servo_trace() -> Vec<String> {
+    let mut p = vec!["reference_position", "table_position"];
+    p.extend(SERVO_LOOP);
     let commands = ["controller_output", "controller_added"]
         .into_iter()
-        .filter(|_| kind == Kind::ServoTrace)
         .flat_map(|b| CommandUnit::ALL.map(|u| format!("{b}_{}", u.suffix())));
+    let mut out = reserved(&["time_s", SERVO_EFFORT[0].0, SERVO_EFFORT[1].0], &p);
+    out.extend(commands);
+    out
+}
+
+pub(in crate::io::experiment_file) fn friction_map() -> Vec<String> {
+    let mut plain: Vec<&str> = MAP_EFFORT.iter().map(|(n, _)| *n).collect();
+    plain.extend(MAP_EFFORT_STD.iter().map(|(n, _)| *n));
+    plain.extend(MAP_COUNTS);
     let speeds = MAP_SPEEDS
         .into_iter()
-        .filter(|_| kind == Kind::FrictionMap)
         .flat_map(|b| SPEED_UNITS.map(|u| format!("{b}_{}", u.suffix)));
-    plain
-        .into_iter()
-        .map(str::to_string)
-        .chain(position_names)
-        .chain(commands)
-        .chain(speeds)
-        .collect()
+    let mut out = reserved(&plain, &[]);
+    out.extend(speeds);
+    out
 }

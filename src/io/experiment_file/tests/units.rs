@@ -1,16 +1,7 @@
 //! Linear units, current-driven and multisine records, and servo traces.
 
-use super::*;
-
-/// Writes `files` (name, text) into a fresh folder; returns it and the path of the first.
-fn files(files: &[(&str, &str)]) -> (tempfile::TempDir, PathBuf) {
-    let dir = tempfile::tempdir().unwrap();
-    for (name, text) in files {
-        std::fs::write(dir.path().join(name), text).unwrap();
-    }
-    let first = dir.path().join(files[0].0);
-    (dir, first)
-}
+use super::{close, files, read_csv};
+use crate::io::experiment_file::*;
 
 /// Reads `csv` as the data of a manifest of `kind` with `conditions` (a JSON object).
 fn read_with(kind: &str, conditions: &str, csv: &str) -> Result<Experiment, ExperimentFileError> {
@@ -18,17 +9,6 @@ fn read_with(kind: &str, conditions: &str, csv: &str) -> Result<Experiment, Expe
         format!(r#"{{"kind": "{kind}", "data": "run.csv", "conditions": {conditions}}}"#);
     let (_dir, path) = files(&[("run.json", &manifest), ("run.csv", csv)]);
     read(&path)
-}
-
-fn read_csv(kind: &str, csv: &str) -> Result<Experiment, ExperimentFileError> {
-    read_with(kind, "{}", csv)
-}
-
-fn close(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len()
-        && a.iter()
-            .zip(b)
-            .all(|(x, y)| (x - y).abs() <= 1e-12 * x.abs().max(y.abs()))
 }
 
 fn error(result: Result<Experiment, ExperimentFileError>) -> String {

@@ -1,8 +1,8 @@
 //! The `friction_map` kind: its columns in any speed unit, rows sorted by speed, and
 //! every cell it refuses named by file, line and column.
 
-use super::units::RPM;
-use super::*;
+use crate::io::experiment_file::units::RPM;
+use crate::io::experiment_file::*;
 
 /// Reads `map.json` of kind `friction_map` with `csv` as `map.csv`.
 fn read_map(csv: &str) -> Result<Experiment, ExperimentFileError> {
