@@ -31,6 +31,10 @@
 //! not wind them up. Gains ([`Gains`], `Copy`) are kept apart from the state that
 //! `update(&mut self, …)` changes.
 
+mod compensation;
+
+pub use compensation::{Compensation, ErrorTable, FrictionCompensation, ReversalPulse, TableError};
+
 use crate::model::params::{LoopMode, Params};
 
 /// Longest encoder dead time, in control periods, the delay line holds.
