@@ -5,6 +5,8 @@
 //! `servo_trace/replay` — one closed-loop replay of the whole record on the published
 //! model, the unit of cost of the output-error identification (`servo-trace`
 //! objective: ~110 replays from the IDIM estimate);
+//! `servo_trace/replay_drive_functions` — the same with the drive's functions on:
+//! velocity and torque feed-forward, the symmetrising lag and four setpoint filters;
 //! `servo_trace/identify` — the whole EMPS identification as `rtid identify` runs it:
 //! the IDIM-LS start, then the output-error search of Jt, Ct, ft, Tload (50
 //! Nelder–Mead iterations) and the uncertainty at the result.
@@ -16,7 +18,7 @@ use rtid::estimation::inverse_dynamics::IdimSettings;
 use rtid::experiments::servo_trace::{replay, ServoTrace};
 use rtid::identify::{identify, Config, ExperimentSpec, Monitor};
 use rtid::io::experiment_file::{self, Data};
-use rtid::model::Params;
+use rtid::model::{Params, SetpointFilter};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/real/emps")
@@ -44,7 +46,34 @@ fn bench(c: &mut Criterion) {
         b.iter(|| trace.fit_friction(&IdimSettings::default()).unwrap())
     });
     group.bench_function("replay", |b| b.iter(|| replay(&params, &trace).unwrap()));
+    let functions = with_drive_functions(&params);
+    group.bench_function("replay_drive_functions", |b| {
+        b.iter(|| replay(&functions, &trace).unwrap())
+    });
     group.finish();
+}
+
+/// `params` with feed-forward, the symmetrising lag and four setpoint filters on.
+fn with_drive_functions(params: &Params) -> Params {
+    let mut p = params.clone();
+    let c = &mut p.controller;
+    (c.kvff, c.kaff, c.symmetrising_s) = (1.0, p.jt / c.drive_gain, 1e-3);
+    let notch = |centre_hz| SetpointFilter::Notch {
+        centre_hz,
+        width_hz: 20.0,
+        depth_db: Some(-20.0),
+    };
+    c.filters = vec![
+        SetpointFilter::LowPass {
+            frequency_hz: 200.0,
+            damping: 0.7,
+        },
+        notch(80.0),
+        notch(120.0),
+        notch(160.0),
+    ];
+    p.validate().unwrap();
+    p
 }
 
 /// The whole identification: seconds per run, so the fewest samples criterion allows.

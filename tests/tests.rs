@@ -22,6 +22,7 @@ mod controller;
 mod conventions;
 mod corpus;
 mod design;
+mod drive_functions;
 mod fixtures;
 mod fluctuation;
 mod format_properties;

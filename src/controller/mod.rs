@@ -32,8 +32,13 @@
 //! `update(&mut self, …)` changes.
 
 mod compensation;
+mod feedforward;
+mod filters;
 
 pub use compensation::{Compensation, ErrorTable, FrictionCompensation, ReversalPulse, TableError};
+pub use filters::{Biquad, FilterChain};
+
+use feedforward::{Motion, ReferenceMotion};
 
 use crate::model::params::{LoopMode, Params};
 
@@ -80,6 +85,14 @@ pub struct Gains {
     /// Encoder dead time in whole periods and the remaining fraction of a period.
     delay_periods: usize,
     delay_fraction: f64,
+    /// Velocity feed-forward, the fraction of the reference's speed.
+    pub kvff: f64,
+    /// Torque feed-forward, output per motor rad/s² (m/s²).
+    pub kaff: f64,
+    /// The symmetrising lag's factor 1 − e^{−Tc/T} (0: none).
+    pub symmetrising: f64,
+    /// The torque-setpoint filters, at rest.
+    pub filters: FilterChain,
 }
 
 impl Gains {
@@ -110,7 +123,21 @@ impl Gains {
             ratio: p.ratio(),
             delay_periods: periods.floor() as usize,
             delay_fraction: periods - periods.floor(),
+            kvff: c.kvff,
+            kaff: c.kaff,
+            symmetrising: if c.symmetrising_s > 0.0 {
+                -(-c.tc / c.symmetrising_s).exp_m1()
+            } else {
+                0.0
+            },
+            filters: FilterChain::new(&c.filters, c.tc),
         })
+    }
+
+    /// Whether the controller derives anything from the reference's motion (feed-
+    /// forward or the symmetrising lag).
+    fn shapes_the_reference(&self) -> bool {
+        self.kvff != 0.0 || self.kaff != 0.0 || self.symmetrising != 0.0
     }
 }
 
@@ -140,6 +167,9 @@ pub struct Controller {
     added: f64,
     history: [f64; HISTORY],
     head: usize,
+    reference: ReferenceMotion,
+    filters: FilterChain,
+    compensation: Compensation,
 }
 
 impl Controller {
@@ -157,7 +187,16 @@ impl Controller {
             added: 0.0,
             history: [motor_angle; HISTORY],
             head: 0,
+            reference: ReferenceMotion::default(),
+            filters: gains.filters,
+            compensation: Compensation::default(),
         }
+    }
+
+    /// Sets the compensations (backlash, error table, friction) applied from the next
+    /// sample on; [`Compensation::default`] switches them off.
+    pub fn set_compensation(&mut self, compensation: Compensation) {
+        self.compensation = compensation;
     }
 
     /// Starts in motion (call right after [`Controller::new`]): the motor has been
@@ -172,6 +211,7 @@ impl Controller {
                 now - (back + 1) as f64 * g.tc * motor_velocity;
         }
         self.previous_motor = quantise(self.delayed_motor_angle(), g.motor_quantum);
+        self.reference.start_moving(motor_velocity);
     }
 
     /// The settings.
@@ -216,26 +256,59 @@ impl Controller {
         self.history[self.head] = motor_angle;
         let motor = quantise(self.delayed_motor_angle(), g.motor_quantum);
         self.table_reading = quantise(table_angle, g.table_quantum);
-        let error = match g.loop_mode {
-            LoopMode::SemiClosed => reference / g.ratio - motor,
-            LoopMode::FullClosed => (reference - self.table_reading) / g.ratio,
+        let (position, speed_ff, torque_ff) = if self.shaping() {
+            self.shaped(reference)
+        } else {
+            (reference, 0.0, 0.0)
         };
-        let speed_command = self.position_loop(error);
+        let error = match g.loop_mode {
+            LoopMode::SemiClosed => position / g.ratio - motor,
+            LoopMode::FullClosed => (position - self.table_reading) / g.ratio,
+        };
+        let speed_command = self.position_loop(error, speed_ff);
         let speed = (motor - self.previous_motor) / g.tc;
         self.previous_motor = motor;
-        let output = self.velocity_loop(speed_command - speed);
+        let output = self.velocity_loop(speed_command - speed, torque_ff);
         self.hold(output)
     }
 
+    /// Whether feed-forward, the symmetrising lag or a compensation act.
+    fn shaping(&self) -> bool {
+        self.gains.shapes_the_reference() || !self.compensation.is_off()
+    }
+
+    /// The position loop's reference (compensated, then symmetrised), the velocity
+    /// feed-forward (motor rad/s) and the torque feed-forward with the friction
+    /// compensation (output units) at reference `r`.
+    fn shaped(&mut self, r: f64) -> (f64, f64, f64) {
+        let g = self.gains;
+        let motion: Motion = self.reference.sample(r, g.tc, g.ratio);
+        let c = &self.compensation;
+        let mut position = r + c.position_offset(r, motion.downwards);
+        if g.symmetrising != 0.0 {
+            position = self.reference.symmetrise(position, g.symmetrising);
+        }
+        let friction = c
+            .friction
+            .as_ref()
+            .map_or(0.0, |f| self.reference.friction(f, &motion));
+        let torque = g.kaff * motion.acceleration + friction / g.drive_gain;
+        (position, g.kvff * motion.speed, torque)
+    }
+
     /// The velocity command for the position error `error`: Kpp·e, plus Kpi·Ie with a
-    /// position integrator, clamped to the speed limit.
-    fn position_loop(&mut self, error: f64) -> f64 {
+    /// position integrator, plus the velocity feed-forward `ff`, clamped to the speed
+    /// limit.
+    fn position_loop(&mut self, error: f64, ff: f64) -> f64 {
         let g = &self.gains;
         if g.kpi == 0.0 {
-            return (g.kpp * error).clamp(-g.speed_limit, g.speed_limit);
+            let command = g.kpp * error;
+            let command = if ff != 0.0 { command + ff } else { command };
+            return command.clamp(-g.speed_limit, g.speed_limit);
         }
         let integral = self.position_integral + g.tc * error;
         let unlimited = g.kpp * error + g.kpi * integral;
+        let unlimited = if ff != 0.0 { unlimited + ff } else { unlimited };
         let command = unlimited.clamp(-g.speed_limit, g.speed_limit);
         if command == unlimited || unlimited.signum() != error.signum() {
             self.position_integral = integral;
@@ -243,11 +316,18 @@ impl Controller {
         command
     }
 
-    /// The saturated output for the velocity error, the added signal included.
-    fn velocity_loop(&mut self, speed_error: f64) -> f64 {
+    /// The saturated output for the velocity error: the PI law plus the torque
+    /// feed-forward `ff`, through the setpoint filters, plus the added signal.
+    fn velocity_loop(&mut self, speed_error: f64, ff: f64) -> f64 {
         let g = &self.gains;
         let integral = self.integral + g.tc * speed_error;
         let law = g.kvp * speed_error + g.kvi * integral;
+        let law = if ff != 0.0 { law + ff } else { law };
+        let law = if self.filters.is_empty() {
+            law
+        } else {
+            self.filters.filter(law)
+        };
         let unlimited = if self.added != 0.0 {
             law + self.added
         } else {

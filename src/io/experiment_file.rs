@@ -20,7 +20,7 @@ mod tests;
 mod units;
 mod writer;
 
-pub use conditions::{Conditions, Excitation};
+pub use conditions::{Conditions, DriveFunctions, Excitation};
 pub use data::{Approaches, Data, ServoTrace, Signal, TimeRecord};
 pub use friction_map::FrictionMap;
 pub use kind::{Definition as KindDefinition, Kind, KINDS};

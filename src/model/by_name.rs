@@ -63,6 +63,7 @@ impl Params {
             });
         }
         self.check_stribeck()?;
+        super::setpoint_filter::check_all(&self.controller.filters, self.controller.tc)?;
         if self.unbalance_mass > 0.0 && self.unbalance_radius == 0.0 {
             return Err(ParamError::Inconsistent {
                 name: "unbalance_radius",

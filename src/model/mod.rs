@@ -15,9 +15,11 @@ pub mod params_json;
 pub mod presets;
 pub mod registry;
 pub mod rest;
+pub mod setpoint_filter;
 
 pub use by_name::MAGNITUDE_RANGE;
 pub use drive::{idx, Drive, NSTATE};
 pub use kernel::{Kernel, States};
 pub use params::{Axis, ControllerParams, LoopMode, ParamError, Params, Topology};
 pub use registry::{spec, Applies, Constraint, ParamSpec, PARAMS};
+pub use setpoint_filter::{FilterError, SetpointFilter, MAX_FILTERS};

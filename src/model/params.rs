@@ -181,6 +181,23 @@ pub struct ControllerParams {
     /// Semi-closed or full-closed loop.
     #[serde(rename = "loop", default)]
     pub loop_mode: LoopMode,
+    /// Velocity feed-forward: the fraction of the reference's velocity added to the
+    /// velocity command (0: off; 1: all of it).
+    #[serde(rename = "Kvff", default, skip_serializing_if = "is_zero")]
+    pub kvff: f64,
+    /// Torque (acceleration) feed-forward: output per rad/s² (m/s²) of the reference's
+    /// motor acceleration, added to the torque setpoint (0: off; the inertia at the
+    /// motor over the drive gain: all of it).
+    #[serde(rename = "Kaff", default, skip_serializing_if = "is_zero")]
+    pub kaff: f64,
+    /// The symmetrising filter's time constant, s: the position loop's reference
+    /// passes a first-order lag of this time constant, so that it meets the motion the
+    /// feed-forward makes (0: none).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub symmetrising_s: f64,
+    /// Filters on the torque (current) setpoint, in series (none by default).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub filters: Vec<SetpointFilter>,
 }
 
 impl ControllerParams {
@@ -196,6 +213,8 @@ impl ControllerParams {
         }
     }
 }
+
+use super::setpoint_filter::SetpointFilter;
 
 fn one() -> f64 {
     1.0
@@ -373,6 +392,8 @@ pub enum ParamError {
     NotForAxis { name: &'static str, axis: Axis },
     #[error("a linear axis needs the direct_drive or two_mass topology, not {topology}")]
     LinearTopology { topology: Topology },
+    #[error(transparent)]
+    Filter(#[from] super::setpoint_filter::FilterError),
     #[error("parameter {name} = {}: {reason}", Num(*value))]
     Inconsistent {
         name: &'static str,

@@ -215,6 +215,9 @@ pub const PARAMS: &[ParamSpec] = &[
     spec!("motor_encoder_counts", ["1/rev"], "motor encoder counts per revolution (0: ideal or given by resolution)", NonNegative, Always, true, 0.0, controller.motor_encoder_counts),
     spec!("motor_encoder_resolution", ["rad", "m"], "motor (loop) encoder resolution (0: ideal or given by counts)", NonNegative, Always, false, 0.0, controller.motor_encoder_resolution),
     spec!("table_encoder_resolution", ["rad", "m"], "table encoder resolution (0: ideal)", NonNegative, Always, false, 0.0, controller.table_encoder_resolution),
+    spec!("Kvff", ["-"], "velocity feed-forward: fraction of the reference's velocity added to the velocity command (0: off)", NonNegative, Always, false, 0.0, controller.kvff),
+    spec!("Kaff", ["N·m·s²/rad", "N·s²/m"], "torque feed-forward: output per unit of the reference's motor acceleration (0: off; inertia at the motor over the drive gain: all of it)", NonNegative, Always, false, 0.0, controller.kaff),
+    spec!("symmetrising_s", ["s"], "time constant of the symmetrising lag on the position loop's reference (0: none)", NonNegative, Always, false, 0.0, controller.symmetrising_s),
 ];
 
 /// Looks a parameter up by name (exact, case-sensitive: `Kw` and `kw` differ in spirit).

@@ -48,13 +48,13 @@ fn determines(p: &Params) -> Vec<&'static str> {
 }
 
 fn build(source: &Source<'_>, _: Fidelity) -> Result<Box<dyn Objective>, SetupError> {
-    let Data::ServoTrace(file) = &source.experiment.data else {
+    let Some(trace) = ServoTrace::from_experiment(source.experiment) else {
         return Err(SetupError::Unsupported {
             file: source.file.into(),
             kind: source.kind().name(),
         });
     };
-    Ok(Box::new(TraceResidual::new(ServoTrace::from_file(file))))
+    Ok(Box::new(TraceResidual::new(trace)))
 }
 
 /// The IDIM-LS estimate of a direct-drive axis's rigid core (M, Fv, Fc, OF → Jt, Ct,

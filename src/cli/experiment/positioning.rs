@@ -118,6 +118,7 @@ fn test(a: &Args, axis: Axis) -> anyhow::Result<positioning::PositioningTest> {
             Axis::Rotary => 5f64.to_radians(),
             Axis::Linear => 5e-3,
         },
+        compensation: Default::default(),
     })
 }
 

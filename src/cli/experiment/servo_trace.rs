@@ -220,11 +220,11 @@ pub fn report(
     model: Option<Params>,
     idim: &IdimArgs,
 ) -> anyhow::Result<()> {
-    let Data::ServoTrace(file) = &exp.data else {
+    let (Data::ServoTrace(file), Some(trace)) = (&exp.data, ServoTrace::from_experiment(exp))
+    else {
         bail!("{}: not a servo trace", exp.path.display());
     };
     let source = exp.path.display().to_string();
-    let trace = ServoTrace::from_file(file);
     let sample_period_s = trace.check().with_context(|| source.clone())?;
     let ratio = frame_ratio(exp, model.as_ref())?;
     let settings = idim.settings(sample_period_s)?;

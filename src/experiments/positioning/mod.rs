@@ -13,7 +13,7 @@ pub mod iso230;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
-use crate::controller::quantise;
+use crate::controller::{quantise, Compensation};
 use crate::input::Move;
 use crate::io::experiment_file::{Approaches, Data, Kind, Manifest};
 use crate::model::idx::THETA_T;
@@ -42,6 +42,8 @@ pub struct PositioningTest {
     pub seed: u64,
     /// Feedback arrangement (default semi-closed, as in the paper).
     pub loop_mode: LoopMode,
+    /// The controller's compensations (default none).
+    pub compensation: Compensation,
 }
 
 impl Default for PositioningTest {
@@ -55,6 +57,7 @@ impl Default for PositioningTest {
             noise: 0.0,
             seed: 0,
             loop_mode: LoopMode::SemiClosed,
+            compensation: Compensation::default(),
         }
     }
 }
@@ -113,6 +116,7 @@ pub fn run(
     let start = stops[0].0;
     sim.set_state(rest_state(&p, start, Preload::None));
     let mut controller = sim.controller(&p)?;
+    controller.set_compensation(test.compensation.clone());
     // Invariant: Normal refuses only a non-finite σ; `noise` is finite (its field's
     // contract; the command line checks it).
     let noise = Normal::new(0.0, test.noise.max(0.0)).expect("a finite σ");

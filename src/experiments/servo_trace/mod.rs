@@ -56,6 +56,9 @@ pub struct ServoTrace {
     pub controller_output: Option<Vec<f64>>,
     /// The signal added to the controller output, same unit, if any.
     pub controller_added: Option<Vec<f64>>,
+    /// The drive's controller functions as recorded (feed-forward, filters), which a
+    /// replay sets on the model's controller; `None`: the model's own.
+    pub drive_functions: Option<file::DriveFunctions>,
 }
 
 /// A trace that cannot be replayed or evaluated, or a replay that failed.
@@ -78,6 +81,8 @@ pub enum TraceError {
     },
     #[error("trace time_s, row {row}: {0}", row = .0.row)]
     NotUniform(NonUniform),
+    #[error("the trace's `conditions.controller`: {0}")]
+    DriveFunctions(crate::model::ParamError),
     #[error("trapezoidal moves: {name} = {value} {reason}")]
     Moves {
         name: &'static str,
@@ -167,7 +172,20 @@ impl ServoTrace {
             force: trace.effort.clone(),
             controller_output: trace.controller_output.as_ref().map(|s| s.values.clone()),
             controller_added: trace.controller_added.as_ref().map(|s| s.values.clone()),
+            drive_functions: None,
         }
+    }
+
+    /// The trace of the `servo_trace` experiment `exp`, with the controller functions
+    /// its manifest states (`conditions.controller`); `None` for another kind.
+    pub fn from_experiment(exp: &file::Experiment) -> Option<ServoTrace> {
+        let file::Data::ServoTrace(data) = &exp.data else {
+            return None;
+        };
+        Some(ServoTrace {
+            drive_functions: exp.manifest.conditions.controller.clone(),
+            ..ServoTrace::from_file(data)
+        })
     }
 
     /// The trace as a `servo_trace` experiment file's data on `axis`, the controller

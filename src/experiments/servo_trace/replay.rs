@@ -53,12 +53,17 @@ pub struct Misfit {
 /// of the first two samples, (position[1] − position[0])/period — exact for a trace
 /// at rest over its first period, as rtid's virtual traces are; a record that starts
 /// in motion (EMPS) starts with that estimate, whose error fades within a few periods
-/// of the velocity loop.
+/// of the velocity loop. The trace's recorded drive functions (feed-forward,
+/// filters), if any, replace the model's controller's.
 pub fn replay(params: &Params, trace: &ServoTrace) -> Result<Replay, TraceError> {
     let period = trace.check()?;
     let mut p = params.clone();
     if (period / p.controller.tc - 1.0).abs() > SAME_PERIOD {
         p.controller.tc = period;
+    }
+    if let Some(functions) = &trace.drive_functions {
+        functions.apply(&mut p.controller);
+        p.validate().map_err(TraceError::DriveFunctions)?;
     }
     let velocity = (trace.position[1] - trace.position[0]) / period;
     let start = Start {

@@ -168,6 +168,7 @@ pub fn virtual_trace(
         force: run.force,
         controller_output: Some(run.controller_output),
         controller_added: added,
+        drive_functions: None,
     })
 }
 

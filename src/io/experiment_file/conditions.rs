@@ -6,7 +6,8 @@ use serde_json::{Map, Value};
 
 use super::response::{Delay, Reference, Response};
 use super::{sample_period, Kind};
-use crate::model::params::LoopMode;
+use crate::model::params::{ControllerParams, LoopMode};
+use crate::model::setpoint_filter::SetpointFilter;
 
 /// How a frequency-response record was excited.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -30,6 +31,43 @@ impl Excitation {
             Excitation::SteppedSine => "stepped_sine",
             Excitation::Broadband => "broadband",
             Excitation::Multisine => "multisine",
+        }
+    }
+}
+
+/// A servo trace's controller functions as the drive had them, each replacing the
+/// model's where given (docs/experiment-files.md, servo trace).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveFunctions {
+    /// Velocity feed-forward, the fraction of the reference's speed.
+    #[serde(rename = "Kvff", default, skip_serializing_if = "Option::is_none")]
+    pub kvff: Option<f64>,
+    /// Torque feed-forward, output per motor rad/s² (m/s²).
+    #[serde(rename = "Kaff", default, skip_serializing_if = "Option::is_none")]
+    pub kaff: Option<f64>,
+    /// The symmetrising lag's time constant, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub symmetrising_s: Option<f64>,
+    /// The torque-setpoint filters, in series.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filters: Option<Vec<SetpointFilter>>,
+}
+
+impl DriveFunctions {
+    /// `controller` with these functions in place of its own.
+    pub fn apply(&self, controller: &mut ControllerParams) {
+        if let Some(v) = self.kvff {
+            controller.kvff = v;
+        }
+        if let Some(v) = self.kaff {
+            controller.kaff = v;
+        }
+        if let Some(v) = self.symmetrising_s {
+            controller.symmetrising_s = v;
+        }
+        if let Some(f) = &self.filters {
+            controller.filters = f.clone();
         }
     }
 }
@@ -111,6 +149,11 @@ pub struct Conditions {
     /// record's (a trace decimated for storage). Absent: the record's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub loop_period_s: Option<f64>,
+    /// Servo trace: the drive's functions as they were set when it was recorded
+    /// (feed-forward, symmetrising lag, setpoint filters); a replay runs the model's
+    /// controller with them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controller: Option<DriveFunctions>,
     /// Frequency response or resonances: the band in which resonances are sought,
     /// [lowest, highest] Hz (identification: the measured peaks, the gain curve and the
     /// model's peaks; `rtid identify --band` sets it). Absent: the whole curve.
