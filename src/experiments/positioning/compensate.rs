@@ -108,8 +108,8 @@ pub enum CompensateWarning {
     /// (warm-up, load), and neither table nor backlash would help.
     NoImprovement { e_before: f64, e_after: f64 },
     /// On the other runs the table lowers E no further than the backlash alone does
-    /// (rad): the position-dependent error drifts between runs; the table would not
-    /// help (the backlash may).
+    /// (rad): the position-dependent error drifts between runs, or scatters more
+    /// than it varies; the table would not help (the backlash may).
     TableDoesNotHelp { e_backlash_only: f64, e_after: f64 },
     /// Every run was used to build the compensation (or fewer than two are left): the
     /// values after compensation are those of the runs it was fitted to, not a check.
@@ -133,8 +133,9 @@ impl CompensateWarning {
                 e_after,
             } => format!(
                 "the error table does not help on the runs it was not built from: E {} with \
-                 the backlash alone, {} with the table too; the position-dependent error \
-                 drifts between runs (warm-up?): do not load the table",
+                 the backlash alone, {} with the table too; the position-dependent error of \
+                 the build runs does not repeat (drift between runs, warm-up, or scatter \
+                 larger than the table): load the backlash alone",
                 v(e_backlash_only),
                 v(e_after)
             ),
@@ -542,7 +543,7 @@ mod tests {
             c.warnings
         );
         let text = c.warnings[0].message(ARCSEC_PER_RAD, "″");
-        assert!(text.contains("drifts") && text.contains("table"), "{text}");
+        assert!(text.contains("drift") && text.contains("table"), "{text}");
         let reversed = record(&targets, 5, |t, d, run| {
             (3.0 - run as f64) * (profile(t) + half(d))
         });
