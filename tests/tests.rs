@@ -18,6 +18,7 @@ mod support;
 mod axes;
 mod cli;
 mod compare;
+mod compensate;
 mod controller;
 mod conventions;
 mod corpus;

@@ -6,6 +6,7 @@ use anyhow::bail;
 
 use crate::cli::common::model_args::ModelArgs;
 use crate::cli::common::plot::Plot;
+use crate::cli::compensate;
 use crate::cli::experiment::{
     fluctuation, frequency_response, frequency_response_time, friction_map, positioning,
     servo_trace, torque_curve,
@@ -25,7 +26,10 @@ file carries one.
   positioning   ISO 230-2 statistics in arc-seconds: per target x̄↑, x̄↓, s↑, s↓, Bi, R↑i, \
 R↓i, Ri; for the axis the reversal B and mean reversal B̄, repeatability R↑, R↓, R, \
 systematic deviation E↑, E↓, E, mean deviation M, accuracy A↑, A↓, A. Plot: the paper's \
-Fig. 10.
+Fig. 10. With --runs, those runs only; with --compensation FILE (from `rtid compensate`), \
+the axis values as the axis with that backlash and table would show them (each reading \
+shifted by the offset the controller would add at its target and direction), beside the \
+uncompensated ones.
   torque_curve  RMS and peak motor torque, N·m (force, N, on a linear axis), and the Coulomb friction at the motor: with the table angle (position) in the file, from the friction law F = M·a + Fv·v + Fc·sign(v) + OF fitted over the whole curve (IDIM-LS: any trajectory); without it, half the torque jump across each reversal of the commanded sine, averaged (the reversals and their jumps are listed either way). Plot: torque over time (the paper's Fig. 9), and over table angle in FILE-vs-angle.svg when the file has the angle.
   fluctuation   deviation θt − θm·ratio over table angle per direction (ratio: the \
 manifest's conditions.ratio, else Rg·Rw of the preset named in `mechanism`): mean, \
@@ -55,6 +59,7 @@ friction. Plots: FILE.svg (Fig. 14) and FILE-spectrum.svg.
 
 Example:
   rtid evaluate runs/worm/positioning.json --json
+  rtid evaluate runs/worm/positioning.json --runs 4-5 --compensation runs/worm/compensation.json
   rtid evaluate runs/worm/torque_curve.json
   rtid evaluate runs/worm/fluctuation.json
   rtid evaluate fixtures/real/emps/emps_estimation.json --params fixtures/real/emps/axis.json";
@@ -81,6 +86,13 @@ pub struct Args {
     pub estimate: frequency_response_time::EstimateArgs,
     #[command(flatten)]
     pub idim: servo_trace::IdimArgs,
+    /// Positioning only: the values as the axis compensated by this file (written by
+    /// `rtid compensate`) would show them, beside the uncompensated ones.
+    #[arg(long, value_name = "compensation.json")]
+    pub compensation: Option<PathBuf>,
+    /// Positioning only: evaluate these runs (`4-5`, `2`) [default: all].
+    #[arg(long, value_name = "FIRST-LAST")]
+    pub runs: Option<rtid::experiments::positioning::compensate::Runs>,
     /// The model a servo trace is replayed on (servo traces only; optional).
     #[command(flatten)]
     pub model: ModelArgs,
@@ -91,6 +103,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut inputs: Vec<&std::path::Path> = vec![&a.file];
     inputs.extend(exp.data_path.as_deref());
     inputs.extend(a.model.params.as_deref());
+    inputs.extend(a.compensation.as_deref());
     let plot = match &a.plot {
         Some(path) => Plot::at(path.clone(), &inputs)?,
         None => Plot::none(),
@@ -108,8 +121,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 
 /// The evaluation of `exp`, printed, with its plots where `plot` says.
 fn report(a: &Args, exp: &experiment_file::Experiment, plot: &Plot) -> anyhow::Result<()> {
+    if exp.manifest.kind != Kind::Positioning && (a.compensation.is_some() || a.runs.is_some()) {
+        bail!(
+            "--compensation and --runs are for positioning records; this is a `{}` experiment",
+            exp.manifest.kind.name()
+        );
+    }
     match exp.manifest.kind {
-        Kind::Positioning => positioning::report(exp, plot, a.json),
+        Kind::Positioning => match &a.compensation {
+            Some(c) => compensate::evaluate(exp, c, a.runs.as_ref(), plot, a.json),
+            None => positioning::report_runs(exp, plot, a.json, a.runs.as_ref()),
+        },
         Kind::FrequencyResponse => frequency_response::report(exp, plot, a.json),
         Kind::TorqueCurve => torque_curve::report(exp, plot, a.json),
         Kind::Fluctuation | Kind::Unbalance => fluctuation::report(exp, plot, a.json),

@@ -3,6 +3,7 @@
 
 pub mod common;
 mod compare;
+mod compensate;
 mod evaluate;
 mod experiment;
 mod identify;
@@ -38,6 +39,7 @@ Examples:
   rtid params --preset worm-gear --set Kw=3.5e5 --out my-table.json
   rtid experiment positioning --preset worm-gear --out runs/worm
   rtid evaluate runs/worm/positioning.json
+  rtid compensate runs/worm/positioning.json --runs 1-3 -o compensation.json
   rtid compare runs/worm runs/roller
   rtid select fit-kw-kg.json fit-kw-kg-kb.json
   rtid report fit.json runs/worm/positioning.json --tolerance-arcsec 20 --out report.html
@@ -79,6 +81,9 @@ pub enum Command {
     /// Evaluate a measured or virtual experiment file (statistics, plot).
     #[command(long_about = evaluate::LONG_ABOUT)]
     Evaluate(evaluate::Args),
+    /// Backlash and error-table compensation from a positioning record (JSON, SINUMERIK, CSV).
+    #[command(long_about = compensate::LONG_ABOUT)]
+    Compensate(compensate::Args),
     /// The paper's Table 3: two folders of experiment files side by side.
     #[command(long_about = compare::LONG_ABOUT)]
     Compare(compare::Args),
@@ -112,6 +117,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Identify(a) => identify::run(a),
         Command::Import(a) => import::run(a),
         Command::Evaluate(a) => evaluate::run(a),
+        Command::Compensate(a) => compensate::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Select(a) => identify::select::run(a),

@@ -2,6 +2,7 @@
 //! [`formats`]: the formats labs export.
 
 pub mod atomic;
+pub mod compensation_file;
 pub mod experiment_file;
 pub mod formats;
 pub mod import;

@@ -9,6 +9,7 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use super::{check, Common};
 use crate::cli::common::progress;
+use rtid::experiments::positioning::compensate::{self, Runs};
 use rtid::experiments::positioning::iso230::ReportUnits;
 use rtid::experiments::positioning::{self, iso230};
 use rtid::io::experiment_file::Experiment;
@@ -199,9 +200,26 @@ fn run_positioning(a: &Args, p: &Params, test: positioning::PositioningTest) -> 
 /// JSON) in the axis's units (arc-seconds, or µm on a linear axis), and the Fig. 10
 /// plot written to `plot`.
 pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
+    report_runs(exp, plot, json, None)
+}
+
+/// [`report`] of runs `runs` only (all for `None`).
+pub fn report_runs(
+    exp: &Experiment,
+    plot: &Plot,
+    json: bool,
+    runs: Option<&Runs>,
+) -> anyhow::Result<()> {
     let Some(readings) = positioning::from_data(&exp.data) else {
         bail!("{}: not a positioning experiment", exp.path.display());
     };
+    let readings = compensate::select(&readings, runs);
+    if readings.is_empty() {
+        bail!(
+            "{}: no measurement of the runs asked for",
+            exp.path.display()
+        );
+    }
     let units = ReportUnits::of(exp.data.axis().unwrap_or_default());
     let report =
         iso230::evaluate(&readings).map_err(|e| anyhow::anyhow!("{}: {e}", exp.path.display()))?;
@@ -291,7 +309,7 @@ fn table(report: &iso230::Iso230Report, u: ReportUnits) -> String {
 }
 
 /// The axis values, already in the unit `d`.
-fn axis_table(x: &iso230::AxisStats, d: &str) -> Table {
+pub fn axis_table(x: &iso230::AxisStats, d: &str) -> Table {
     let mut axis = Table::new();
     axis.load_preset(UTF8_FULL_CONDENSED);
     axis.set_header([

@@ -8,6 +8,7 @@
 //! the start. Moves are ramps at `speed`; the reading is the table encoder's
 //! (quantised to its resolution) plus optional Gaussian measurement noise.
 
+pub mod compensate;
 pub mod iso230;
 
 use rand::SeedableRng;

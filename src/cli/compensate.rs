@@ -1,0 +1,384 @@
+//! `rtid compensate`: the backlash and error table of an axis from its ISO 230-2
+//! positioning record, checked on the runs it was not built from, written as
+//! compensation.json, a SINUMERIK program and a CSV.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+
+use crate::cli::common::inputs::refuse_overwrite;
+use rtid::experiments::positioning::compensate::{self, BeforeAfter, Computed, Runs};
+use rtid::experiments::positioning::iso230::{AxisStats, ReportUnits};
+use rtid::experiments::positioning::{self};
+use rtid::io::compensation_file::{self, sinumerik, table_csv, CompensationFile, Source};
+use rtid::io::experiment_file::{self, Experiment};
+use rtid::model::Axis;
+
+pub const LONG_ABOUT: &str = "\
+The compensation of an axis from its ISO 230-2 positioning record (docs/compensation.md): \
+an error table of −x̄↑ at each target (the mean deviation approaching upwards, with its sign \
+turned) and a backlash of the mean reversal value B̄ = mean(x̄↑ − x̄↓), each added to the \
+commanded position (the backlash while moving down), which cancel the record's mean \
+deviations in both directions up to the target-to-target scatter of the reversal. On a \
+rotary axis whose targets lie within one turn the table is modulo 360°.
+
+With --runs the compensation is built from those runs and checked on the others: the \
+ISO 230-2 values before and after are printed for both, and a warning says so when it \
+does not lower the systematic deviation E of the runs it was not built from (an axis that \
+drifts between runs, warming up): a table that only fits the runs it came from is no \
+compensation. Without --runs every run builds it, and nothing checks it.
+
+Outputs, each only when asked and never over an input, written atomically:
+  -o compensation.json   positions and values in degrees (mm on a linear axis)
+  --sinumerik FILE --axis-number N   a SINUMERIK EEC program ($AA_ENC_COMP…, values the \
+axis's error: the opposite sign), resampled onto equidistant points, modulo 360° on a \
+rotary table; the backlash for MD32450 in a comment
+  --csv FILE             position_deg,value_arcsec (position_mm,value_um)
+
+Examples:
+  rtid experiment positioning --preset worm-gear --noise-arcsec 0.3 --seed 1 --out runs/worm
+  rtid compensate runs/worm/positioning.json --runs 1-3 -o runs/worm/compensation.json
+  rtid evaluate runs/worm/positioning.json --runs 4-5 --compensation runs/worm/compensation.json
+  rtid compensate runs/worm/positioning.json --sinumerik AX4_EEC.SPF --axis-number 4 --csv table.csv";
+
+/// Arguments of `rtid compensate`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The positioning record (experiment manifest).
+    #[arg(value_name = "POSITIONING.json")]
+    pub file: PathBuf,
+    /// Build from these runs (`1-3`, `2`); the others check it [default: all].
+    #[arg(long, value_name = "FIRST-LAST")]
+    pub runs: Option<Runs>,
+    /// Write the compensation file.
+    #[arg(short = 'o', long = "out", value_name = "compensation.json")]
+    pub out: Option<PathBuf>,
+    /// Write a SINUMERIK encoder/leadscrew error compensation program (needs --axis-number).
+    #[arg(long, value_name = "FILE", requires = "axis_number")]
+    pub sinumerik: Option<PathBuf>,
+    /// The machine axis of the SINUMERIK program: AX<N>.
+    #[arg(long, value_name = "N")]
+    pub axis_number: Option<u32>,
+    /// Write the table as CSV.
+    #[arg(long, value_name = "FILE.csv")]
+    pub csv: Option<PathBuf>,
+    /// Print JSON instead of tables.
+    #[arg(long)]
+    pub json: bool,
+    /// No notes on stderr.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let exp = experiment_file::read(&a.file)?;
+    let outputs = outputs(&a, &exp)?;
+    let (measurements, axis) = record(&exp)?;
+    let computed = compensate::compute(&measurements, axis, a.runs.as_ref())
+        .with_context(|| a.file.display().to_string())?;
+    write_outputs(&a, &computed, &outputs)?;
+    if a.json {
+        print_json(&a, &computed)
+    } else {
+        print_tables(&a, &computed);
+        Ok(())
+    }
+}
+
+/// The outputs asked for, each refused over an input or over another output.
+fn outputs(a: &Args, exp: &Experiment) -> anyhow::Result<Vec<(&'static str, PathBuf)>> {
+    let mut inputs: Vec<&Path> = vec![&a.file];
+    inputs.extend(exp.data_path.as_deref());
+    let asked = [
+        ("-o", a.out.as_ref()),
+        ("--sinumerik", a.sinumerik.as_ref()),
+        ("--csv", a.csv.as_ref()),
+    ];
+    let mut outs: Vec<(&'static str, PathBuf)> = Vec::new();
+    for (option, path) in asked {
+        let Some(path) = path else { continue };
+        refuse_overwrite(option, path, &inputs)?;
+        let before: Vec<&Path> = outs.iter().map(|o| o.1.as_path()).collect();
+        refuse_overwrite(option, path, &before)?;
+        outs.push((option, path.clone()));
+    }
+    Ok(outs)
+}
+
+/// The measurements (SI) and the axis of a positioning record.
+pub fn record(exp: &Experiment) -> anyhow::Result<(Vec<positioning::iso230::Measurement>, Axis)> {
+    let Some(m) = positioning::from_data(&exp.data) else {
+        bail!(
+            "{}: a `{}` experiment, not a positioning record",
+            exp.path.display(),
+            exp.manifest.kind.name()
+        );
+    };
+    Ok((m, exp.data.axis().unwrap_or_default()))
+}
+
+fn write_outputs(
+    a: &Args,
+    c: &Computed,
+    outputs: &[(&'static str, PathBuf)],
+) -> anyhow::Result<()> {
+    for (option, path) in outputs {
+        match *option {
+            "-o" => compensation_file::write(path, &file_of(a, c))?,
+            "--sinumerik" => {
+                let text = sinumerik_program(a, c)?;
+                sinumerik::write(path, &text)?;
+            }
+            _ => {
+                let table = table_of(c)?;
+                let text = table_csv::text(table, c.axis, c.compensation.backlash);
+                table_csv::write(path, &text).with_context(|| path.display().to_string())?;
+            }
+        }
+        if !a.quiet && !a.json {
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+fn table_of(c: &Computed) -> anyhow::Result<&rtid::controller::ErrorTable> {
+    c.compensation
+        .table
+        .as_ref()
+        .context("the compensation has no table")
+}
+
+fn sinumerik_program(a: &Args, c: &Computed) -> anyhow::Result<String> {
+    let Some(n) = a.axis_number else {
+        bail!("--sinumerik needs --axis-number N (the machine axis AX<N>)");
+    };
+    let grid = sinumerik::Grid::of(table_of(c)?)?;
+    let note = format!(
+        "rtid {} compensate {}{}",
+        rtid::VERSION,
+        a.file.display(),
+        a.runs
+            .as_ref()
+            .map_or(String::new(), |r| format!(" --runs {r}"))
+    );
+    Ok(sinumerik::program(
+        &grid,
+        c.axis,
+        n,
+        c.compensation.backlash,
+        &note,
+    ))
+}
+
+fn file_of(a: &Args, c: &Computed) -> CompensationFile {
+    CompensationFile {
+        axis: c.axis,
+        compensation: c.compensation.clone(),
+        source: vec![Source {
+            file: a.file.display().to_string(),
+            runs: a.runs.as_ref().map(Runs::to_string),
+        }],
+    }
+}
+
+fn print_json(a: &Args, c: &Computed) -> anyhow::Result<()> {
+    let u = ReportUnits::of(c.axis);
+    let k = u.deviation_per_si;
+    let scaled = |b: &BeforeAfter| {
+        serde_json::json!({
+            "before": b.before.scaled(k),
+            "backlash_only": b.backlash_only.scaled(k),
+            "after": b.after.scaled(k),
+        })
+    };
+    let targets: Vec<_> = c
+        .targets
+        .iter()
+        .map(|t| {
+            serde_json::json!({
+                format!("target_{}", u.target_key): t.target * u.target_per_si,
+                "mean_up": t.mean_up * k, "mean_down": t.mean_down * k,
+                "reversal": t.reversal * k, "table": t.table * k,
+            })
+        })
+        .collect();
+    let warnings: Vec<_> = c
+        .warnings
+        .iter()
+        .map(|w| {
+            let mut v = rtid::io::json::value(w)?;
+            v["message"] = w.message(k, u.deviation).into();
+            Ok(v)
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let value = serde_json::json!({
+        "kind": "compensation",
+        "source": a.file,
+        "unit": u.deviation_key,
+        "build_runs": c.build_runs,
+        "check_runs": c.check_runs,
+        "backlash": c.compensation.backlash.unwrap_or(0.0) * k,
+        "targets": targets,
+        "build": scaled(&c.build),
+        "check": c.check.as_ref().map(scaled),
+        "warnings": warnings,
+    });
+    println!("{}", rtid::io::json::pretty(&value)?);
+    Ok(())
+}
+
+fn print_tables(a: &Args, c: &Computed) {
+    let u = ReportUnits::of(c.axis);
+    let (k, d) = (u.deviation_per_si, u.deviation);
+    println!(
+        "{}: compensation from runs {} ({}), each value added to the commanded position",
+        a.file.display(),
+        runs_text(&c.build_runs),
+        u.deviation_name
+    );
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header([
+        format!("target {}", u.target),
+        format!("x̄↑ {d}"),
+        format!("x̄↓ {d}"),
+        format!("table {d}"),
+        format!("reversal Bi {d}"),
+    ]);
+    for r in &c.targets {
+        t.add_row([
+            format!("{:.2}", r.target * u.target_per_si),
+            format!("{:.2}", r.mean_up * k),
+            format!("{:.2}", r.mean_down * k),
+            format!("{:.2}", r.table * k),
+            format!("{:.2}", r.reversal * k),
+        ]);
+    }
+    println!("{t}");
+    let b = c.compensation.backlash.unwrap_or(0.0) * k;
+    println!("backlash (added while moving down) = B̄ = {b:.2}{d}");
+    println!(
+        "{}",
+        before_after_table(
+            &c.build,
+            &format!("runs {} (built from)", runs_text(&c.build_runs)),
+            k,
+            d
+        )
+    );
+    if let Some(check) = &c.check {
+        let title = format!("runs {} (check)", runs_text(&c.check_runs));
+        println!("{}", before_after_table(check, &title, k, d));
+    }
+    for w in &c.warnings {
+        println!("warning: {}", w.message(k, d));
+    }
+}
+
+/// Runs as text: `1-3` when consecutive, else listed.
+fn runs_text(runs: &[u32]) -> String {
+    match (runs.first(), runs.last()) {
+        (Some(&a), Some(&b)) if (b - a) as usize + 1 == runs.len() && a != b => format!("{a}-{b}"),
+        _ => runs
+            .iter()
+            .map(u32::to_string)
+            .collect::<Vec<_>>()
+            .join(", "),
+    }
+}
+
+/// One of the axis values.
+type AxisValue = fn(&AxisStats) -> f64;
+
+/// The ISO 230-2 axis values of some runs before, with the backlash alone, and after.
+fn before_after_table(b: &BeforeAfter, title: &str, k: f64, d: &str) -> Table {
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    t.set_header([
+        format!("{title}, {d}"),
+        "uncompensated".into(),
+        "backlash only".into(),
+        "compensated".into(),
+    ]);
+    let rows: [(&str, AxisValue); 5] = [
+        ("mean reversal B̄", |x| x.b_mean),
+        ("reversal B", |x| x.b),
+        ("systematic deviation E", |x| x.e),
+        ("repeatability R", |x| x.r),
+        ("accuracy A", |x| x.a),
+    ];
+    for (name, f) in rows {
+        t.add_row([
+            name.to_string(),
+            format!("{:.2}", f(&b.before) * k),
+            format!("{:.2}", f(&b.backlash_only) * k),
+            format!("{:.2}", f(&b.after) * k),
+        ]);
+    }
+    t
+}
+
+/// `rtid evaluate POSITIONING.json --compensation FILE`: the ISO 230-2 values of runs
+/// `runs` (all for `None`) without and with the compensation of `file`.
+pub fn evaluate(
+    exp: &Experiment,
+    file: &Path,
+    runs: Option<&Runs>,
+    plot: &crate::cli::common::plot::Plot,
+    json: bool,
+) -> anyhow::Result<()> {
+    let (all, axis) = record(exp)?;
+    let comp = compensation_file::read(file)?;
+    comp.check_axis(file, axis)?;
+    let measurements = compensate::select(&all, runs);
+    if measurements.is_empty() {
+        bail!(
+            "{}: no measurement of runs {} (its runs: {})",
+            exp.path.display(),
+            runs.map_or(String::new(), Runs::to_string),
+            runs_text(&compensate::run_numbers(&all))
+        );
+    }
+    let b = compensate::before_after(&measurements, &comp.compensation)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", exp.path.display()))?;
+    let u = ReportUnits::of(axis);
+    let corrected = compensate::apply(&measurements, &comp.compensation);
+    let report = positioning::iso230::evaluate(&corrected)?;
+    let title = format!(
+        "{}: ISO 230-2 positioning, compensated",
+        exp.manifest.mechanism.as_deref().unwrap_or("table")
+    );
+    plot.write(
+        &rtid::report::positioning::deviations(&report, &title, u),
+        "",
+    )?;
+    let runs_used = runs_text(&compensate::run_numbers(&measurements));
+    let k = u.deviation_per_si;
+    if json {
+        let value = serde_json::json!({
+            "kind": "positioning",
+            "source": exp.path,
+            "compensation": file,
+            "runs": compensate::run_numbers(&measurements),
+            "unit": u.deviation_key,
+            "uncompensated": b.before.scaled(k),
+            "backlash_only": b.backlash_only.scaled(k),
+            "compensated": b.after.scaled(k),
+        });
+        println!("{}", rtid::io::json::pretty(&value)?);
+        return Ok(());
+    }
+    println!(
+        "{}: ISO 230-2 evaluation of runs {runs_used}, {}, as the axis compensated by {} would show them",
+        exp.path.display(),
+        u.deviation_name,
+        file.display()
+    );
+    println!(
+        "{}",
+        before_after_table(&b, &format!("runs {runs_used}"), k, u.deviation)
+    );
+    Ok(())
+}
