@@ -12,6 +12,7 @@ use crate::cli::common::progress;
 use rtid::experiments::positioning::compensate::{self, Runs};
 use rtid::experiments::positioning::iso230::ReportUnits;
 use rtid::experiments::positioning::{self, iso230};
+use rtid::io::compensation_file;
 use rtid::io::experiment_file::Experiment;
 use rtid::model::{Axis, LoopMode, Params};
 
@@ -30,7 +31,13 @@ targets every 50 mm over 500 mm at 3000 mm/min (--target-step-mm, --travel-mm, \
 Examples:
   rtid experiment positioning --preset worm-gear --out runs/worm
   rtid experiment positioning --preset worm-gear --noise-arcsec 0.5 --seed 7 --out runs/noisy
-  rtid experiment positioning --params fixtures/real/emps/axis.json --travel-mm 200 --out runs/emps";
+  rtid experiment positioning --params fixtures/real/emps/axis.json --travel-mm 200 --out runs/emps
+
+With --compensation FILE (a compensation.json of `rtid compensate`) the CNC's backlash \
+and error-table compensation run in the model's controller — the effect of a \
+compensation predicted on the model, not read off a record:
+  rtid compensate runs/worm/positioning.json -o runs/worm/compensation.json
+  rtid experiment positioning --preset worm-gear --compensation runs/worm/compensation.json --out runs/comp";
 
 /// Arguments of `rtid experiment positioning`.
 #[derive(Debug, clap::Args)]
@@ -74,6 +81,10 @@ pub struct Args {
     /// Seed of the measurement noise.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// A compensation.json (`rtid compensate`): its backlash and error table run in
+    /// the model's controller, added to the commanded position.
+    #[arg(long, value_name = "FILE")]
+    pub compensation: Option<std::path::PathBuf>,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -119,7 +130,14 @@ fn test(a: &Args, axis: Axis) -> anyhow::Result<positioning::PositioningTest> {
             Axis::Rotary => 5f64.to_radians(),
             Axis::Linear => 5e-3,
         },
-        compensation: Default::default(),
+        compensation: match &a.compensation {
+            Some(path) => {
+                let file = compensation_file::read(path)?;
+                file.check_axis(path, axis)?;
+                file.compensation
+            }
+            None => Default::default(),
+        },
     })
 }
 

@@ -218,7 +218,7 @@ pub fn manifest(params: &Params, test: &PositioningTest) -> Manifest {
         ),
     };
     m.notes = Some(format!(
-        "virtual ISO 230-2 test by rtid: {} targets, {} runs each way, table encoder {encoder} {}{}",
+        "virtual ISO 230-2 test by rtid: {} targets, {} runs each way, table encoder {encoder} {}{}{}",
         test.targets.len(),
         test.runs,
         if test.noise > 0.0 {
@@ -230,6 +230,11 @@ pub fn manifest(params: &Params, test: &PositioningTest) -> Manifest {
             format!(", speed {:.0} mm/min", test.speed * 6e4)
         } else {
             String::new()
+        },
+        if test.compensation.is_off() {
+            ""
+        } else {
+            ", with the CNC's compensation (backlash, error table) in the controller"
         }
     ));
     m
