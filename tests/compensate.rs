@@ -423,3 +423,56 @@ fn the_compensation_run_in_the_models_controller_cancels_the_reversal() {
     let e = err(&rtid(&wrong, dir.path()));
     assert!(e.contains("linear.json"), "{e}");
 }
+
+/// `--friction-map`: the worm-gear table's own virtual map gives the friction
+/// compensation its Coulomb law at the motor, written in the file in SI with its
+/// units and read back by the controller's run; a record passed as a map is refused.
+#[test]
+fn a_friction_map_adds_the_law_it_determines() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = [
+        "experiment",
+        "friction-map",
+        "--preset",
+        "worm-gear",
+        "--out",
+        "map",
+    ];
+    ok(&rtid(&map, dir.path()));
+    let record = fixture().join("positioning.json");
+    let args = [
+        "compensate",
+        record.to_str().unwrap(),
+        "--friction-map",
+        "map/friction_map.json",
+        "-o",
+        "c.json",
+        "--json",
+    ];
+    let got = json(&rtid(&args, dir.path()));
+    let friction = &got["friction"];
+    // The preset's friction lumped at the motor — every body's Coulomb level and
+    // damping through the ratios, the model's steady effort's odd part L·sgn(ω) + S·ω
+    // — as the map's Coulomb fit finds it, with no rise.
+    let (coulomb, viscous) = (
+        friction["coulomb"].as_f64().unwrap(),
+        friction["viscous"].as_f64().unwrap(),
+    );
+    let p = rtid::model::presets::load("worm-gear").unwrap();
+    let d = rtid::model::Drive::new(&p).unwrap();
+    let effort = rtid::experiments::friction_map::model_effort;
+    let odd = |w: f64| 0.5 * (effort(&d, w) - effort(&d, -w));
+    let slope = odd(2.0) - odd(1.0);
+    let level = odd(1.0) - slope;
+    assert!((coulomb / level - 1.0).abs() < 0.01, "{coulomb} vs {level}");
+    assert!((viscous / slope - 1.0).abs() < 0.01, "{viscous} vs {slope}");
+    assert!(friction["stribeck"].is_null(), "{friction}");
+    let file = compensation_file::read(&dir.path().join("c.json")).unwrap();
+    let law = file.compensation.friction.unwrap().law;
+    assert_eq!((law.coulomb, law.viscous), (coulomb, viscous));
+    let mut wrong = args;
+    wrong[3] = record.to_str().unwrap();
+    wrong[5] = "d.json";
+    let e = err(&rtid(&wrong, dir.path()));
+    assert!(e.contains("not a friction map"), "{e}");
+}

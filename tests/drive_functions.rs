@@ -179,3 +179,47 @@ fn a_trace_recorded_with_feed_forward_replays_from_its_stated_functions() {
         "{e}"
     );
 }
+
+/// The direct-drive table following a sine of ±10° over 2 s: the largest following
+/// error (rad) over the second period, with `compensation` in the controller.
+fn sine_following_error(p: &Params, compensation: Compensation) -> f64 {
+    let mut sim = Simulation::with_default_step(p).unwrap();
+    sim.set_state(rest_state(p, 0.0, Preload::None));
+    let mut controller = sim.controller(p).unwrap();
+    controller.set_compensation(compensation);
+    let amplitude = 10f64.to_radians();
+    let reference = |t: f64| amplitude * (1.0 - (std::f64::consts::PI * t).cos());
+    sim.run_closed_loop(&mut controller, &reference, 2.0, &mut NullRecorder)
+        .unwrap();
+    let mut worst = 0.0f64;
+    for _ in 0..2000 {
+        sim.run_closed_loop(&mut controller, &reference, 1e-3, &mut NullRecorder)
+            .unwrap();
+        worst = worst.max((reference(sim.time()) - sim.state()[THETA_T]).abs());
+    }
+    worst
+}
+
+#[test]
+fn friction_compensation_by_the_drives_own_law_shrinks_the_reversal_error() {
+    use rtid::controller::FrictionCompensation;
+    use rtid::model::friction::Body;
+    // Feed-forward on in both: what is left of the following error is the friction's.
+    let mut p = presets::load("direct-drive").unwrap();
+    p.controller.kvff = 1.0;
+    p.controller.kaff = p.jt / p.controller.drive_gain;
+    let plain = sine_following_error(&p, Compensation::default());
+    let law = FrictionCompensation {
+        law: p.steady(Body::Table),
+        offset: 0.0,
+        pulse: None,
+    };
+    let compensated = sine_following_error(
+        &p,
+        Compensation {
+            friction: Some(law),
+            ..Default::default()
+        },
+    );
+    assert!(compensated < 0.5 * plain, "{plain} → {compensated} rad");
+}

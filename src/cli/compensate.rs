@@ -8,11 +8,14 @@ use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::common::inputs::refuse_overwrite;
+use rtid::controller::FrictionCompensation;
+use rtid::estimation::friction_law::LawFit;
+use rtid::experiments::friction_map;
 use rtid::experiments::positioning::compensate::{self, BeforeAfter, Computed, Runs};
 use rtid::experiments::positioning::iso230::{AxisStats, ReportUnits};
 use rtid::experiments::positioning::{self};
 use rtid::io::compensation_file::{self, sinumerik, table_csv, CompensationFile, Source};
-use rtid::io::experiment_file::{self, Experiment};
+use rtid::io::experiment_file::{self, Data, Experiment};
 use rtid::model::Axis;
 
 pub const LONG_ABOUT: &str = "\
@@ -40,7 +43,12 @@ Examples:
   rtid experiment positioning --preset worm-gear --noise-arcsec 0.3 --seed 1 --out runs/worm
   rtid compensate runs/worm/positioning.json --runs 1-3 -o runs/worm/compensation.json
   rtid evaluate runs/worm/positioning.json --runs 4-5 --compensation runs/worm/compensation.json
-  rtid compensate runs/worm/positioning.json --sinumerik AX4_EEC.SPF --axis-number 4 --csv table.csv";
+  rtid compensate runs/worm/positioning.json --sinumerik AX4_EEC.SPF --axis-number 4 --csv table.csv
+
+With --friction-map MAP.json the file also holds a friction compensation: the symmetric \
+law the map determines (Coulomb, viscous, a Stribeck rise where the map shows one, the \
+offset), at the motor, fed forward on the commanded speed (docs/compensation.md):
+  rtid compensate runs/worm/positioning.json --friction-map runs/worm/friction_map.json -o c.json";
 
 /// Arguments of `rtid compensate`.
 #[derive(Debug, clap::Args)]
@@ -63,6 +71,11 @@ pub struct Args {
     /// Write the table as CSV.
     #[arg(long, value_name = "FILE.csv")]
     pub csv: Option<PathBuf>,
+    /// Add a friction compensation: the symmetric law (Coulomb, viscous, Stribeck,
+    /// offset) this friction map determines, at the motor. Refused where the map does
+    /// not determine one.
+    #[arg(long, value_name = "MAP.json")]
+    pub friction_map: Option<PathBuf>,
     /// Print JSON instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -75,8 +88,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let exp = experiment_file::read(&a.file)?;
     let outputs = outputs(&a, &exp)?;
     let (measurements, axis) = record(&exp)?;
-    let computed = compensate::compute(&measurements, axis, a.runs.as_ref())
+    let mut computed = compensate::compute(&measurements, axis, a.runs.as_ref())
         .with_context(|| a.file.display().to_string())?;
+    if let Some(map) = &a.friction_map {
+        computed.compensation.friction = Some(friction_of(map, axis)?);
+    }
     write_outputs(&a, &computed, &outputs)?;
     if a.json {
         print_json(&a, &computed)
@@ -84,6 +100,42 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         print_tables(&a, &computed);
         Ok(())
     }
+}
+
+/// The friction compensation a friction map determines: the symmetric law of its
+/// selected family, if determined, on the positioning record's axis.
+fn friction_of(path: &Path, axis: Axis) -> anyhow::Result<FrictionCompensation> {
+    let exp = experiment_file::read(path)?;
+    let Data::FrictionMap(map) = &exp.data else {
+        bail!(
+            "--friction-map {}: a `{}` experiment, not a friction map",
+            path.display(),
+            exp.manifest.kind.name()
+        );
+    };
+    if map.axis != axis {
+        bail!(
+            "--friction-map {}: a map of a {} axis for a {} axis's compensation",
+            path.display(),
+            compensation_file::axis_name(map.axis),
+            compensation_file::axis_name(axis)
+        );
+    }
+    let evaluation = friction_map::evaluate(map)
+        .with_context(|| format!("--friction-map {}", path.display()))?;
+    let Some((law, offset)) = evaluation.symmetric().and_then(LawFit::steady) else {
+        bail!(
+            "--friction-map {}: the map determines no symmetric law (the data support {}, \
+             whose symmetric form is not determined): no friction compensation",
+            path.display(),
+            evaluation.laws.selected
+        );
+    };
+    Ok(FrictionCompensation {
+        law,
+        offset,
+        pulse: None,
+    })
 }
 
 /// The outputs asked for, each refused over an input or over another output.
@@ -176,10 +228,15 @@ fn file_of(a: &Args, c: &Computed) -> CompensationFile {
     CompensationFile {
         axis: c.axis,
         compensation: c.compensation.clone(),
-        source: vec![Source {
+        source: std::iter::once(Source {
             file: a.file.display().to_string(),
             runs: a.runs.as_ref().map(Runs::to_string),
-        }],
+        })
+        .chain(a.friction_map.iter().map(|m| Source {
+            file: m.display().to_string(),
+            runs: None,
+        }))
+        .collect(),
     }
 }
 
@@ -220,6 +277,7 @@ fn print_json(a: &Args, c: &Computed) -> anyhow::Result<()> {
         "build_runs": c.build_runs,
         "check_runs": c.check_runs,
         "backlash": c.compensation.backlash.unwrap_or(0.0) * k,
+        "friction": c.compensation.friction.as_ref().map(friction_json),
         "targets": targets,
         "build": scaled(&c.build),
         "check": c.check.as_ref().map(scaled),
@@ -227,6 +285,33 @@ fn print_json(a: &Args, c: &Computed) -> anyhow::Result<()> {
     });
     println!("{}", rtid::io::json::pretty(&value)?);
     Ok(())
+}
+
+/// A friction compensation in JSON, SI at the motor.
+fn friction_json(f: &FrictionCompensation) -> serde_json::Value {
+    serde_json::json!({
+        "coulomb": f.law.coulomb,
+        "viscous": f.law.viscous,
+        "stribeck": f.law.rise.map(|r| serde_json::json!({
+            "rise": r.rise, "speed": r.speed, "shape": r.shape,
+        })),
+        "offset": f.offset,
+    })
+}
+
+/// The friction compensation in words.
+fn friction_text(f: &FrictionCompensation, axis: Axis) -> String {
+    let (effort, speed) = compensation_file::friction_units(axis);
+    let rise = f.law.rise.map_or(String::new(), |r| {
+        format!(
+            ", Stribeck rise {:.4} {effort} at {:.4} {speed} (shape {:.2})",
+            r.rise, r.speed, r.shape
+        )
+    });
+    format!(
+        "friction (at the motor, on the commanded speed) = {:.4} {effort} + {:.4e} {effort} per {speed}{rise}, offset {:.4} {effort}",
+        f.law.coulomb, f.law.viscous, f.offset
+    )
 }
 
 fn print_tables(a: &Args, c: &Computed) {
@@ -259,6 +344,9 @@ fn print_tables(a: &Args, c: &Computed) {
     println!("{t}");
     let b = c.compensation.backlash.unwrap_or(0.0) * k;
     println!("backlash (added while moving down) = B̄ = {b:.2}{d}");
+    if let Some(f) = &c.compensation.friction {
+        println!("{}", friction_text(f, c.axis));
+    }
     println!(
         "{}",
         before_after_table(

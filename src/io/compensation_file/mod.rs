@@ -25,7 +25,10 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::controller::{Compensation, ErrorTable, TableError};
+use crate::controller::{
+    Compensation, ErrorTable, FrictionCompensation, ReversalPulse, TableError,
+};
+use crate::model::friction::{Rise, SteadyFriction};
 use crate::model::Axis;
 
 /// Where a compensation came from: a record and its runs (`None`: all).
@@ -74,8 +77,6 @@ pub enum CompensationFileError {
         field: &'static str,
         problem: String,
     },
-    #[error("{path}: field `friction`: a friction compensation is not read by this version of rtid (leave it out)")]
-    Friction { path: PathBuf },
     #[error(
         "{path}: a compensation of a {compensation} axis cannot be applied to a record of a {record} axis"
     )]
@@ -97,9 +98,49 @@ struct FileForm {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     table: Option<TableForm>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    friction: Option<serde_json::Value>,
+    friction: Option<FrictionForm>,
     #[serde(default)]
     source: Vec<Source>,
+}
+
+/// The friction compensation as written: the law at the motor in SI, its units
+/// stated (`N·m` and `rad/s` on a rotary axis, `N` and `m/s` on a linear one).
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FrictionForm {
+    effort_unit: String,
+    speed_unit: String,
+    coulomb: f64,
+    viscous: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    stribeck: Option<StribeckForm>,
+    #[serde(default)]
+    offset: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pulse: Option<PulseForm>,
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StribeckForm {
+    rise: f64,
+    speed: f64,
+    shape: f64,
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PulseForm {
+    amplitude: f64,
+    decay_s: f64,
+}
+
+/// The units of a friction law at the motor of `axis`: effort, speed.
+pub fn friction_units(axis: Axis) -> (&'static str, &'static str) {
+    match axis {
+        Axis::Rotary => ("N·m", "rad/s"),
+        Axis::Linear => ("N", "m/s"),
+    }
 }
 
 #[derive(Debug, Serialize, Deserialize)]
@@ -193,9 +234,88 @@ fn to_form(file: &CompensationFile) -> FileForm {
                 modulo,
             }
         }),
-        friction: None,
+        friction: c.friction.as_ref().map(|f| friction_form(f, file.axis)),
         source: file.source.clone(),
     }
+}
+
+fn friction_form(f: &FrictionCompensation, axis: Axis) -> FrictionForm {
+    let (effort_unit, speed_unit) = friction_units(axis);
+    FrictionForm {
+        effort_unit: effort_unit.into(),
+        speed_unit: speed_unit.into(),
+        coulomb: f.law.coulomb,
+        viscous: f.law.viscous,
+        stribeck: f.law.rise.map(|r| StribeckForm {
+            rise: r.rise,
+            speed: r.speed,
+            shape: r.shape,
+        }),
+        offset: f.offset,
+        pulse: f.pulse.map(|p| PulseForm {
+            amplitude: p.amplitude,
+            decay_s: p.decay_s,
+        }),
+    }
+}
+
+/// The friction compensation of `form` on `axis`, checked: its units the axis's,
+/// every number finite, the levels and the pulse non-negative, speeds, shape and
+/// decay positive.
+fn friction_from(
+    form: FrictionForm,
+    axis: Axis,
+    path: &Path,
+) -> Result<FrictionCompensation, CompensationFileError> {
+    let (effort, speed) = friction_units(axis);
+    for (name, got, want) in [
+        ("friction.effort_unit", &form.effort_unit, effort),
+        ("friction.speed_unit", &form.speed_unit, speed),
+    ] {
+        if got != want {
+            return Err(field(
+                path,
+                name,
+                format!("`{got}`: a {} axis's law is in `{want}`", axis_name(axis)),
+            ));
+        }
+    }
+    let check = |name: &'static str, v: f64, positive: bool| {
+        let ok = v.is_finite() && if positive { v > 0.0 } else { v >= 0.0 };
+        let what = if positive { "positive" } else { "non-negative" };
+        if ok {
+            Ok(v)
+        } else {
+            Err(field(path, name, format!("{v}: must be finite and {what}")))
+        }
+    };
+    let rise = match form.stribeck {
+        Some(r) => Some(Rise {
+            rise: check("friction.stribeck.rise", r.rise, false)?,
+            speed: check("friction.stribeck.speed", r.speed, true)?,
+            shape: check("friction.stribeck.shape", r.shape, true)?,
+        }),
+        None => None,
+    };
+    let pulse = match form.pulse {
+        Some(p) => Some(ReversalPulse {
+            amplitude: check("friction.pulse.amplitude", p.amplitude, false)?,
+            decay_s: check("friction.pulse.decay_s", p.decay_s, true)?,
+        }),
+        None => None,
+    };
+    if !form.offset.is_finite() {
+        return Err(field(path, "friction.offset", "not a finite number".into()));
+    }
+    Ok(FrictionCompensation {
+        law: SteadyFriction {
+            coulomb: check("friction.coulomb", form.coulomb, false)?,
+            viscous: check("friction.viscous", form.viscous, false)?,
+            rise,
+        },
+        offset: form.offset,
+        pulse,
+    })
 }
 
 /// The checked content of `form`, read from `path`, in SI.
@@ -210,9 +330,10 @@ fn from_form(form: FileForm, path: &Path) -> Result<CompensationFile, Compensati
             want,
         });
     }
-    if form.friction.is_some() {
-        return Err(CompensationFileError::Friction { path: p() });
-    }
+    let friction = form
+        .friction
+        .map(|f| friction_from(f, form.axis, path))
+        .transpose()?;
     let backlash = match form.backlash {
         Some(b) if !b.value.is_finite() => {
             return Err(field(path, "backlash.value", "not a finite number".into()))
@@ -228,7 +349,7 @@ fn from_form(form: FileForm, path: &Path) -> Result<CompensationFile, Compensati
         compensation: Compensation {
             backlash,
             table,
-            friction: None,
+            friction,
         },
         source: form.source,
     })

@@ -1,4 +1,6 @@
 use super::*;
+use crate::controller::{FrictionCompensation, ReversalPulse};
+use crate::model::friction::{Rise, SteadyFriction};
 use std::f64::consts::TAU;
 
 fn rotary() -> CompensationFile {
@@ -11,7 +13,22 @@ fn rotary() -> CompensationFile {
                 values: (0..=12).map(|i| 1e-6 * ((i % 12) as f64 - 3.0)).collect(),
                 modulo: Some(TAU),
             }),
-            friction: None,
+            friction: Some(FrictionCompensation {
+                law: SteadyFriction {
+                    coulomb: 0.33,
+                    viscous: 2.1e-3,
+                    rise: Some(Rise {
+                        rise: 0.05,
+                        speed: 0.8,
+                        shape: 1.5,
+                    }),
+                },
+                offset: -4.7e-4,
+                pulse: Some(ReversalPulse {
+                    amplitude: 0.1,
+                    decay_s: 0.02,
+                }),
+            }),
         },
         source: vec![Source {
             file: "positioning.json".into(),
@@ -51,6 +68,9 @@ fn a_file_written_reads_back_in_si() {
     for (x, y) in ta.values.iter().zip(&tb.values) {
         assert!((x - y).abs() < 1e-18, "{x} {y}");
     }
+    // The friction law is SI in the file: it reads back exactly.
+    assert_eq!(a.friction, b.friction);
+    assert!(text.contains("\"effort_unit\": \"N·m\""), "{text}");
 }
 
 #[test]
@@ -89,8 +109,16 @@ fn bad_files_name_the_file_and_the_field() {
             "field `table.modulo`: a linear axis has no modulo",
         ),
         (
-            r#"{"axis": "linear", "unit": "mm", "friction": {"coulomb": 1}}"#.to_string(),
-            "field `friction`",
+            r#"{"axis": "linear", "unit": "mm", "friction": {"effort_unit": "N·m", "speed_unit": "m/s", "coulomb": 1, "viscous": 0}}"#.to_string(),
+            "field `friction.effort_unit`: `N·m`: a linear axis's law is in `N`",
+        ),
+        (
+            r#"{"axis": "rotary", "unit": "deg", "friction": {"effort_unit": "N·m", "speed_unit": "rad/s", "coulomb": 1, "viscous": 0, "stribeck": {"rise": 0.1, "speed": 0, "shape": 2}}}"#.to_string(),
+            "field `friction.stribeck.speed`: 0: must be finite and positive",
+        ),
+        (
+            r#"{"axis": "rotary", "unit": "deg", "friction": {"effort_unit": "N·m", "speed_unit": "rad/s", "coulomb": -1, "viscous": 0}}"#.to_string(),
+            "field `friction.coulomb`: -1: must be finite and non-negative",
         ),
         (
             r#"{"axis": "rotary", "unit": "deg", "backlsh": {"value": 1}}"#.to_string(),
