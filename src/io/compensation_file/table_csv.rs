@@ -8,12 +8,38 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::controller::ErrorTable;
-use crate::experiments::positioning::iso230::ReportUnits;
 use crate::model::Axis;
+
+/// The columns' units on an axis: per SI unit and the column-name suffix, of a
+/// position and of a value.
+struct Units {
+    target_per_si: f64,
+    target_key: &'static str,
+    deviation_per_si: f64,
+    deviation_key: &'static str,
+}
+
+fn units(axis: Axis) -> Units {
+    let degrees = 180.0 / std::f64::consts::PI;
+    match axis {
+        Axis::Rotary => Units {
+            target_per_si: degrees,
+            target_key: "deg",
+            deviation_per_si: degrees * 3600.0,
+            deviation_key: "arcsec",
+        },
+        Axis::Linear => Units {
+            target_per_si: 1e3,
+            target_key: "mm",
+            deviation_per_si: 1e6,
+            deviation_key: "um",
+        },
+    }
+}
 
 /// The CSV text of `table` on `axis`, with `backlash` (rad or m) in a comment.
 pub fn text(table: &ErrorTable, axis: Axis, backlash: Option<f64>) -> String {
-    let u = ReportUnits::of(axis);
+    let u = units(axis);
     let mut s = String::new();
     // Invariant: writing to a String does not fail.
     let _ = writeln!(
