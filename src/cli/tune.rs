@@ -101,6 +101,9 @@ fn print_table(name: &str, t: &Tuned) {
         let m = &s.velocity_loop;
         at(m.gain_margin_db.zip(m.gain_margin_hz), " dB")
     }));
+    table.add_row(row("position loop: peak", &|s| {
+        format!("{:.2} dB", s.position_peak_db)
+    }));
     println!("{table}");
 }
 

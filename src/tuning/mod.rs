@@ -10,6 +10,7 @@
 pub mod margins;
 pub mod notches;
 pub mod open_loop;
+pub mod position;
 pub mod search;
 
 use serde::Serialize;
@@ -88,6 +89,8 @@ pub struct Setting {
     pub kpp: f64,
     pub filters: Vec<SetpointFilter>,
     pub velocity_loop: Margins,
+    /// The closed position loop's largest gain, dB ([`position::peak_db`]).
+    pub position_peak_db: f64,
 }
 
 /// The drive's settings before and after tuning, and the tuned parameter set.
@@ -123,6 +126,7 @@ pub fn tune(p: &Params, targets: Targets) -> Result<Tuned, TuneError> {
         kpp: c.kpp,
         filters: c.filters.clone(),
         velocity_loop: search::Grid::new(&before_loop).margins(current),
+        position_peak_db: position::peak_db(&before_loop, current, c.kpp),
     };
     let nyquist = 0.5 / c.tc;
     let resonances = notches::resonances(p, notches::MAX_RELATIVE_CENTRE * nyquist)?;
@@ -146,6 +150,7 @@ pub fn tune(p: &Params, targets: Targets) -> Result<Tuned, TuneError> {
             kpp,
             filters,
             velocity_loop: v.margins,
+            position_peak_db: position::peak_db(&lp, v.pi, kpp),
         },
         params,
     })
@@ -175,6 +180,24 @@ mod tests {
         };
         assert!(best < 166.0 && best > 50.0, "{best}");
         assert!(err.to_string().contains("170° "), "{err}");
+    }
+
+    #[test]
+    fn the_tuned_position_loop_has_no_peak_and_a_higher_gain_would() {
+        // Kpp = ω_c/4 keeps the closed position loop at or below 0 dB; 0.7·ω_c
+        // (about 1.8 times the largest gain that does) peaks above it.
+        for name in ["worm-gear", "two-mass"] {
+            let p = presets::load(name).unwrap();
+            let t = tune(&p, Targets::default()).unwrap();
+            assert!(t.after.position_peak_db <= 1e-6, "{name}: {t:?}");
+            let lp = VelocityLoop::new(&p, &t.after.filters).unwrap();
+            let pi = VelocityPi {
+                kvp: t.after.kvp,
+                kvi: t.after.kvi,
+            };
+            let high = position::peak_db(&lp, pi, 0.7 * 4.0 * t.after.kpp);
+            assert!(high > 0.5, "{name}: {high} dB");
+        }
     }
 
     #[test]

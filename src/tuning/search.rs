@@ -10,7 +10,8 @@
 //! connected range of good crossovers from below: a higher crossover that passes again
 //! (past a resonance, or once the phase has wrapped) is not taken. The position gain is Kpp = ω_c/4: with the velocity loop read as a
 //! first-order lag of bandwidth ω_c, the position loop s² + ω_c·s + ω_c·Kpp is
-//! critically damped (no overshoot).
+//! critically damped (no overshoot); [`super::position`] checks the closed position
+//! loop for a peak above 0 dB.
 
 use std::f64::consts::TAU;
 
