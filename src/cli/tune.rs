@@ -28,7 +28,10 @@ Examples:
   rtid tune --preset worm-gear
   rtid tune --preset two-mass --phase-margin-deg 60 --gain-margin-db 10 -o two-mass-tuned.json
   rtid tune --params fit-params.json --set encoder_delay=1e-4 --json
-  rtid simulate --params two-mass-tuned.json ...   # the tuned drive in closed loop";
+  rtid simulate --params two-mass-tuned.json --input move:target_deg=1 --duration-s 1 --out step.csv
+
+The tuned file's setpoint filters are the notches only: filters of the input (a \
+low-pass, say) are in the \"before\" column and not carried over.";
 
 /// Arguments of `rtid tune`.
 #[derive(Debug, clap::Args)]
