@@ -88,6 +88,8 @@ pub mod report;
 pub mod sim;
 #[doc(hidden)]
 pub mod sweep;
+#[doc(hidden)]
+pub mod tuning;
 mod version;
 
 // Parameters and presets.

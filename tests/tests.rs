@@ -57,3 +57,4 @@ mod slurm;
 mod stribeck;
 mod sweep;
 mod torque_curve;
+mod tuning;

@@ -14,6 +14,7 @@ mod properties;
 mod report;
 mod shell;
 mod sweep;
+mod tune;
 
 use clap::{Parser, Subcommand};
 
@@ -87,6 +88,9 @@ pub enum Command {
     /// The paper's Table 3: two folders of experiment files side by side.
     #[command(long_about = compare::LONG_ABOUT)]
     Compare(compare::Args),
+    /// Velocity PI, position gain and notch filters for a target phase margin, from the model.
+    #[command(long_about = tune::LONG_ABOUT)]
+    Tune(tune::Args),
     /// Sensitivity sweeps: grid, local, Morris, Sobol; streamed, resumable, shardable.
     #[command(long_about = sweep::LONG_ABOUT)]
     Sweep(sweep::Args),
@@ -120,6 +124,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Compensate(a) => compensate::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Sweep(a) => sweep::run(a),
+        Command::Tune(a) => tune::run(a),
         Command::Select(a) => identify::select::run(a),
         Command::Design(a) => identify::design::run(a),
         Command::Completions(a) => shell::completions(a),

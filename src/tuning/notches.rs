@@ -1,0 +1,101 @@
+//! Notch filters at the drive's resonances that the velocity loop would excite
+//! (docs/tuning.md): the motor-free natural frequencies of the linear model — the
+//! resonances of the compliance θm/T the velocity loop acts on — below the Nyquist
+//! frequency, the lowest [`MAX_FILTERS`].
+//!
+//! Each mode's damping ratio ζ comes from the eigenvalue λ of the damped first-order
+//! system nearest its undamped frequency, ζ = −Re λ/|λ|. The notch sits at the
+//! undamped frequency with the depth [`DEPTH_DB`] and the width
+//! max(4·ζ·f, [`MIN_RELATIVE_WIDTH`]·f): twice the resonance's half-power bandwidth
+//! 2ζ·f, and never narrower than a fifth of its frequency, so that a resonance
+//! identified a few per cent off still falls inside.
+
+use std::f64::consts::TAU;
+
+use crate::model::modes::{modes, LinearModel, SCHUR_ITERATIONS};
+use crate::model::{ParamError, Params, SetpointFilter, MAX_FILTERS};
+
+/// The notches' gain at their centre, dB.
+pub const DEPTH_DB: f64 = -20.0;
+/// The narrowest notch, as a fraction of its centre frequency.
+pub const MIN_RELATIVE_WIDTH: f64 = 0.2;
+/// The highest notch centre, as a fraction of the Nyquist frequency: the Tustin
+/// notch is squeezed against Nyquist above it.
+pub const MAX_RELATIVE_CENTRE: f64 = 0.8;
+
+/// One resonance of the compliance: its undamped frequency, Hz, and damping ratio.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Resonance {
+    pub hz: f64,
+    pub damping: f64,
+}
+
+/// The resonances of `p`'s compliance θm/T below `max_hz`, ascending.
+pub fn resonances(p: &Params, max_hz: f64) -> Result<Vec<Resonance>, ParamError> {
+    let free = modes(p)?.free_hz;
+    let s = LinearModel::new(p)?.state_matrix();
+    let eigen: Vec<(f64, f64)> = match s.try_schur(f64::EPSILON, SCHUR_ITERATIONS) {
+        Some(schur) => schur
+            .complex_eigenvalues()
+            .iter()
+            .filter(|l| l.im > 0.0)
+            .map(|l| (l.norm() / TAU, -l.re / l.norm()))
+            .collect(),
+        None => Vec::new(),
+    };
+    Ok(free
+        .into_iter()
+        .filter(|&hz| hz > 0.0 && hz < max_hz)
+        .map(|hz| {
+            let damping = eigen
+                .iter()
+                .min_by(|a, b| (a.0 - hz).abs().total_cmp(&(b.0 - hz).abs()))
+                .map_or(0.0, |e| e.1);
+            Resonance { hz, damping }
+        })
+        .collect())
+}
+
+/// A notch at each resonance below [`MAX_RELATIVE_CENTRE`]·Nyquist, the lowest
+/// [`MAX_FILTERS`].
+pub fn notches(p: &Params) -> Result<Vec<SetpointFilter>, ParamError> {
+    let nyquist = 0.5 / p.controller.tc;
+    Ok(resonances(p, MAX_RELATIVE_CENTRE * nyquist)?
+        .into_iter()
+        .take(MAX_FILTERS)
+        .map(notch)
+        .collect())
+}
+
+/// The notch of one resonance.
+pub fn notch(r: Resonance) -> SetpointFilter {
+    SetpointFilter::Notch {
+        centre_hz: r.hz,
+        width_hz: (4.0 * r.damping * r.hz).max(MIN_RELATIVE_WIDTH * r.hz),
+        depth_db: Some(DEPTH_DB),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets;
+
+    #[test]
+    fn the_two_mass_drive_gets_one_notch_at_its_coupling_mode() {
+        let p = presets::load("two-mass").unwrap();
+        let r = resonances(&p, 1250.0).unwrap();
+        // The preset's notes: motor-free mode 76.3 Hz, damping ratio 0.02.
+        assert_eq!(r.len(), 1, "{r:?}");
+        assert!((r[0].hz - 76.3).abs() < 0.1, "{r:?}");
+        assert!((r[0].damping - 0.02).abs() < 2e-3, "{r:?}");
+        let f = notches(&p).unwrap();
+        assert_eq!(f.len(), 1);
+    }
+
+    #[test]
+    fn a_direct_drive_has_no_resonance_to_notch() {
+        let p = presets::load("direct-drive").unwrap();
+        assert!(notches(&p).unwrap().is_empty());
+    }
+}
