@@ -182,10 +182,16 @@ impl ServoTrace {
         let file::Data::ServoTrace(data) = &exp.data else {
             return None;
         };
-        Some(ServoTrace {
-            drive_functions: exp.manifest.conditions.controller.clone(),
-            ..ServoTrace::from_file(data)
-        })
+        Some(ServoTrace::from_record(data, &exp.manifest.conditions))
+    }
+
+    /// The trace of a `servo_trace` file's data with the controller functions its
+    /// manifest's `conditions` state.
+    pub fn from_record(trace: &file::ServoTrace, conditions: &file::Conditions) -> ServoTrace {
+        ServoTrace {
+            drive_functions: conditions.controller.clone(),
+            ..ServoTrace::from_file(trace)
+        }
     }
 
     /// The trace as a `servo_trace` experiment file's data on `axis`, the controller

@@ -88,7 +88,7 @@ pub fn compare(
         Data::ServoTrace(file) => trace(
             source,
             file.axis,
-            &ServoTrace::from_experiment(exp).unwrap_or_else(|| ServoTrace::from_file(file)),
+            &ServoTrace::from_record(file, &exp.manifest.conditions),
             start,
             fitted,
         )?,

@@ -176,6 +176,31 @@ fn servo_trace(axis: Axis, n: usize) -> Data {
     })
 }
 
+/// A servo trace's series, absent signals empty.
+fn servo_numbers(t: &ServoTrace) -> Vec<Vec<f64>> {
+    let signal = |s: &Option<Signal>| s.as_ref().map_or(vec![], |s| s.values.clone());
+    vec![
+        t.time_s.clone(),
+        t.reference_position.clone(),
+        t.position.clone(),
+        t.table_position.clone().unwrap_or_default(),
+        t.effort.clone(),
+        signal(&t.controller_output),
+        signal(&t.controller_added),
+    ]
+}
+
+/// A friction map's series in order of speed (as the reader returns its rows), its
+/// extra columns included.
+fn map_numbers(m: &FrictionMap) -> Vec<Vec<f64>> {
+    let m = m.sorted();
+    let mut v = vec![m.speed, m.effort];
+    let optional = [m.speed_std, m.effort_std, m.samples, m.dropped, m.transient];
+    v.extend(optional.into_iter().map(Option::unwrap_or_default));
+    v.extend(m.extra.into_values());
+    v
+}
+
 /// The numeric series of `data` in a fixed order, for comparison within 1e-12.
 fn numbers(data: &Data) -> Vec<Vec<f64>> {
     let mut v = match data {
@@ -264,27 +289,8 @@ fn numbers(data: &Data) -> Vec<Vec<f64>> {
             motor_angle_rad.clone(),
             table_angle_rad.clone(),
         ],
-        Data::ServoTrace(t) => {
-            let signal = |s: &Option<Signal>| s.as_ref().map_or(vec![], |s| s.values.clone());
-            vec![
-                t.time_s.clone(),
-                t.reference_position.clone(),
-                t.position.clone(),
-                t.table_position.clone().unwrap_or_default(),
-                t.effort.clone(),
-                signal(&t.controller_output),
-                signal(&t.controller_added),
-            ]
-        }
-        Data::FrictionMap(m) => {
-            // The reader returns the rows in order of speed.
-            let m = m.sorted();
-            let mut v = vec![m.speed, m.effort];
-            let optional = [m.speed_std, m.effort_std, m.samples, m.dropped, m.transient];
-            v.extend(optional.into_iter().map(Option::unwrap_or_default));
-            v.extend(m.extra.into_values());
-            return v;
-        }
+        Data::ServoTrace(t) => servo_numbers(t),
+        Data::FrictionMap(m) => return map_numbers(m),
     };
     v.extend(data.extra().into_iter().flat_map(|e| e.values().cloned()));
     v
