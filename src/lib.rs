@@ -81,6 +81,8 @@ pub mod names;
 #[doc(hidden)]
 pub mod objectives;
 #[doc(hidden)]
+pub mod prediction;
+#[doc(hidden)]
 pub mod recorder;
 #[doc(hidden)]
 pub mod report;

@@ -47,6 +47,7 @@ mod no_alloc;
 mod peaks;
 mod physics;
 mod positioning;
+mod predict;
 mod profile;
 mod properties;
 mod real_data;

@@ -9,6 +9,7 @@ mod experiment;
 mod identify;
 mod import;
 mod model;
+mod predict;
 #[cfg(test)]
 mod properties;
 mod report;
@@ -91,6 +92,9 @@ pub enum Command {
     /// Velocity PI, position gain and notch filters for a target phase margin, from the model.
     #[command(long_about = tune::LONG_ABOUT)]
     Tune(tune::Args),
+    /// The effect of a compensation or tuning on the identified model, with the fit's uncertainty.
+    #[command(long_about = predict::LONG_ABOUT)]
+    Predict(predict::Args),
     /// Sensitivity sweeps: grid, local, Morris, Sobol; streamed, resumable, shardable.
     #[command(long_about = sweep::LONG_ABOUT)]
     Sweep(sweep::Args),
@@ -125,6 +129,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Compare(a) => compare::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Tune(a) => tune::run(a),
+        Command::Predict(a) => predict::run(a),
         Command::Select(a) => identify::select::run(a),
         Command::Design(a) => identify::design::run(a),
         Command::Completions(a) => shell::completions(a),

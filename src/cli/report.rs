@@ -110,8 +110,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let fits: Vec<(String, IdentifyResult)> = (a.files.iter().zip(&loaded))
         .filter_map(|(f, l)| Some((f.display().to_string(), l.fit.clone()?)))
         .collect();
+    let predictions: Vec<(String, rtid::prediction::Prediction)> = (a.files.iter().zip(&loaded))
+        .filter_map(|(f, l)| Some((html::prediction::file_name(f), l.prediction.clone()?)))
+        .collect();
+    let records: Vec<html::prediction::Measured> =
+        loaded.iter().filter_map(|l| l.measured.clone()).collect();
     let mut sections: Vec<html::Section> = loaded.into_iter().map(|l| l.section).collect();
     sections.extend(html::selection::section(&fits));
+    sections.extend(html::prediction::comparison(&predictions, &records));
     let title = a.title.as_deref().unwrap_or("rtid report");
     let page = html::page(title, &sections);
     rtid::io::atomic::write(&a.out, page.as_bytes())

@@ -140,8 +140,12 @@ impl CompensateWarning {
                 v(e_after)
             ),
             CompensateWarning::Unchecked { check_runs } => format!(
-                "built from all runs but {check_runs}: the values after compensation are those \
-                 of the runs it was fitted to; keep runs aside (--runs 1-3 of 5) to check it"
+                "built from {}: the values after compensation are those of the runs it was \
+                 fitted to; keep runs aside (--runs 1-3 of 5) to check it",
+                match check_runs {
+                    0 => "every run".to_string(),
+                    n => format!("all runs but {n}"),
+                }
             ),
         }
     }

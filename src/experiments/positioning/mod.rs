@@ -68,6 +68,21 @@ impl Default for PositioningTest {
 type Stop = (f64, Option<(f64, Direction, u32)>);
 
 impl PositioningTest {
+    /// The standard cycle on `axis`: a rotary table's is the default (every 30°);
+    /// a linear axis's every 50 mm over 500 mm at 3000 mm/min, 5 mm beyond the ends
+    /// (as `rtid experiment positioning` runs them).
+    pub fn standard(axis: Axis) -> Self {
+        match axis {
+            Axis::Rotary => PositioningTest::default(),
+            Axis::Linear => PositioningTest {
+                targets: (0..=10).map(|i| 0.05 * i as f64).collect(),
+                speed: 3.0 / 60.0,
+                overrun: 5e-3,
+                ..PositioningTest::default()
+            },
+        }
+    }
+
     /// The sequence of (commanded angle, reading taken there as which measurement).
     fn cycle(&self) -> Vec<Stop> {
         let mut targets = self.targets.clone();

@@ -123,6 +123,15 @@ impl IdentifyResult {
         crate::io::atomic::write(path, format!("{text}\n").as_bytes())
     }
 
+    /// Sets the identified values in `p` (the base the fit started from: a preset, a
+    /// parameter file).
+    pub fn apply_to(&self, p: &mut crate::model::Params) -> Result<(), crate::model::ParamError> {
+        for (name, &value) in &self.parameters {
+            p.set(name, value)?;
+        }
+        Ok(())
+    }
+
     /// The standard error of fitted parameter `name` in its unit, where defined.
     pub fn standard_error(&self, name: &str) -> Option<f64> {
         self.uncertainty

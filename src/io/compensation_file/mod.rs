@@ -38,6 +38,9 @@ pub struct Source {
     pub file: String,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub runs: Option<String>,
+    /// Where the compensation is the model's: which of its virtual tests gave it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
 }
 
 /// A compensation file's content, SI inside (rad or m).

@@ -129,7 +129,7 @@ pub fn program(
     line(format!("; encoder/leadscrew error compensation of {ax}, {unit}; each value is the axis's error (SINUMERIK adds it to the actual position: the opposite of rtid's table)"));
     line(format!("; {n} equidistant points, resampled linearly from rtid's table; MD38000 $MA_MM_ENC_COMP_MAX_POINTS[0,{ax}] >= {n}, activate with MD32700 $MA_ENC_COMP_ENABLE[0,{ax}] = 1"));
     if let Some(b) = backlash {
-        line(format!("; backlash (machine data, not set by this program): MD32450 $MA_BACKLASH[0,{ax}] = {:.decimals$} ({unit}, the magnitude of the mean reversal value)", (b * k).abs()));
+        line(format!("; backlash (machine data, not set by this program): MD32450 $MA_BACKLASH[0,{ax}] = {:.decimals$} ({unit}: -B_mean; positive when the encoder leads the machine part, the table stopping short of its targets)", -b * k));
     }
     line("CHANDATA(1)".into());
     for (i, v) in grid.values.iter().enumerate() {

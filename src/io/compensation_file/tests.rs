@@ -33,6 +33,7 @@ fn rotary() -> CompensationFile {
         source: vec![Source {
             file: "positioning.json".into(),
             runs: Some("1-3".into()),
+            model: None,
         }],
     }
 }

@@ -12,6 +12,7 @@ pub mod identify;
 pub mod markup;
 pub mod page;
 pub mod positioning;
+pub mod prediction;
 pub mod selection;
 pub mod source;
 pub mod sweep;
@@ -31,6 +32,8 @@ pub enum Kind {
     Sweep,
     /// The comparison of the page's identifications (AIC, BIC, F-tests).
     Selection,
+    /// A prediction (`rtid predict -o`), or the predictions beside the records.
+    Prediction,
 }
 
 impl Kind {
@@ -41,6 +44,7 @@ impl Kind {
             Kind::Positioning => "positioning",
             Kind::Sweep => "sweep",
             Kind::Selection => "model selection",
+            Kind::Prediction => "prediction",
         }
     }
 }
@@ -57,10 +61,26 @@ pub struct Section {
     pub body: String,
 }
 
-/// An identification's result with its section (for the page's model selection).
+/// A file's section, with what the page's own sections need of it: an
+/// identification's result (model selection), a positioning record's axis values and
+/// a prediction (the predictions beside the records).
 pub struct Loaded {
     pub section: Section,
     pub fit: Option<crate::identify::IdentifyResult>,
+    pub measured: Option<prediction::Measured>,
+    pub prediction: Option<crate::prediction::Prediction>,
+}
+
+impl Loaded {
+    /// A section the page needs nothing else of.
+    pub fn alone(section: Section) -> Loaded {
+        Loaded {
+            section,
+            fit: None,
+            measured: None,
+            prediction: None,
+        }
+    }
 }
 
 /// Why a section cannot be written; each names its file.
@@ -72,7 +92,7 @@ pub enum HtmlError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{path}: not a report input ({reason}); expected an identification result (`rtid identify --out`), an ISO 230-2 positioning experiment manifest (`\"kind\": \"positioning\"`) or a sweep file (`rtid sweep --out`)")]
+    #[error("{path}: not a report input ({reason}); expected an identification result (`rtid identify --out`), an ISO 230-2 positioning experiment manifest (`\"kind\": \"positioning\"`), a prediction (`rtid predict -o`) or a sweep file (`rtid sweep --out`)")]
     Unrecognised { path: PathBuf, reason: String },
     #[error("{path}: malformed {what}: {message}")]
     Malformed {

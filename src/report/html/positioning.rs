@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use super::markup::{escape, fixed, svg_block, table};
+use super::prediction::{file_name, Measured};
 use super::{HtmlError, Kind, Section, Tolerances};
 use crate::experiments::positioning;
 use crate::experiments::positioning::iso230::{self, AxisStats, Iso230Report, ReportUnits};
@@ -12,8 +13,9 @@ use crate::io::experiment_file::{self, Kind as ExperimentKind};
 
 const WHAT: &str = "positioning experiment";
 
-/// The section of the positioning manifest `path`.
-pub fn section(path: &Path, tolerances: &Tolerances) -> Result<Section, HtmlError> {
+/// The section of the positioning manifest `path`, and its axis values in the
+/// report's unit (for the predictions beside it).
+pub fn section(path: &Path, tolerances: &Tolerances) -> Result<(Section, Measured), HtmlError> {
     let bad = |message: String| HtmlError::Malformed {
         path: path.to_path_buf(),
         what: WHAT,
@@ -43,12 +45,17 @@ pub fn section(path: &Path, tolerances: &Tolerances) -> Result<Section, HtmlErro
     body.push_str("<h3>Targets</h3>\n");
     body.push_str(&targets_table(&report, units));
     body.push_str(&svg_block(&chart));
-    Ok(Section {
+    let section = Section {
         kind: Kind::Positioning,
         file: path.to_path_buf(),
         title: format!("Positioning (ISO 230-2): {mechanism}"),
         body,
-    })
+    };
+    let measured = Measured {
+        file: file_name(path),
+        axis: report.axis.scaled(units.deviation_per_si),
+    };
+    Ok((section, measured))
 }
 
 /// The tolerance of the axis's kind, if given; the other kind's option is refused

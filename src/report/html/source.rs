@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use super::{identify, positioning, sweep, HtmlError, Loaded, Section};
+use super::{identify, positioning, prediction, sweep, HtmlError, Loaded};
 use crate::identify::IdentifyResult;
 
 /// Acceptance tolerances of the bidirectional accuracy A, one per kind of axis.
@@ -37,15 +37,27 @@ pub fn load(path: &Path, options: &Options) -> Result<Loaded, HtmlError> {
         reason,
     };
     let text = crate::io::without_bom(&text);
-    let alone = |section: Section| Loaded { section, fit: None };
     if text.starts_with(crate::sweep::stream::MAGIC) {
-        return sweep::section(path).map(alone);
+        return sweep::section(path).map(Loaded::alone);
     }
     let value: Value = serde_json::from_str(text)
         .map_err(|e| unrecognised(format!("not a sweep file, and not JSON: {e}")))?;
     match recognise(&value) {
         Some(Recognised::Identification) => identification(path, value),
-        Some(Recognised::Positioning) => positioning::section(path, &options.tolerances).map(alone),
+        Some(Recognised::Positioning) => {
+            let (section, measured) = positioning::section(path, &options.tolerances)?;
+            Ok(Loaded {
+                measured: Some(measured),
+                ..Loaded::alone(section)
+            })
+        }
+        Some(Recognised::Prediction) => {
+            let (section, p) = prediction::section(path, value)?;
+            Ok(Loaded {
+                prediction: Some(p),
+                ..Loaded::alone(section)
+            })
+        }
         Some(Recognised::OtherExperiment(kind)) => Err(unrecognised(format!(
             "an experiment manifest of kind `{kind}`; only positioning experiments are reported"
         ))),
@@ -58,6 +70,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Loaded, HtmlError> {
 enum Recognised {
     Identification,
     Positioning,
+    Prediction,
     OtherExperiment(String),
 }
 
@@ -71,10 +84,11 @@ fn recognise(v: &Value) -> Option<Recognised> {
             other => Recognised::OtherExperiment(other.to_string()),
         });
     }
-    let result = ["parameters", "residuals", "termination"]
-        .iter()
-        .all(|k| o.contains_key(*k));
-    result.then_some(Recognised::Identification)
+    let has = |keys: &[&str]| keys.iter().all(|k| o.contains_key(*k));
+    if has(&["cases", "drawn", "level", "completed"]) {
+        return Some(Recognised::Prediction);
+    }
+    has(&["parameters", "residuals", "termination"]).then_some(Recognised::Identification)
 }
 
 /// The section of a result file's JSON.
@@ -87,7 +101,7 @@ fn identification(path: &Path, value: Value) -> Result<Loaded, HtmlError> {
         })?;
     let section = identify::section(path, &result)?;
     Ok(Loaded {
-        section,
         fit: Some(result),
+        ..Loaded::alone(section)
     })
 }

@@ -1,6 +1,9 @@
 //! `rtid compensate`: the backlash and error table of an axis from its ISO 230-2
-//! positioning record, checked on the runs it was not built from, written as
-//! compensation.json, a SINUMERIK program and a CSV.
+//! positioning record (or an identified model's virtual one: [`model`]), checked on
+//! the runs it was not built from, written as compensation.json, a SINUMERIK program
+//! and a CSV.
+
+mod model;
 
 use std::path::{Path, PathBuf};
 
@@ -8,6 +11,7 @@ use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::common::inputs::refuse_overwrite;
+use crate::cli::ModelArgs;
 use rtid::controller::FrictionCompensation;
 use rtid::estimation::friction_law::LawFit;
 use rtid::experiments::friction_map;
@@ -48,14 +52,40 @@ Examples:
 With --friction-map MAP.json the file also holds a friction compensation: the symmetric \
 law the map determines (Coulomb, viscous, a Stribeck rise where the map shows one, the \
 offset), at the motor, fed forward on the commanded speed (docs/compensation.md):
-  rtid compensate runs/worm/positioning.json --friction-map runs/worm/friction_map.json -o c.json";
+  rtid compensate runs/worm/positioning.json --friction-map runs/worm/friction_map.json -o c.json
+
+From an identification instead of a record: --fit FIT.json with the base it started from \
+(--preset or --params) runs the identified model's own ISO 230-2 cycle (5 runs, no noise) \
+and builds the compensation from it — the reversal the meshes' play, the elastic lost \
+motion and the friction make together, not the play alone. --friction adds the friction \
+law of the model's steady map at the motor; --tune FILE uses a tuned controller (a \
+compensation holds for the servo settings it was made with). `rtid predict` then gives \
+its effect with the fit's uncertainty:
+  rtid compensate --fit fit.json --preset worm-gear --friction -o compensation.json
+  rtid predict fit.json --preset worm-gear --compensation compensation.json";
 
 /// Arguments of `rtid compensate`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The positioning record (experiment manifest).
-    #[arg(value_name = "POSITIONING.json")]
-    pub file: PathBuf,
+    /// The positioning record (experiment manifest); without it, the model's own
+    /// virtual positioning test (--fit with --preset or --params).
+    #[arg(value_name = "POSITIONING.json", required_unless_present_any = ["fit", "preset", "params"])]
+    pub file: Option<PathBuf>,
+    /// An identification result (`rtid identify --out`): its values set in the model
+    /// (--preset or --params, the base it started from), whose virtual positioning test
+    /// gives the compensation.
+    #[arg(long, value_name = "FIT.json", conflicts_with = "file")]
+    pub fit: Option<PathBuf>,
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// With a model: the controller settings of this tuned parameter file (`rtid tune
+    /// -o`) — a compensation holds for the servo settings it was made with.
+    #[arg(long, value_name = "FILE", conflicts_with = "file")]
+    pub tune: Option<PathBuf>,
+    /// With a model: add the friction compensation its steady friction map gives (the
+    /// symmetric law at the motor).
+    #[arg(long, conflicts_with_all = ["file", "friction_map"])]
+    pub friction: bool,
     /// Build from these runs (`1-3`, `2`); the others check it [default: all].
     #[arg(long, value_name = "FIRST-LAST")]
     pub runs: Option<Runs>,
@@ -85,21 +115,74 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let exp = experiment_file::read(&a.file)?;
-    let outputs = outputs(&a, &exp)?;
-    let (measurements, axis) = record(&exp)?;
-    let mut computed = compensate::compute(&measurements, axis, a.runs.as_ref())
-        .with_context(|| a.file.display().to_string())?;
+    let origin = origin(&a)?;
+    let outputs = outputs(&a, &origin.inputs)?;
+    let mut computed = compensate::compute(&origin.measurements, origin.axis, a.runs.as_ref())
+        .with_context(|| origin.name.clone())?;
     if let Some(map) = &a.friction_map {
-        computed.compensation.friction = Some(friction_of(map, axis)?);
+        computed.compensation.friction = Some(friction_of(map, origin.axis)?);
     }
-    write_outputs(&a, &computed, &outputs)?;
+    if let Some(p) = origin.model.as_ref().filter(|_| a.friction) {
+        computed.compensation.friction = Some(model::friction(p, &origin.name)?);
+    }
+    write_outputs(&a, &origin, &computed, &outputs)?;
     if a.json {
-        print_json(&a, &computed)
+        print_json(&origin, &computed)
     } else {
-        print_tables(&a, &computed);
+        print_tables(&origin, &computed);
         Ok(())
     }
+}
+
+/// Where the readings come from: a record, or the model's virtual test.
+struct Origin {
+    /// The record, or the model, in messages and the file's source.
+    name: String,
+    /// The files read (no output may overwrite them).
+    inputs: Vec<PathBuf>,
+    measurements: Vec<positioning::iso230::Measurement>,
+    axis: Axis,
+    /// The model, where it is the origin.
+    model: Option<rtid::model::Params>,
+    /// `--runs` as given.
+    runs: Option<Runs>,
+}
+
+fn origin(a: &Args) -> anyhow::Result<Origin> {
+    if let Some(file) = &a.file {
+        if a.model.given() || !a.model.set.is_empty() {
+            bail!("--preset, --params and --set describe a model: give a positioning record or a model (--fit with --preset/--params), not both");
+        }
+        let exp = experiment_file::read(file)?;
+        let (measurements, axis) = record(&exp)?;
+        let mut inputs = vec![file.clone()];
+        inputs.extend(exp.data_path.clone());
+        return Ok(Origin {
+            name: file.display().to_string(),
+            inputs,
+            measurements,
+            axis,
+            model: None,
+            runs: a.runs.clone(),
+        });
+    }
+    let p = model::params(a)?;
+    let measurements = model::record(&p, a.quiet || a.json)?;
+    let inputs = a
+        .fit
+        .iter()
+        .chain(&a.model.params)
+        .chain(&a.tune)
+        .cloned()
+        .collect();
+    Ok(Origin {
+        name: model::name(a),
+        inputs,
+        measurements,
+        axis: p.axis,
+        model: Some(p),
+        runs: a.runs.clone(),
+    })
 }
 
 /// The friction compensation a friction map determines: the symmetric law of its
@@ -139,9 +222,8 @@ fn friction_of(path: &Path, axis: Axis) -> anyhow::Result<FrictionCompensation> 
 }
 
 /// The outputs asked for, each refused over an input or over another output.
-fn outputs(a: &Args, exp: &Experiment) -> anyhow::Result<Vec<(&'static str, PathBuf)>> {
-    let mut inputs: Vec<&Path> = vec![&a.file];
-    inputs.extend(exp.data_path.as_deref());
+fn outputs(a: &Args, inputs: &[PathBuf]) -> anyhow::Result<Vec<(&'static str, PathBuf)>> {
+    let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
     let asked = [
         ("-o", a.out.as_ref()),
         ("--sinumerik", a.sinumerik.as_ref()),
@@ -172,14 +254,15 @@ pub fn record(exp: &Experiment) -> anyhow::Result<(Vec<positioning::iso230::Meas
 
 fn write_outputs(
     a: &Args,
+    o: &Origin,
     c: &Computed,
     outputs: &[(&'static str, PathBuf)],
 ) -> anyhow::Result<()> {
     for (option, path) in outputs {
         match *option {
-            "-o" => compensation_file::write(path, &file_of(a, c))?,
+            "-o" => compensation_file::write(path, &file_of(a, o, c))?,
             "--sinumerik" => {
-                let text = sinumerik_program(a, c)?;
+                let text = sinumerik_program(a, o, c)?;
                 sinumerik::write(path, &text)?;
             }
             _ => {
@@ -202,7 +285,7 @@ fn table_of(c: &Computed) -> anyhow::Result<&rtid::controller::ErrorTable> {
         .context("the compensation has no table")
 }
 
-fn sinumerik_program(a: &Args, c: &Computed) -> anyhow::Result<String> {
+fn sinumerik_program(a: &Args, o: &Origin, c: &Computed) -> anyhow::Result<String> {
     let Some(n) = a.axis_number else {
         bail!("--sinumerik needs --axis-number N (the machine axis AX<N>)");
     };
@@ -210,7 +293,7 @@ fn sinumerik_program(a: &Args, c: &Computed) -> anyhow::Result<String> {
     let note = format!(
         "rtid {} compensate {}{}",
         rtid::VERSION,
-        a.file.display(),
+        o.name,
         a.runs
             .as_ref()
             .map_or(String::new(), |r| format!(" --runs {r}"))
@@ -224,23 +307,29 @@ fn sinumerik_program(a: &Args, c: &Computed) -> anyhow::Result<String> {
     ))
 }
 
-fn file_of(a: &Args, c: &Computed) -> CompensationFile {
+fn file_of(a: &Args, o: &Origin, c: &Computed) -> CompensationFile {
     CompensationFile {
         axis: c.axis,
         compensation: c.compensation.clone(),
         source: std::iter::once(Source {
-            file: a.file.display().to_string(),
-            runs: a.runs.as_ref().map(Runs::to_string),
+            file: o.name.clone(),
+            runs: o.runs.as_ref().map(Runs::to_string),
+            model: o.model.as_ref().map(|_| MODEL_SOURCE.to_string()),
         })
         .chain(a.friction_map.iter().map(|m| Source {
             file: m.display().to_string(),
             runs: None,
+            model: None,
         }))
         .collect(),
     }
 }
 
-fn print_json(a: &Args, c: &Computed) -> anyhow::Result<()> {
+/// What a model's compensation rests on, in the file's source.
+const MODEL_SOURCE: &str =
+    "the virtual positioning test (ISO 230-2 standard cycle) of the identified model";
+
+fn print_json(o: &Origin, c: &Computed) -> anyhow::Result<()> {
     let u = ReportUnits::of(c.axis);
     let k = u.deviation_per_si;
     let scaled = |b: &BeforeAfter| {
@@ -272,7 +361,7 @@ fn print_json(a: &Args, c: &Computed) -> anyhow::Result<()> {
         .collect::<anyhow::Result<_>>()?;
     let value = serde_json::json!({
         "kind": "compensation",
-        "source": a.file,
+        "source": o.name,
         "unit": u.deviation_key,
         "build_runs": c.build_runs,
         "check_runs": c.check_runs,
@@ -314,12 +403,12 @@ fn friction_text(f: &FrictionCompensation, axis: Axis) -> String {
     )
 }
 
-fn print_tables(a: &Args, c: &Computed) {
+fn print_tables(o: &Origin, c: &Computed) {
     let u = ReportUnits::of(c.axis);
     let (k, d) = (u.deviation_per_si, u.deviation);
     println!(
         "{}: compensation from runs {} ({}), each value added to the commanded position",
-        a.file.display(),
+        o.name,
         runs_text(&c.build_runs),
         u.deviation_name
     );

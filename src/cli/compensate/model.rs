@@ -1,0 +1,72 @@
+//! `rtid compensate --fit FIT.json --preset …`: the compensation of an identified
+//! model, from its own virtual positioning test (the reversal the meshes' play, the
+//! elastic lost motion and the friction make together) and, with `--friction`, the
+//! friction law its steady map gives at the motor.
+
+use anyhow::{bail, Context};
+
+use super::Args;
+use crate::cli::predict::read_fit;
+use rtid::controller::FrictionCompensation;
+use rtid::estimation::friction_law::LawFit;
+use rtid::experiments::friction_map::{self, steady::model_map, MapTest};
+use rtid::experiments::positioning::{self, iso230::Measurement, PositioningTest};
+use rtid::io::experiment_file::FrictionMap;
+use rtid::model::Params;
+
+/// The identified model: the base set (--preset, --params) with the fit's values and
+/// the tuned controller (--tune).
+pub fn params(a: &Args) -> anyhow::Result<Params> {
+    let mut p = a.model.load()?;
+    if let Some(path) = &a.fit {
+        let fit = read_fit(path)?;
+        fit.apply_to(&mut p)
+            .and_then(|()| p.validate())
+            .with_context(|| format!("{}: its values on the model", path.display()))?;
+    }
+    if let Some(path) = &a.tune {
+        p.controller = crate::cli::predict::tuned_controller(path, &p)?;
+    }
+    Ok(p)
+}
+
+/// The model's name in messages: the fit, else the parameter file or preset.
+pub fn name(a: &Args) -> String {
+    match (&a.fit, &a.model.params, &a.model.preset) {
+        (Some(f), _, _) => f.display().to_string(),
+        (None, Some(p), _) => p.display().to_string(),
+        (None, None, Some(n)) => format!("preset {n}"),
+        _ => "the model".into(),
+    }
+}
+
+/// The standard positioning test's readings on the model (no noise).
+pub fn record(p: &Params, quiet: bool) -> anyhow::Result<Vec<Measurement>> {
+    let test = PositioningTest::standard(p.axis);
+    let bar = crate::cli::common::progress::bar(test.readings() as u64, "positioning", quiet);
+    let readings = positioning::run(p, &test, |done, _| bar.set_position(done as u64))
+        .context("the virtual positioning test on the model")?;
+    bar.finish_and_clear();
+    Ok(readings)
+}
+
+/// The friction compensation of the model: the symmetric law fitted to its steady
+/// map at the standard friction-map speeds (exact where the bodies' laws lump into
+/// one; the fit's family chosen as for a measured map).
+pub fn friction(p: &Params, name: &str) -> anyhow::Result<FrictionCompensation> {
+    let speeds = MapTest::default_speeds(p);
+    let effort = model_map(p, &speeds).context("the model's friction map")?;
+    let map = FrictionMap::new(p.axis, speeds, effort);
+    let evaluation = friction_map::evaluate(&map).context("the model's friction map")?;
+    let Some((law, offset)) = evaluation.symmetric().and_then(LawFit::steady) else {
+        bail!(
+            "--friction: the steady map of {name} determines no symmetric law (it supports {}, whose symmetric form is not determined)",
+            evaluation.laws.selected
+        );
+    };
+    Ok(FrictionCompensation {
+        law,
+        offset,
+        pulse: None,
+    })
+}

@@ -1,0 +1,323 @@
+//! `rtid predict`: the effect of a compensation and a tuning on the identified model,
+//! with the fit's uncertainty carried through (docs/compensation.md).
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+use anyhow::{bail, Context};
+use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
+
+use crate::cli::common::inputs::refuse_overwrite;
+use crate::cli::common::{interrupt, progress};
+use crate::cli::ModelArgs;
+use rtid::experiments::positioning::PositioningTest;
+use rtid::identify::result::IdentifyResult;
+use rtid::io::{compensation_file, params_file};
+use rtid::model::params::ControllerParams;
+use rtid::model::Params;
+use rtid::names::Num;
+use rtid::prediction::{self, draws, Case, DrawSource, Prediction, Setup, Test};
+
+pub const LONG_ABOUT: &str = "\
+The effect of settings predicted on the identified model, with the fit's uncertainty: \
+parameter sets are drawn from the fit (FIT.json of `rtid identify --out`) — normal draws \
+from its standard errors and correlations (in log space for a parameter with positive \
+bounds), or its bootstrap replicates (`identify --resample`) — and the virtual test runs \
+on each, before (the model's own controller, no compensation) and after (with \
+--compensation and --tune). Each output is given at the fit's values with the central \
+interval of the draws: \"A after 3.6 [3.4 … 3.9]″\".
+
+The model is the base the fit started from (--preset or --params, as given to identify) \
+with the fit's values set. The interval carries the fitted parameters' uncertainty only: \
+every other parameter keeps its value, and the output names them. A fitted parameter \
+the data did not determine (no standard error) cannot be drawn: the command refuses \
+until it is held at its value (--hold NAME), and then says so.
+
+Tests: positioning (ISO 230-2: B̄, B, E, M, R, A in arc-seconds or µm; --runs per \
+direction). The draws run in parallel; Ctrl-C stops them and the prediction is made \
+from those done.
+
+Examples:
+  rtid identify fixtures/worm-gear/torque_curve.json fixtures/worm-gear/unbalance.json \\
+      --preset worm-gear --fit theta_bw,fm,fw --out fit.json --save-params fit-params.json
+  rtid compensate --fit fit.json --preset worm-gear -o compensation.json
+  rtid predict fit.json --preset worm-gear --compensation compensation.json --draws 40
+  rtid predict fit.json --params fit-params.json --tune tuned.json --json -o prediction.json";
+
+/// Arguments of `rtid predict`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The identification result (`rtid identify --out`).
+    #[arg(value_name = "FIT.json")]
+    pub fit: PathBuf,
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// The compensation to predict (compensation.json of `rtid compensate`).
+    #[arg(long, value_name = "FILE")]
+    pub compensation: Option<PathBuf>,
+    /// A tuned parameter file (`rtid tune -o`): its controller settings are used.
+    #[arg(long, value_name = "FILE")]
+    pub tune: Option<PathBuf>,
+    /// The virtual tests, comma-separated.
+    #[arg(long, value_name = "LIST", default_value = "positioning")]
+    pub tests: String,
+    /// Parameter sets drawn (normal draws; the replicates' number is the bootstrap's).
+    #[arg(long, value_name = "N", default_value_t = 50)]
+    pub draws: usize,
+    /// Where the draws come from [default: bootstrap where the fit has replicates].
+    #[arg(long, value_enum, value_name = "SOURCE")]
+    pub from: Option<FromArg>,
+    /// Hold a fitted parameter at its value instead of drawing it; repeatable.
+    #[arg(long, value_name = "NAME")]
+    pub hold: Vec<String>,
+    /// Positioning test: runs per direction.
+    #[arg(long, value_name = "N", default_value_t = 5)]
+    pub runs: u32,
+    /// Probability of the central interval.
+    #[arg(long, value_name = "P", default_value_t = 0.95)]
+    pub level: f64,
+    /// Seed of the normal draws.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print JSON instead of tables.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the prediction (JSON).
+    #[arg(short = 'o', long = "out", value_name = "prediction.json")]
+    pub out: Option<PathBuf>,
+    /// No progress bar or notes on stderr.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum FromArg {
+    Covariance,
+    Bootstrap,
+}
+
+/// Most draws a prediction takes.
+const MAX_DRAWS: usize = 100_000;
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    refuse_outputs(&a)?;
+    let fit = read_fit(&a.fit)?;
+    let params = model(&a, &fit)?;
+    let (source, draws) = draws(&a, &fit)?;
+    let cases = cases(&a, &params)?;
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    interrupt::on_interrupt(move || !flag.swap(true, Ordering::SeqCst));
+    let bar = progress::bar(draws.sets.len() as u64, "draws", a.quiet);
+    let setup = Setup {
+        params: &params,
+        draws: &draws,
+        source,
+        held: a.hold.clone(),
+        level: a.level,
+        cases: &cases,
+    };
+    let p = prediction::predict(&setup, &|| bar.inc(1), &stop)?;
+    bar.finish_and_clear();
+    if let Some(out) = &a.out {
+        let text = rtid::io::json::pretty(&p)?;
+        rtid::io::atomic::write(out, format!("{text}\n").as_bytes())
+            .with_context(|| format!("writing {}", out.display()))?;
+    }
+    if a.json {
+        println!("{}", rtid::io::json::pretty(&p)?);
+    } else {
+        print(&a, &p, &params);
+    }
+    Ok(())
+}
+
+fn refuse_outputs(a: &Args) -> anyhow::Result<()> {
+    let Some(out) = &a.out else { return Ok(()) };
+    let mut inputs: Vec<&Path> = vec![&a.fit];
+    inputs.extend(a.model.params.as_deref());
+    inputs.extend(a.compensation.as_deref());
+    inputs.extend(a.tune.as_deref());
+    refuse_overwrite("-o", out, &inputs)
+}
+
+pub(crate) fn read_fit(path: &Path) -> anyhow::Result<IdentifyResult> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    serde_json::from_str(&text).with_context(|| {
+        format!(
+            "{}: not an identification result (rtid identify --out)",
+            path.display()
+        )
+    })
+}
+
+/// The base set with the fit's values, and the tuned controller with --tune.
+fn model(a: &Args, fit: &IdentifyResult) -> anyhow::Result<Params> {
+    let mut p = a.model.load()?;
+    fit.apply_to(&mut p)
+        .with_context(|| format!("{}: its values on the model", a.fit.display()))?;
+    p.validate()
+        .with_context(|| format!("{}: its values on the model", a.fit.display()))?;
+    Ok(p)
+}
+
+fn draws(a: &Args, fit: &IdentifyResult) -> anyhow::Result<(DrawSource, draws::Draws)> {
+    if a.draws < prediction::MIN_DRAWS || a.draws > MAX_DRAWS {
+        bail!(
+            "--draws {}: from {} (an interval) to {MAX_DRAWS}",
+            a.draws,
+            prediction::MIN_DRAWS
+        );
+    }
+    for name in &a.hold {
+        if !fit.parameters.contains_key(name) {
+            bail!(
+                "--hold {name}: not a parameter of the fit ({})",
+                fitted(fit)
+            );
+        }
+    }
+    let bootstrap = match a.from {
+        Some(FromArg::Bootstrap) => true,
+        Some(FromArg::Covariance) => false,
+        None => fit.resampling.as_ref().is_some_and(|r| r.fitted > 1),
+    };
+    let context = || format!("{}", a.fit.display());
+    if bootstrap {
+        if !a.hold.is_empty() {
+            bail!("--hold: the bootstrap replicates are drawn as they are (use --from covariance)");
+        }
+        let d = draws::from_bootstrap(fit).with_context(context)?;
+        return Ok((DrawSource::Bootstrap, d));
+    }
+    let d = draws::from_covariance(fit, &a.hold, a.draws, a.seed).with_context(context)?;
+    Ok((DrawSource::Covariance, d))
+}
+
+fn fitted(fit: &IdentifyResult) -> String {
+    fit.parameters
+        .keys()
+        .cloned()
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Before (the model as it is) and after (with the settings) for each test.
+fn cases(a: &Args, p: &Params) -> anyhow::Result<Vec<Case>> {
+    let mut after = PositioningTest::standard(p.axis);
+    if a.runs < 2 || a.runs > 100 {
+        bail!("--runs {}: from 2 (ISO 230-2) to 100", a.runs);
+    }
+    after.runs = a.runs;
+    let before = after.clone();
+    if let Some(path) = &a.compensation {
+        let file = compensation_file::read(path)?;
+        file.check_axis(path, p.axis)?;
+        after.compensation = file.compensation;
+    }
+    let tuned = a
+        .tune
+        .as_deref()
+        .map(|t| tuned_controller(t, p))
+        .transpose()?;
+    for test in a.tests.split(',').map(str::trim) {
+        if test != "positioning" {
+            bail!("--tests {test}: not a test prediction runs (positioning)");
+        }
+    }
+    let case = |label: &str, test: PositioningTest| Case {
+        label: label.to_string(),
+        test: Test::Positioning { test, axis: p.axis },
+        controller: None,
+    };
+    let mut out = vec![case("before", before)];
+    if a.compensation.is_some() || tuned.is_some() {
+        let mut c = case("after", after);
+        c.controller = tuned;
+        out.push(c);
+    }
+    Ok(out)
+}
+
+/// The controller settings of a tuned parameter file (`rtid tune -o`) for model `p`.
+pub(crate) fn tuned_controller(path: &Path, p: &Params) -> anyhow::Result<ControllerParams> {
+    let tuned = params_file::read(path)?;
+    if tuned.topology != p.topology || tuned.axis != p.axis {
+        bail!(
+            "--tune {}: a {:?} {:?} drive's settings for a {:?} {:?} model",
+            path.display(),
+            tuned.topology,
+            tuned.axis,
+            p.topology,
+            p.axis
+        );
+    }
+    Ok(tuned.controller)
+}
+
+fn print(a: &Args, p: &Prediction, params: &Params) {
+    let source = match p.source {
+        DrawSource::Covariance => "normal draws from the fit's standard errors and correlations",
+        DrawSource::Bootstrap => "the fit's bootstrap replicates",
+    };
+    println!(
+        "{}: {} of {} parameter sets ({source}; {} drawn: {}), {} % central intervals",
+        a.fit.display(),
+        p.completed,
+        p.asked,
+        p.drawn.len(),
+        p.drawn.join(", "),
+        Num(p.level * 100.0)
+    );
+    println!("{}", table(p));
+    if !a.quiet {
+        notes(p, params);
+    }
+}
+
+fn table(p: &Prediction) -> Table {
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    let mut header = vec![format!("positioning, {}", p.cases[0].unit)];
+    header.extend(p.cases.iter().map(|c| c.case.clone()));
+    t.set_header(header);
+    for (k, v) in p.cases[0].values.iter().enumerate() {
+        let mut row = vec![v.name.replace("B_mean", "B̄")];
+        row.extend(p.cases.iter().map(|c| cell(&c.values[k])));
+        t.add_row(row);
+    }
+    t
+}
+
+fn cell(v: &prediction::Predicted) -> String {
+    match (v.lower, v.upper) {
+        (Some(lo), Some(hi)) => format!("{:.2} [{:.2} … {:.2}]", v.nominal, lo, hi),
+        _ => format!("{:.2} (no interval)", v.nominal),
+    }
+}
+
+fn notes(p: &Prediction, params: &Params) {
+    if !p.held.is_empty() {
+        eprintln!(
+            "note: held at the fit's values, not drawn: {}",
+            p.held.join(", ")
+        );
+    }
+    let fixed = p.conditional_on(params);
+    eprintln!(
+        "note: the intervals carry the uncertainty of {} only; the model's other {} parameters keep their values, which these intervals take as exact",
+        p.drawn.join(", "),
+        fixed.len()
+    );
+    if p.rejected > 0 {
+        eprintln!(
+            "note: {} normal draws fell outside the fit's bounds and were drawn again",
+            p.rejected
+        );
+    }
+    for n in &p.notes {
+        eprintln!("note: {n}");
+    }
+}

@@ -1,0 +1,295 @@
+//! The effect of settings predicted on an identified model, with the fit's
+//! uncertainty carried through (`rtid predict`): parameter sets drawn from the fit
+//! ([`draws`]), a virtual test run on each with and without the settings
+//! ([`cases`]), and each output's value at the fit with the interval the draws give.
+//!
+//! The interval is that of the fitted parameters only: every parameter the fit did not
+//! vary keeps its value, and the prediction holds for the model as far as those
+//! values hold. [`Prediction::conditional_on`] names them.
+
+pub mod cases;
+pub mod draws;
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use rayon::prelude::*;
+
+use crate::model::{ParamError, Params};
+pub use cases::{Case, CaseError, Output, Test};
+pub use draws::{DrawSource, Draws};
+
+/// Why a prediction could not be made.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PredictError {
+    #[error("the fit has no standard errors to draw from (a fit without uncertainty, or interrupted): run identify to the end, or use its bootstrap replicates")]
+    NoUncertainty,
+    #[error("the fit has no bootstrap replicates (run `rtid identify --resample N`)")]
+    NoReplicates,
+    #[error("`{name}` has no standard error: the data did not determine it, so no interval can carry its uncertainty (hold it at its value with --hold {name}, and read the interval as conditional on it)")]
+    NotDetermined { name: String },
+    #[error("{rejected} draws fell outside the fit's bounds before enough fell inside: the standard errors are too large for the bounds (a parameter the data barely determine)")]
+    OutsideBounds { rejected: usize },
+    #[error("the level {0} is not in (0, 1)")]
+    Level(f64),
+    #[error("parameter set at the fit: {0}")]
+    Params(#[from] ParamError),
+    #[error("the {case} test at the fit's values: {source}")]
+    Nominal { case: String, source: CaseError },
+    #[error("{failed} of {total} drawn parameter sets failed to simulate (first: {first}): the fit's uncertainty reaches parameters the model cannot run")]
+    Failed {
+        failed: usize,
+        total: usize,
+        first: String,
+    },
+}
+
+/// One output's prediction: its value at the fit, and the draws' median and central
+/// interval (absent with fewer than [`MIN_DRAWS`] completed draws).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Predicted {
+    pub name: String,
+    pub nominal: f64,
+    pub median: Option<f64>,
+    pub lower: Option<f64>,
+    pub upper: Option<f64>,
+}
+
+/// The outputs of one case (a test with or without the settings), in `unit`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CasePrediction {
+    pub case: String,
+    pub unit: String,
+    pub values: Vec<Predicted>,
+}
+
+/// A prediction.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Prediction {
+    pub source: DrawSource,
+    /// Central interval's probability (0.95).
+    pub level: f64,
+    /// Draws asked for, completed (Ctrl-C may stop early), and thrown away outside
+    /// the bounds.
+    pub asked: usize,
+    pub completed: usize,
+    pub rejected: usize,
+    /// The parameters drawn, and the fitted ones held at their values.
+    pub drawn: Vec<String>,
+    pub held: Vec<String>,
+    pub cases: Vec<CasePrediction>,
+    /// What the interval does not include, and why draws are missing.
+    pub notes: Vec<String>,
+}
+
+/// Fewest completed draws that give an interval.
+pub const MIN_DRAWS: usize = 10;
+
+/// What a prediction runs on.
+pub struct Setup<'a> {
+    /// The identified model (the fit's values in it).
+    pub params: &'a Params,
+    pub draws: &'a Draws,
+    pub source: DrawSource,
+    pub held: Vec<String>,
+    pub level: f64,
+    pub cases: &'a [Case],
+}
+
+/// Runs every case at the fit and on every drawn set (in parallel), `progress` called
+/// after each draw; `stop` ends it early with the draws done.
+pub fn predict(
+    s: &Setup,
+    progress: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> Result<Prediction, PredictError> {
+    if !(s.level > 0.0 && s.level < 1.0) {
+        return Err(PredictError::Level(s.level));
+    }
+    let nominal = s
+        .cases
+        .iter()
+        .map(|c| {
+            c.run(s.params).map_err(|source| PredictError::Nominal {
+                case: c.label.clone(),
+                source,
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let skipped = AtomicUsize::new(0);
+    let runs: Vec<Result<Vec<Vec<Output>>, String>> = s
+        .draws
+        .sets
+        .par_iter()
+        .filter_map(|set| {
+            if stop.load(Ordering::Relaxed) {
+                skipped.fetch_add(1, Ordering::Relaxed);
+                return None;
+            }
+            let r = run_draw(s, set);
+            progress();
+            Some(r)
+        })
+        .collect();
+    let total = runs.len();
+    let (done, failures): (Vec<_>, Vec<_>) = runs.into_iter().partition(Result::is_ok);
+    let failures: Vec<String> = failures.into_iter().filter_map(Result::err).collect();
+    if failures.len() * 10 > total.max(1) {
+        return Err(PredictError::Failed {
+            failed: failures.len(),
+            total,
+            first: failures[0].clone(),
+        });
+    }
+    let done: Vec<Vec<Vec<Output>>> = done.into_iter().filter_map(Result::ok).collect();
+    let mut notes = Vec::new();
+    note_missing(&mut notes, failures.len(), skipped.into_inner(), done.len());
+    let cases = summarise(s, &nominal, &done);
+    note_rough(&mut notes, &cases);
+    Ok(Prediction {
+        source: s.source,
+        level: s.level,
+        asked: s.draws.sets.len(),
+        completed: done.len(),
+        rejected: s.draws.rejected,
+        drawn: s.draws.names.clone(),
+        held: s.held.clone(),
+        cases,
+        notes,
+    })
+}
+
+impl Prediction {
+    /// The parameters the prediction rests on without their uncertainty: every
+    /// registry parameter of `params` neither drawn nor held (their values as given).
+    pub fn conditional_on(&self, params: &Params) -> Vec<String> {
+        crate::model::registry::PARAMS
+            .iter()
+            .map(|d| d.name)
+            .filter(|n| params.get(n).is_ok())
+            .filter(|n| !self.drawn.iter().any(|d| d == n) && !self.held.iter().any(|h| h == n))
+            .map(str::to_string)
+            .collect()
+    }
+}
+
+/// Every case on one drawn set.
+fn run_draw(s: &Setup, set: &[f64]) -> Result<Vec<Vec<Output>>, String> {
+    let mut p = s.params.clone();
+    for (name, &v) in s.draws.names.iter().zip(set) {
+        p.set(name, v).map_err(|e| e.to_string())?;
+    }
+    p.validate().map_err(|e| e.to_string())?;
+    s.cases
+        .iter()
+        .map(|c| c.run(&p).map_err(|e| format!("{}: {e}", c.label)))
+        .collect()
+}
+
+fn note_missing(notes: &mut Vec<String>, failed: usize, skipped: usize, done: usize) {
+    if failed > 0 {
+        notes.push(format!(
+            "{failed} drawn sets failed to simulate and are left out"
+        ));
+    }
+    if skipped > 0 {
+        notes.push(format!("stopped: {skipped} draws not run"));
+    }
+    if done < MIN_DRAWS {
+        notes.push(format!(
+            "{done} draws completed, fewer than {MIN_DRAWS}: no interval"
+        ));
+    }
+}
+
+/// Names each output whose value at the fit lies outside the draws' interval: one
+/// that jumps with the parameters (where the axis sticks, how it rattles in the
+/// backlash) rather than following them smoothly.
+fn note_rough(notes: &mut Vec<String>, cases: &[CasePrediction]) {
+    let rough: Vec<String> = cases
+        .iter()
+        .flat_map(|c| {
+            c.values
+                .iter()
+                .filter_map(move |v| match (v.lower, v.upper) {
+                    (Some(lo), Some(hi)) if outside(v.nominal, lo, hi) => {
+                        Some(format!("{} {}", v.name, c.case))
+                    }
+                    _ => None,
+                })
+        })
+        .collect();
+    if !rough.is_empty() {
+        notes.push(format!(
+            "the value at the fit lies outside the draws' interval for {}: these outputs jump \
+             with small changes of the parameters (where the axis sticks, how it rattles in the \
+             backlash); read their interval as the spread the fit's uncertainty allows, not as \
+             an interval around the value at the fit",
+            rough.join(", ")
+        ));
+    }
+}
+
+/// Whether `x` lies outside [lo, hi] by more than rounding (quantised outputs repeat
+/// one value exactly, summed in different orders).
+fn outside(x: f64, lo: f64, hi: f64) -> bool {
+    let slack = 1e-9 * x.abs().max(1.0);
+    x < lo - slack || x > hi + slack
+}
+
+/// Each case's outputs: value at the fit, the draws' median and central interval.
+fn summarise(s: &Setup, nominal: &[Vec<Output>], done: &[Vec<Vec<Output>>]) -> Vec<CasePrediction> {
+    let tail = (1.0 - s.level) / 2.0;
+    s.cases
+        .iter()
+        .enumerate()
+        .map(|(c, case)| CasePrediction {
+            case: case.label.clone(),
+            unit: case.unit().to_string(),
+            values: nominal[c]
+                .iter()
+                .enumerate()
+                .map(|(k, out)| {
+                    let mut v: Vec<f64> = done.iter().map(|d| d[c][k].value).collect();
+                    v.sort_by(f64::total_cmp);
+                    let at = |q: f64| (v.len() >= MIN_DRAWS).then(|| quantile(&v, q));
+                    Predicted {
+                        name: out.name.to_string(),
+                        nominal: out.value,
+                        median: at(0.5),
+                        lower: at(tail),
+                        upper: at(1.0 - tail),
+                    }
+                })
+                .collect(),
+        })
+        .collect()
+}
+
+/// The `q` quantile of sorted values, linear between order statistics (type 7).
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    let h = (sorted.len() - 1) as f64 * q;
+    let (i, f) = (h.floor() as usize, h - h.floor());
+    let next = sorted[(i + 1).min(sorted.len() - 1)];
+    sorted[i] + f * (next - sorted[i])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_value_at_an_end_of_the_interval_is_inside() {
+        assert!(!outside(36.0 - 1e-12, 36.0, 37.0));
+        assert!(outside(35.9, 36.0, 37.0) && outside(37.1, 36.0, 37.0));
+    }
+
+    #[test]
+    fn quantiles_interpolate_between_order_statistics() {
+        let v = [1.0, 2.0, 3.0, 4.0, 5.0];
+        assert_eq!(quantile(&v, 0.5), 3.0);
+        assert_eq!(quantile(&v, 0.0), 1.0);
+        assert_eq!(quantile(&v, 1.0), 5.0);
+        assert!((quantile(&v, 0.125) - 1.5).abs() < 1e-15);
+    }
+}

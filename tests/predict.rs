@@ -1,0 +1,282 @@
+//! From an identification to the machine's compensation and its predicted effect: the
+//! worm-gear preset's backlash and frictions identified from its shipped experiments
+//! (fixtures/predict/worm-gear/fit.json), `rtid compensate --fit` on the identified
+//! model, `rtid predict` with the fit's uncertainty, and the virtual test on the
+//! preset itself (the "real" drive here) with that compensation.
+
+use std::path::{Path, PathBuf};
+
+use crate::cli_support::{err, ok, root, rtid};
+
+fn fit() -> PathBuf {
+    root().join("fixtures/predict/worm-gear/fit.json")
+}
+
+fn json(out: &std::process::Output) -> serde_json::Value {
+    serde_json::from_str(&ok(out)).unwrap()
+}
+
+/// `compensate --fit` into `dir`/compensation.json.
+fn compensate(dir: &Path) -> serde_json::Value {
+    let fit = fit();
+    let out = rtid(
+        &[
+            "compensate",
+            "--fit",
+            fit.to_str().unwrap(),
+            "--preset",
+            "worm-gear",
+            "-o",
+            "compensation.json",
+            "--json",
+        ],
+        dir,
+    );
+    json(&out)
+}
+
+/// `predict` of the shipped fit with the compensation of `dir`, 2 runs, `draws`
+/// draws, then `extra`.
+fn predict(dir: &Path, draws: &str, extra: &[&str]) -> std::process::Output {
+    let fit = fit();
+    let mut args = vec![
+        "predict",
+        fit.to_str().unwrap(),
+        "--preset",
+        "worm-gear",
+        "--compensation",
+        "compensation.json",
+        "--draws",
+        draws,
+        "--runs",
+        "2",
+    ];
+    args.extend_from_slice(extra);
+    rtid(&args, dir)
+}
+
+/// One predicted value: (at the fit, lower, upper).
+fn predicted(p: &serde_json::Value, case: &str, name: &str) -> (f64, f64, f64) {
+    let case = p["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["case"] == case)
+        .unwrap();
+    let v = case["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|v| v["name"] == name)
+        .unwrap();
+    let f = |k: &str| v[k].as_f64().unwrap();
+    (f("nominal"), f("lower"), f("upper"))
+}
+
+/// The ISO 230-2 axis values of the preset's own positioning test, 2 runs, with the
+/// compensation of `dir`, arc-seconds.
+fn preset_with_compensation(dir: &Path) -> serde_json::Value {
+    let out = rtid(
+        &[
+            "experiment",
+            "positioning",
+            "--preset",
+            "worm-gear",
+            "--runs",
+            "2",
+            "--compensation",
+            "compensation.json",
+            "--out",
+            "real",
+            "--json",
+        ],
+        dir,
+    );
+    json(&out)["axis"].clone()
+}
+
+#[test]
+fn the_fit_compensates_the_preset_and_the_prediction_holds_what_its_test_shows() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = compensate(dir.path());
+    // The identified model's own reversal: the preset's B̄ −35″ (docs/compensation.md).
+    let backlash = c["backlash"].as_f64().unwrap();
+    assert!((-36.0..-34.0).contains(&backlash), "{backlash}");
+    let out = predict(dir.path(), "12", &["--json"]);
+    let p = json(&out);
+    assert_eq!(p["completed"], 12);
+    assert_eq!(p["drawn"], serde_json::json!(["theta_bw", "fm", "fw"]));
+    let real = preset_with_compensation(dir.path());
+    let (b_before, _, _) = predicted(&p, "before", "B_mean");
+    let (a_before, _, _) = predicted(&p, "before", "A");
+    for name in ["B_mean", "A"] {
+        let (at_fit, lo, hi) = predicted(&p, "after", name);
+        let shown = real[name].as_f64().unwrap();
+        assert!(
+            lo <= shown && shown <= hi,
+            "{name}: the preset shows {shown}″, predicted {at_fit} [{lo} … {hi}]"
+        );
+    }
+    let b = real["B_mean"].as_f64().unwrap();
+    assert!(b.abs() < 2.0 && b_before < -34.0, "B̄ {b_before} → {b}″");
+    let a = real["A"].as_f64().unwrap();
+    assert!(a < 0.5 * a_before, "A {a_before} → {a}″");
+}
+
+#[test]
+fn the_model_s_friction_compensation_is_its_lumped_law() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = rtid(
+        &[
+            "compensate",
+            "--preset",
+            "worm-gear",
+            "--friction",
+            "--json",
+        ],
+        dir.path(),
+    );
+    let f = json(&out)["friction"].clone();
+    // fm + Rg·fw + Rg·Rw·ft and Cm + Rg²·Cw + (Rg·Rw)²·Ct of the preset.
+    let p = rtid::preset("worm-gear").unwrap();
+    let (rg, rw) = (p.rg.unwrap(), p.rw);
+    let coulomb = p.fm + rg * p.fw + rg * rw * p.ft;
+    let viscous = p.cm + rg * rg * p.cw + (rg * rw).powi(2) * p.ct;
+    let got = (
+        f["coulomb"].as_f64().unwrap(),
+        f["viscous"].as_f64().unwrap(),
+    );
+    assert!(
+        (got.0 / coulomb - 1.0).abs() < 1e-6,
+        "{got:?} against {coulomb}"
+    );
+    assert!(
+        (got.1 / viscous - 1.0).abs() < 1e-6,
+        "{got:?} against {viscous}"
+    );
+}
+
+#[test]
+fn a_parameter_the_data_did_not_determine_is_refused_until_held() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut fit: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fit()).unwrap()).unwrap();
+    fit["uncertainty"]["standard_errors"][1][1] = serde_json::Value::Null;
+    std::fs::write(dir.path().join("fit.json"), fit.to_string()).unwrap();
+    let args = [
+        "predict",
+        "fit.json",
+        "--preset",
+        "worm-gear",
+        "--draws",
+        "10",
+        "--runs",
+        "2",
+    ];
+    let e = err(&rtid(&args, dir.path()));
+    assert!(
+        e.contains("`fm` has no standard error") && e.contains("--hold fm"),
+        "{e}"
+    );
+    let mut held = args.to_vec();
+    held.extend(["--hold", "fm", "--json"]);
+    let p = json(&rtid(&held, dir.path()));
+    assert_eq!(p["held"], serde_json::json!(["fm"]));
+    assert_eq!(p["drawn"], serde_json::json!(["theta_bw", "fw"]));
+    // Only "before": nothing to predict the effect of.
+    assert_eq!(p["cases"].as_array().unwrap().len(), 1);
+}
+
+#[test]
+fn bad_predict_options_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let fit = fit();
+    let f = fit.to_str().unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (&["--draws", "3"], "--draws 3"),
+        (&["--hold", "Kw"], "--hold Kw: not a parameter of the fit"),
+        (&["--tests", "servo"], "--tests servo"),
+        (&["--level", "1.5"], "level 1.5"),
+        (&["--from", "bootstrap"], "no bootstrap replicates"),
+    ];
+    for (extra, want) in cases {
+        let mut args = vec!["predict", f, "--preset", "worm-gear"];
+        args.extend_from_slice(extra);
+        let e = err(&rtid(&args, dir.path()));
+        assert!(e.contains(want), "{extra:?}: {e}");
+    }
+    let cargo = root().join("Cargo.toml");
+    let e = err(&rtid(
+        &["predict", cargo.to_str().unwrap(), "--preset", "worm-gear"],
+        dir.path(),
+    ));
+    assert!(e.contains("not an identification result"), "{e}");
+}
+
+/// The shipped fit is what rtid's identification of the shipped experiments gives.
+#[cfg(feature = "slow-tests")]
+#[test]
+fn the_shipped_fit_is_rtid_s_identification() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = root().join("fixtures/worm-gear");
+    let (tc, ub) = (exp.join("torque_curve.json"), exp.join("unbalance.json"));
+    let out = rtid(
+        &[
+            "identify",
+            tc.to_str().unwrap(),
+            ub.to_str().unwrap(),
+            "--preset",
+            "worm-gear",
+            "--fit",
+            "theta_bw,fm,fw",
+            "--out",
+            "fit.json",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    ok(&out);
+    let read = |p: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    };
+    let (got, shipped) = (read(&dir.path().join("fit.json")), read(&fit()));
+    for name in ["theta_bw", "fm", "fw"] {
+        let (g, s) = (
+            got["parameters"][name].as_f64().unwrap(),
+            shipped["parameters"][name].as_f64().unwrap(),
+        );
+        assert!((g / s - 1.0).abs() < 1e-9, "{name}: {g} against {s}");
+    }
+    assert_eq!(got["uncertainty"], shipped["uncertainty"]);
+}
+
+#[test]
+fn the_report_puts_the_prediction_beside_the_records() {
+    let dir = tempfile::tempdir().unwrap();
+    compensate(dir.path());
+    let out = predict(dir.path(), "10", &["-o", "prediction.json", "--quiet"]);
+    ok(&out);
+    preset_with_compensation(dir.path());
+    let out = rtid(
+        &[
+            "report",
+            "prediction.json",
+            "real/positioning.json",
+            "--out",
+            "report.html",
+            "--json",
+        ],
+        dir.path(),
+    );
+    let kinds: Vec<String> = json(&out)["sections"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["kind"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(kinds, ["prediction", "positioning", "prediction"]);
+    let page = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
+    assert!(page.contains("Before, after and predicted"));
+    assert!(page.contains("after predicted (prediction.json)"));
+    assert!(page.contains("measured (real/positioning.json)"));
+}
