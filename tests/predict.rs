@@ -119,6 +119,34 @@ fn the_fit_compensates_the_preset_and_the_prediction_holds_what_its_test_shows()
     }
     let b = real["B_mean"].as_f64().unwrap();
     assert!(b.abs() < 2.0 && b_before < -34.0, "B̄ {b_before} → {b}″");
+    // The value at the fit is the virtual test on the identified model with it.
+    let fit = fit();
+    let identified = json(&rtid(
+        &[
+            "experiment",
+            "positioning",
+            "--preset",
+            "worm-gear",
+            "--fit",
+            fit.to_str().unwrap(),
+            "--runs",
+            "2",
+            "--compensation",
+            "compensation.json",
+            "--out",
+            "identified",
+            "--json",
+        ],
+        dir.path(),
+    ));
+    for name in ["B_mean", "A"] {
+        let (at_fit, _, _) = predicted(&p, "after", name);
+        let shown = identified["axis"][name].as_f64().unwrap();
+        assert!(
+            (at_fit - shown).abs() < 1e-9,
+            "{name}: {at_fit} against {shown}"
+        );
+    }
     let a = real["A"].as_f64().unwrap();
     assert!(a < 0.5 * a_before, "A {a_before} → {a}″");
 }

@@ -9,12 +9,11 @@ use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::common::inputs::refuse_overwrite;
-use crate::cli::common::{interrupt, progress};
+use crate::cli::common::{interrupt, model_args, progress};
 use crate::cli::ModelArgs;
 use rtid::experiments::positioning::PositioningTest;
 use rtid::identify::result::IdentifyResult;
-use rtid::io::{compensation_file, params_file};
-use rtid::model::params::ControllerParams;
+use rtid::io::compensation_file;
 use rtid::model::Params;
 use rtid::names::Num;
 use rtid::prediction::{self, draws, Case, DrawSource, Prediction, Setup, Test};
@@ -102,8 +101,8 @@ const MAX_DRAWS: usize = 100_000;
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     refuse_outputs(&a)?;
-    let fit = read_fit(&a.fit)?;
-    let params = model(&a, &fit)?;
+    let fit = model_args::read_fit(&a.fit)?;
+    let params = model(&a)?;
     let (source, draws) = draws(&a, &fit)?;
     let cases = cases(&a, &params)?;
     let stop = Arc::new(AtomicBool::new(false));
@@ -142,25 +141,9 @@ fn refuse_outputs(a: &Args) -> anyhow::Result<()> {
     refuse_overwrite("-o", out, &inputs)
 }
 
-pub(crate) fn read_fit(path: &Path) -> anyhow::Result<IdentifyResult> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    serde_json::from_str(&text).with_context(|| {
-        format!(
-            "{}: not an identification result (rtid identify --out)",
-            path.display()
-        )
-    })
-}
-
 /// The base set with the fit's values, and the tuned controller with --tune.
-fn model(a: &Args, fit: &IdentifyResult) -> anyhow::Result<Params> {
-    let mut p = a.model.load()?;
-    fit.apply_to(&mut p)
-        .with_context(|| format!("{}: its values on the model", a.fit.display()))?;
-    p.validate()
-        .with_context(|| format!("{}: its values on the model", a.fit.display()))?;
-    Ok(p)
+fn model(a: &Args) -> anyhow::Result<Params> {
+    model_args::fitted(&a.model, Some(&a.fit), None)
 }
 
 fn draws(a: &Args, fit: &IdentifyResult) -> anyhow::Result<(DrawSource, draws::Draws)> {
@@ -220,7 +203,7 @@ fn cases(a: &Args, p: &Params) -> anyhow::Result<Vec<Case>> {
     let tuned = a
         .tune
         .as_deref()
-        .map(|t| tuned_controller(t, p))
+        .map(|t| model_args::tuned_controller(t, p))
         .transpose()?;
     for test in a.tests.split(',').map(str::trim) {
         if test != "positioning" {
@@ -239,22 +222,6 @@ fn cases(a: &Args, p: &Params) -> anyhow::Result<Vec<Case>> {
         out.push(c);
     }
     Ok(out)
-}
-
-/// The controller settings of a tuned parameter file (`rtid tune -o`) for model `p`.
-pub(crate) fn tuned_controller(path: &Path, p: &Params) -> anyhow::Result<ControllerParams> {
-    let tuned = params_file::read(path)?;
-    if tuned.topology != p.topology || tuned.axis != p.axis {
-        bail!(
-            "--tune {}: a {:?} {:?} drive's settings for a {:?} {:?} model",
-            path.display(),
-            tuned.topology,
-            tuned.axis,
-            p.topology,
-            p.axis
-        );
-    }
-    Ok(tuned.controller)
 }
 
 fn print(a: &Args, p: &Prediction, params: &Params) {

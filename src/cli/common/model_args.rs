@@ -1,11 +1,13 @@
 //! `--preset`, `--params`, `--set`: the mechanism every command works on.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use clap::Args;
 
+use rtid::identify::result::IdentifyResult;
 use rtid::io::params_file;
+use rtid::model::params::ControllerParams;
 use rtid::model::{presets, Params};
 
 /// Which parameter set to use, and overrides.
@@ -47,6 +49,55 @@ impl ModelArgs {
         p.validate().context("after --set")?;
         Ok(p)
     }
+}
+
+/// The identified model with its settings: the set `model` names, the values of the
+/// identification result `fit` set in it, and the controller settings of the tuned
+/// parameter file `tune` (`rtid tune -o`).
+pub fn fitted(
+    model: &ModelArgs,
+    fit: Option<&Path>,
+    tune: Option<&Path>,
+) -> anyhow::Result<Params> {
+    let mut p = model.load()?;
+    if let Some(path) = fit {
+        read_fit(path)?
+            .apply_to(&mut p)
+            .and_then(|()| p.validate())
+            .with_context(|| format!("{}: its values on the model", path.display()))?;
+    }
+    if let Some(path) = tune {
+        p.controller = tuned_controller(path, &p)?;
+    }
+    Ok(p)
+}
+
+/// An identification result (`rtid identify --out`).
+pub fn read_fit(path: &Path) -> anyhow::Result<IdentifyResult> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    serde_json::from_str(&text).with_context(|| {
+        format!(
+            "{}: not an identification result (rtid identify --out)",
+            path.display()
+        )
+    })
+}
+
+/// The controller settings of a tuned parameter file (`rtid tune -o`) for model `p`.
+pub fn tuned_controller(path: &Path, p: &Params) -> anyhow::Result<ControllerParams> {
+    let tuned = params_file::read(path)?;
+    if tuned.topology != p.topology || tuned.axis != p.axis {
+        bail!(
+            "--tune {}: a {:?} {:?} drive's settings for a {:?} {:?} model",
+            path.display(),
+            tuned.topology,
+            tuned.axis,
+            p.topology,
+            p.axis
+        );
+    }
+    Ok(tuned.controller)
 }
 
 /// `NAME=VALUE` with a finite number.

@@ -6,7 +6,6 @@
 use anyhow::{bail, Context};
 
 use super::Args;
-use crate::cli::predict::read_fit;
 use rtid::controller::FrictionCompensation;
 use rtid::estimation::friction_law::LawFit;
 use rtid::experiments::friction_map::{self, steady::model_map, MapTest};
@@ -17,17 +16,7 @@ use rtid::model::Params;
 /// The identified model: the base set (--preset, --params) with the fit's values and
 /// the tuned controller (--tune).
 pub fn params(a: &Args) -> anyhow::Result<Params> {
-    let mut p = a.model.load()?;
-    if let Some(path) = &a.fit {
-        let fit = read_fit(path)?;
-        fit.apply_to(&mut p)
-            .and_then(|()| p.validate())
-            .with_context(|| format!("{}: its values on the model", path.display()))?;
-    }
-    if let Some(path) = &a.tune {
-        p.controller = crate::cli::predict::tuned_controller(path, &p)?;
-    }
-    Ok(p)
+    crate::cli::common::model_args::fitted(&a.model, a.fit.as_deref(), a.tune.as_deref())
 }
 
 /// The model's name in messages: the fit, else the parameter file or preset.

@@ -156,7 +156,7 @@ impl Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let p = a.common.model.load()?;
+    let p = a.common.params()?;
     let test = a.test()?;
     a.common.create_out()?;
     let response = Response::from(a.response);

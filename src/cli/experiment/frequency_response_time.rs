@@ -161,7 +161,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let p = a.common.model.load()?;
+    let p = a.common.params()?;
     let test = a.test()?;
     a.common.create_out()?;
     let bar = progress::bar(test.duration().ceil() as u64, "simulated s", a.common.quiet);

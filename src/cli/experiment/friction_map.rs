@@ -100,7 +100,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let p = a.common.model.load()?;
+    let p = a.common.params()?;
     let test = test(&a, &p)?;
     check::work(
         test.duration(&p),

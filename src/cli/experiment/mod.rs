@@ -61,6 +61,14 @@ pub enum Test {
 pub struct Common {
     #[command(flatten)]
     pub model: ModelArgs,
+    /// An identification result (`rtid identify --out`): its values set in the model
+    /// (--preset or --params, the base the fit started from) — the test on the
+    /// identified model.
+    #[arg(long, value_name = "FIT.json")]
+    pub fit: Option<PathBuf>,
+    /// A tuned parameter file (`rtid tune -o`): the test with its controller settings.
+    #[arg(long, value_name = "FILE")]
+    pub tune: Option<PathBuf>,
     /// Folder for the manifest, CSV and plot (created if missing).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -77,6 +85,27 @@ pub struct Common {
 pub type Report = fn(&Experiment, &Plot, bool) -> anyhow::Result<()>;
 
 impl Common {
+    /// The model the test runs on: the named set, with --fit's values and --tune's
+    /// controller.
+    pub fn params(&self) -> anyhow::Result<rtid::Params> {
+        crate::cli::common::model_args::fitted(
+            &self.model,
+            self.fit.as_deref(),
+            self.tune.as_deref(),
+        )
+    }
+
+    /// The files the test reads (no output may overwrite them).
+    fn inputs(&self) -> Vec<&Path> {
+        self.model
+            .params
+            .iter()
+            .chain(&self.fit)
+            .chain(&self.tune)
+            .map(PathBuf::as_path)
+            .collect()
+    }
+
     /// Writes the test's experiment file as `STEM.json` + `STEM.csv` in the output
     /// folder, reads it back — so the report is exactly what `rtid evaluate` says of
     /// the file — and reports it with the plot `STEM.svg`.
@@ -88,19 +117,16 @@ impl Common {
         report: Report,
     ) -> anyhow::Result<()> {
         let path = self.out.join(format!("{stem}.json"));
-        if let Some(params) = &self.model.params {
-            for ext in ["json", "csv", "svg"] {
-                let output = self.out.join(format!("{stem}.{ext}"));
-                crate::cli::common::inputs::refuse_overwrite("--out", &output, &[params])?;
-            }
+        for ext in ["json", "csv", "svg"] {
+            let output = self.out.join(format!("{stem}.{ext}"));
+            crate::cli::common::inputs::refuse_overwrite("--out", &output, &self.inputs())?;
         }
         manifest.data = Some(format!("{stem}.csv"));
         experiment_file::write(&path, &manifest, data)?;
         let plot = self.out.join(format!("{stem}.svg"));
-        let inputs: Vec<&Path> = self.model.params.iter().map(PathBuf::as_path).collect();
         report(
             &experiment_file::read(&path)?,
-            &Plot::at(plot, &inputs)?,
+            &Plot::at(plot, &self.inputs())?,
             self.json,
         )
     }

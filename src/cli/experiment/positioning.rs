@@ -88,7 +88,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let p = a.common.model.load()?;
+    let p = a.common.params()?;
     let test = test(&a, p.axis)?;
     check::work(
         test.duration(),

@@ -153,7 +153,7 @@ fn moves(a: &Args) -> anyhow::Result<TrapezoidalMoves> {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let p = a.common.model.load()?;
+    let p = a.common.params()?;
     let m = moves(&a)?;
     check::work(
         m.duration(),

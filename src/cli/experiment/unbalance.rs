@@ -46,7 +46,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let p = a.common.model.load()?;
+    let p = a.common.params()?;
     a.common.create_out()?;
     let own = p.unbalance_mass > 0.0 && p.unbalance_radius > 0.0;
     let (mass, radius) = match (a.mass_kg, a.radius_m) {
