@@ -76,6 +76,9 @@ pub struct Figure {
     pub y_label: String,
     pub series: Vec<Series>,
     pub x_scale: Scale,
+    /// Values the x axis spans at least, drawn or not (a phase plot on its gain
+    /// plot's frequency range).
+    pub x_extent: Option<(f64, f64)>,
     /// One unit is as long on the y axis as on the x axis (a Nyquist plot: a mode's
     /// circle stays a circle). Applies to the first panel of a figure with one only.
     pub equal_axes: bool,
@@ -115,6 +118,7 @@ impl Figure {
             y_label: y_label.into(),
             series: Vec::new(),
             x_scale: Scale::Linear,
+            x_extent: None,
             equal_axes: false,
             lower: None,
         }
@@ -129,6 +133,12 @@ impl Figure {
     /// The same figure on a logarithmic x axis.
     pub fn log_x(mut self) -> Self {
         self.x_scale = Scale::Log;
+        self
+    }
+
+    /// The same figure with its x axis spanning at least `lo` to `hi`.
+    pub fn spanning(mut self, lo: f64, hi: f64) -> Self {
+        self.x_extent = Some((lo, hi));
         self
     }
 
@@ -226,7 +236,13 @@ pub(crate) fn frame(figure: &Figure) -> Result<Frame, FigureError> {
         .iter()
         .map(|s| s.iter().flat_map(|s| drawn(&s.points, log)).collect())
         .collect();
-    let x = axis::span(panels.iter().flatten().map(|p| p.0)).ok_or_else(empty)?;
+    let extent = drawn(
+        &figure
+            .x_extent
+            .map_or(vec![], |(a, b)| vec![(a, 0.0), (b, 0.0)]),
+        log,
+    );
+    let x = axis::span(panels.iter().flatten().chain(&extent).map(|p| p.0)).ok_or_else(empty)?;
     let x = if log {
         axis::padded_log(x)
     } else {
@@ -506,6 +522,23 @@ mod tests {
         // Both panels: the gain's and the phase's y labels; one legend entry for L.
         assert!(svg.contains("gain, dB") && svg.contains("phase, deg"));
         assert_eq!(svg.matches(">\nL\n<").count(), 1);
+    }
+
+    #[test]
+    fn an_extent_widens_the_x_axis() {
+        let f = Figure::new("t", "f", "y")
+            .with(Series::new(
+                "s",
+                vec![(10.0, 0.0), (20.0, 1.0)],
+                Style::Line,
+            ))
+            .log_x();
+        let narrow = frame(&f).unwrap().x;
+        let wide = frame(&f.spanning(1.0, 1000.0)).unwrap().x;
+        assert!(
+            narrow.start > 0.9 && wide.start < 0.0 && wide.end > 3.0,
+            "{wide:?}"
+        );
     }
 
     #[test]

@@ -7,7 +7,7 @@ use std::ops::Range;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 
 /// The ticks drawn at most on a linear axis.
-const LINEAR_TICKS: f64 = 8.0;
+const LINEAR_TICKS: f64 = 10.0;
 
 /// The finite span `lo..hi` of `values`, or `None` without one.
 pub fn span(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
@@ -176,6 +176,6 @@ mod tests {
             linear_ticks(&(-0.1..1.05)),
             [0.0, 0.2, 0.4, 0.6000000000000001, 0.8, 1.0]
         );
-        assert_eq!(linear_ticks(&(0.0..1000.0)).len(), 6);
+        assert_eq!(linear_ticks(&(0.0..1000.0)).len(), 11);
     }
 }
