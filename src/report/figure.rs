@@ -305,32 +305,34 @@ fn equalise(frame: &mut Frame) {
 /// without a name continues the previous series.
 fn colours(panels: &[&[Series]]) -> (Vec<Vec<RGBColor>>, Vec<legend::Entry>) {
     let mut entries: Vec<legend::Entry> = Vec::new();
-    let mut current = COLOURS[0];
+    // The entry of the series drawn last.
+    let mut current: Option<usize> = None;
+    let mut colour_of = |s: &Series| {
+        if s.name.is_empty() {
+            let e = current.and_then(|k| entries.get_mut(k));
+            return e.map_or(COLOURS[0], |e| {
+                e.marked |= s.style == Style::Markers;
+                e.colour
+            });
+        }
+        let k = match entries.iter().position(|e| e.name == s.name) {
+            Some(k) => k,
+            None => {
+                entries.push(legend::Entry {
+                    name: s.name.clone(),
+                    style: s.style,
+                    marked: false,
+                    colour: COLOURS[entries.len() % COLOURS.len()],
+                });
+                entries.len() - 1
+            }
+        };
+        current = Some(k);
+        entries[k].colour
+    };
     let per_panel = panels
         .iter()
-        .map(|series| {
-            series
-                .iter()
-                .map(|s| {
-                    if s.name.is_empty() {
-                        return current;
-                    }
-                    current = match entries.iter().find(|e| e.name == s.name) {
-                        Some(e) => e.colour,
-                        None => {
-                            let colour = COLOURS[entries.len() % COLOURS.len()];
-                            entries.push(legend::Entry {
-                                name: s.name.clone(),
-                                style: s.style,
-                                colour,
-                            });
-                            colour
-                        }
-                    };
-                    current
-                })
-                .collect()
-        })
+        .map(|series| series.iter().map(&mut colour_of).collect())
         .collect();
     (per_panel, entries)
 }
@@ -588,6 +590,17 @@ mod tests {
         // Two data points and one legend marker; no line of the series' colour.
         assert_eq!(markers.matches("<circle").count(), 3, "{markers}");
         assert!(!markers.contains("polyline fill=\"none\" opacity=\"1\" stroke=\"#1F77B4\""));
+        // A line continued by its markers: both in the legend.
+        let both = Figure::new("t", "x", "y")
+            .with(Series::new("H", vec![(0.0, 1.0), (1.0, 2.0)], Style::Line))
+            .with(Series::new(
+                "",
+                vec![(0.0, 1.0), (1.0, 2.0)],
+                Style::Markers,
+            ))
+            .render()
+            .unwrap();
+        assert_eq!(both.matches("<circle").count(), 3, "{both}");
         let dashed = Figure::new("t", "x", "y")
             .with(Series::new(
                 "model",

@@ -18,6 +18,9 @@ const RIGHT: i32 = 884;
 pub struct Entry {
     pub name: String,
     pub style: Style,
+    /// Its markers too, where an unnamed series continues it with markers (a line
+    /// through its points).
+    pub marked: bool,
     pub colour: RGBColor,
 }
 
@@ -71,7 +74,10 @@ pub fn draw<DB: DrawingBackend>(
                     ))?;
                 }
             }
-            Style::Markers => area.draw(&Circle::new((x + 11, y), 3, e.colour.filled()))?,
+            Style::Markers => {}
+        }
+        if e.marked || e.style == Style::Markers {
+            area.draw(&Circle::new((x + 11, y), 3, e.colour.filled()))?;
         }
         let font = ("sans-serif", 15).into_font().color(&BLACK);
         let style = font.pos(Pos::new(HPos::Left, VPos::Center));
