@@ -60,7 +60,7 @@ fn degrees(v: f64) -> String {
 
 /// A frequency with three significant digits, no trailing `.0`: `120`, `8.43`.
 fn hz(f: f64) -> String {
-    let digits = (2 - f.abs().log10().floor() as i32).max(0) as usize;
+    let digits = (2.0 - f.abs().log10().floor()).clamp(0.0, 12.0) as usize;
     let s = format!("{f:.digits$}");
     super::figure::tick_label(s.parse().unwrap_or(f))
 }

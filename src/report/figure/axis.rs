@@ -50,8 +50,9 @@ fn step(span: f64) -> f64 {
 /// Ticks of a linear axis over `r`: the multiples of a 1–2–5 step.
 pub fn linear_ticks(r: &Range<f64>) -> Vec<f64> {
     let s = step(r.end - r.start);
-    if !(s.is_finite() && s > 0.0) {
-        return vec![r.start];
+    // A span too narrow for its offset to count steps in: its ends.
+    if !(s.is_finite() && s > 0.0) || (r.start / s).abs().max((r.end / s).abs()) > 1e15 {
+        return vec![r.start, r.end];
     }
     let first = (r.start / s).ceil() as i64;
     let last = (r.end / s).floor() as i64;
@@ -177,5 +178,6 @@ mod tests {
             [0.0, 0.2, 0.4, 0.6000000000000001, 0.8, 1.0]
         );
         assert_eq!(linear_ticks(&(0.0..1000.0)).len(), 11);
+        assert_eq!(linear_ticks(&(1e20..(1e20 + 1e5))), [1e20, 1e20 + 1e5]);
     }
 }
