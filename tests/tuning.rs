@@ -128,6 +128,50 @@ fn the_command_writes_a_tuned_parameter_file_and_never_over_its_input() {
 }
 
 #[test]
+fn the_command_plots_the_open_loop_before_and_after_with_the_margins() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = rtid(
+        &[
+            "tune", "--preset", "two-mass", "--json", "--plot", "loop.svg",
+        ],
+        dir.path(),
+    );
+    let v: serde_json::Value = serde_json::from_str(&ok(&out)).unwrap();
+    let svg = std::fs::read_to_string(dir.path().join("loop.svg")).unwrap();
+    assert!(svg.starts_with("<svg"));
+    for s in [
+        "L, before tuning",
+        "L, after tuning",
+        "before: phase margin",
+        "after: phase margin",
+        "after: gain margin",
+        "frequency, Hz",
+    ] {
+        assert!(svg.contains(s), "{s}");
+    }
+    let pm = v["after"]["velocity_loop"]["phase_margin_deg"]
+        .as_f64()
+        .unwrap();
+    assert!(svg.contains(&format!("phase margin {pm:.1}°")), "{pm}");
+
+    // Never over an input or the parameter file written.
+    std::fs::write(dir.path().join("p.json"), "{}").unwrap();
+    let over = rtid(
+        &["tune", "--params", "p.json", "--plot", "./p.json"],
+        dir.path(),
+    );
+    assert!(err(&over).contains("input"), "{}", err(&over));
+    let over = rtid(
+        &[
+            "tune", "--preset", "two-mass", "-o", "t.json", "--plot", "t.json",
+        ],
+        dir.path(),
+    );
+    err(&over);
+    assert!(!dir.path().join("t.json").exists());
+}
+
+#[test]
 fn an_unreachable_target_names_the_best() {
     let dir = tempfile::tempdir().unwrap();
     let out = rtid(

@@ -1,14 +1,15 @@
 //! `rtid tune`: the velocity and position loop gains and notch filters for a target
 //! phase margin, from the model's linear response (docs/tuning.md).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::common::inputs::refuse_overwrite;
+use crate::cli::common::plot::Plot;
 use crate::cli::ModelArgs;
 use rtid::io::params_file;
-use rtid::tuning::{self, Setting, Targets, Tuned};
+use rtid::tuning::{self, bode, Setting, Targets, Tuned};
 
 pub const LONG_ABOUT: &str = "\
 Tune the cascade from the model (docs/tuning.md): notch filters (−20 dB) at the resonances \
@@ -22,12 +23,16 @@ controller's discrete PI and filters, the drive's exact linear compliance (no ba
 no friction), the zero-order hold, the backward-difference speed, the encoder dead time \
 and the output delay; aliasing neglected. The table shows them for the current settings \
 and the tuned ones. With -o the tuned parameter file is written (atomically, never over \
-the --params input).
+the --params input). With --plot the velocity loop's open loop before and after tuning is \
+drawn as a Bode plot (SVG: gain in dB over phase in degrees on a log frequency axis from \
+0.1 Hz to 0.99·Nyquist), each phase margin and gain margin marked where it is read and \
+named with its value in the legend.
 
 Examples:
   rtid tune --preset worm-gear
   rtid tune --preset two-mass --phase-margin-deg 60 --gain-margin-db 10 -o two-mass-tuned.json
   rtid tune --params fit-params.json --set encoder_delay=1e-4 --json
+  rtid tune --preset two-mass --plot two-mass-loop.svg
   rtid simulate --params two-mass-tuned.json --input move:target_deg=1 --duration-s 1 --out step.csv
 
 The tuned file's setpoint filters are the notches only: filters of the input (a \
@@ -50,6 +55,10 @@ pub struct Args {
     /// Write the tuned parameter file.
     #[arg(short = 'o', long = "out", value_name = "tuned.json")]
     pub out: Option<PathBuf>,
+    /// Write the velocity loop's open-loop Bode plot, before and after tuning, with
+    /// the margins marked (SVG; never over an input or the -o file).
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
     /// No notes on stderr (accepted like every command's `--quiet`).
     #[arg(long)]
     pub quiet: bool,
@@ -59,6 +68,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let (Some(out), Some(input)) = (&a.out, &a.model.params) {
         refuse_overwrite("-o", out, &[input])?;
     }
+    let plot = match &a.plot {
+        Some(path) => {
+            let mut inputs: Vec<&Path> = a.model.params.iter().map(PathBuf::as_path).collect();
+            inputs.extend(a.out.as_deref());
+            Plot::at(path.clone(), &inputs)?
+        }
+        None => Plot::none(),
+    };
     let p = a.model.load()?;
     let targets = Targets {
         phase_margin_deg: a.phase_margin_deg,
@@ -67,6 +84,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let t = tuning::tune(&p, targets)?;
     if let Some(out) = &a.out {
         params_file::write(out, &t.params)?;
+    }
+    if a.plot.is_some() {
+        let title = format!(
+            "{}: velocity loop, open loop L(jω) on the sampled loop",
+            p.name
+        );
+        let figure = rtid::report::tuning::open_loop(
+            &bode::bode(&p, &t.before)?,
+            &bode::bode(&t.params, &t.after)?,
+            &title,
+        );
+        plot.write(&figure, "")?;
     }
     if a.json {
         println!("{}", rtid::io::json::pretty(&t)?);

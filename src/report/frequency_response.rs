@@ -1,5 +1,6 @@
-//! Figures of the frequency-response test (paper Fig. 8): the gain over frequency, the
-//! linear model's curve where the file carries one, the resonances marked.
+//! Figures of the frequency-response test (paper Fig. 8): the gain over frequency (a
+//! log axis), the linear model's curve where the file carries one, the resonances
+//! marked; the phase on the same frequency axis, and the Nyquist plot to equal scale.
 
 use super::figure::{Figure, Series, Style};
 use crate::estimation::peaks::Peak;
@@ -28,11 +29,13 @@ pub fn gain(
     if let Some(lin) = linear_db {
         figure = figure.with(Series::new("linear model", curve(lin), Style::Dashed));
     }
-    figure.with(Series::new(
-        "resonances",
-        peaks.iter().map(|p| (p.frequency_hz, p.gain_db)).collect(),
-        Style::Markers,
-    ))
+    figure
+        .with(Series::new(
+            "resonances",
+            peaks.iter().map(|p| (p.frequency_hz, p.gain_db)).collect(),
+            Style::Markers,
+        ))
+        .log_x()
 }
 
 /// The phase (rad, any wrapping) over frequency (ascending), drawn in degrees and
@@ -40,20 +43,22 @@ pub fn gain(
 /// taken as a whole turn.
 pub fn phase(frequency_hz: &[f64], phase_rad: &[f64], title: &str) -> Figure {
     let unwrapped = crate::objectives::complex_response::unwrap(phase_rad);
-    Figure::new(title, "frequency, Hz", "phase, degrees (unwrapped)").with(Series::new(
-        "phase (unwrapped along frequency)",
-        frequency_hz
-            .iter()
-            .zip(&unwrapped)
-            .map(|(&f, p)| (f, p.to_degrees()))
-            .collect(),
-        Style::Line,
-    ))
+    Figure::new(title, "frequency, Hz", "phase, degrees (unwrapped)")
+        .with(Series::new(
+            "phase (unwrapped along frequency)",
+            frequency_hz
+                .iter()
+                .zip(&unwrapped)
+                .map(|(&f, p)| (f, p.to_degrees()))
+                .collect(),
+            Style::Line,
+        ))
+        .log_x()
 }
 
 /// The Nyquist plot: Im H against Re H, lines joined in frequency order (`ln_gain`:
-/// natural log of |H|, `phase_rad`), each line marked; the axes are not to equal
-/// scale.
+/// natural log of |H|, `phase_rad`), each line marked; the axes to equal scale (a
+/// mode's circle is a circle).
 pub fn nyquist(ln_gain: &[f64], phase_rad: &[f64], title: &str, unit: &str) -> Figure {
     let h: Vec<(f64, f64)> = ln_gain
         .iter()
@@ -72,6 +77,7 @@ pub fn nyquist(ln_gain: &[f64], phase_rad: &[f64], title: &str, unit: &str) -> F
             Style::Line,
         ))
         .with(Series::new("", h, Style::Markers))
+        .to_equal_scale()
 }
 
 /// The phase plot and the Nyquist plot of a complex response (lines ascending in

@@ -25,7 +25,8 @@ pub fn figures(e: &Evaluation, mechanism: &str) -> (Figure, Option<Figure>) {
                 "gain, dB",
             )
             .with(Series::new("gain (stepped sine)", curve, Style::Line))
-            .with(markers);
+            .with(markers)
+            .log_x();
             (gain, None)
         }
         Evaluation::H1 {
@@ -47,14 +48,14 @@ pub fn figures(e: &Evaluation, mechanism: &str) -> (Figure, Option<Figure>) {
                 gain = gain.with(Series::new(name, run, Style::Line));
             }
             let coherence = coherence(bins, *min_coherence, mechanism);
-            (gain.with(markers), Some(coherence))
+            (gain.with(markers).log_x(), Some(coherence))
         }
         Evaluation::Periodic(p) => super::periodic::figures(p, mechanism),
     }
 }
 
 /// The coherence up to a little beyond the highest kept bin (above it is noise), with
-/// the threshold.
+/// the threshold, on a log frequency axis (the 0 Hz bin not drawn).
 fn coherence(bins: &[Bin], min_coherence: f64, mechanism: &str) -> Figure {
     let top = bins
         .iter()
@@ -67,6 +68,7 @@ fn coherence(bins: &[Bin], min_coherence: f64, mechanism: &str) -> Figure {
         .filter(|b| b.frequency_hz <= top)
         .map(|b| (b.frequency_hz, b.coherence))
         .collect();
+    let x0 = points.iter().map(|c| c.0).find(|f| *f > 0.0).unwrap_or(1.0);
     let x1 = points.last().map_or(1.0, |c| c.0);
     Figure::new(
         format!("{mechanism}: coherence, motor angle → table angle"),
@@ -76,7 +78,8 @@ fn coherence(bins: &[Bin], min_coherence: f64, mechanism: &str) -> Figure {
     .with(Series::new("coherence γ²", points, Style::Line))
     .with(Series::new(
         "threshold",
-        vec![(0.0, min_coherence), (x1, min_coherence)],
+        vec![(x0, min_coherence), (x1, min_coherence)],
         Style::Dashed,
     ))
+    .log_x()
 }

@@ -6,13 +6,21 @@ use crate::identify::result::comparison::{Comparison, Role};
 use crate::identify::result::profile::Profile;
 
 /// The measured data as markers (frequency responses) or lines, the model at the
-/// start dashed and at the identified values as a line.
+/// start dashed and at the identified values as a line; a frequency on a log axis,
+/// the complex plane to equal scale. The title names the experiment's file, not its
+/// folder.
 pub fn comparison(c: &Comparison) -> Figure {
     let mut figure = Figure::new(
-        format!("identification: {}", c.source),
+        format!("identification: {}", file_name(&c.source)),
         &c.x_label,
         &c.y_label,
     );
+    if c.x_label.starts_with("frequency") {
+        figure = figure.log_x();
+    }
+    if c.x_label == "real part" {
+        figure = figure.to_equal_scale();
+    }
     // Measured lines (a frequency response, its Nyquist plot) are points, not a trace.
     let sampled = c.x_label.starts_with("frequency") || c.x_label == "real part";
     for curve in &c.curves {
@@ -30,6 +38,14 @@ pub fn comparison(c: &Comparison) -> Figure {
         ));
     }
     figure
+}
+
+/// The last component of a file's path (the path itself where it has none): a
+/// title names the file, not where it lies on the machine that ran the command.
+pub fn file_name(source: &str) -> String {
+    std::path::Path::new(source)
+        .file_name()
+        .map_or_else(|| source.to_string(), |n| n.to_string_lossy().into_owned())
 }
 
 /// The statistic is drawn up to this multiple of the threshold: beyond, a leap

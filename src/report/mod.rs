@@ -13,3 +13,4 @@ pub mod positioning;
 pub mod servo_trace;
 pub mod sweep;
 pub mod torque_curve;
+pub mod tuning;

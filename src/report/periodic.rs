@@ -55,6 +55,7 @@ pub fn figures(p: &PeriodicEvaluation, mechanism: &str) -> (Figure, Option<Figur
             "antiresonances",
             marks(|c| &c.antiresonances),
             Style::Markers,
-        ));
-    (gain, Some(coherence))
+        ))
+        .log_x();
+    (gain, Some(coherence.log_x()))
 }

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use ndarray::{ArrayView1, ArrayView2};
 use plotters::prelude::*;
 
-use super::figure::{Figure, FigureError, Series, Style};
+use super::figure::{tick_label, Figure, FigureError, Series, Style};
 use crate::sweep::analysis::Indices;
 use crate::sweep::spec::{Factor, Scale};
 
@@ -65,6 +65,7 @@ pub fn tornado_svg(
             .map_err(|e| text(&e))?;
         c.configure_mesh()
             .x_desc(x_label)
+            .x_label_formatter(&|v: &f64| tick_label(*v))
             .y_labels(n)
             .y_label_formatter(&|y: &f64| {
                 let i = y.round();
@@ -306,6 +307,8 @@ fn heat_map(
         c.configure_mesh()
             .x_desc(axis_label(fx))
             .y_desc(axis_label(fy))
+            .x_label_formatter(&|v: &f64| tick_label(*v))
+            .y_label_formatter(&|v: &f64| tick_label(*v))
             .disable_mesh()
             .draw()
             .map_err(|e| text(&e))?;

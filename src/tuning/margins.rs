@@ -93,7 +93,7 @@ pub fn margins_on(
 
 /// The phase of each grid value, deg, unwrapped from the principal value at the
 /// first.
-fn unwrapped_deg(grid: &[(f64, Complex<f64>)]) -> Vec<f64> {
+pub(crate) fn unwrapped_deg(grid: &[(f64, Complex<f64>)]) -> Vec<f64> {
     let mut out: Vec<f64> = Vec::with_capacity(grid.len());
     for (_, v) in grid {
         let a = v.arg().to_degrees();

@@ -2,11 +2,13 @@
 //! open-loop frequency response on the sampled loop ([`open_loop`]), its stability
 //! margins ([`margins`]), notch filters at the resonances ([`notches`]), and the
 //! velocity PI and position gain for a target phase margin with a gain-margin floor
-//! ([`search`]). [`tune`] puts them together with the margins before and after.
+//! ([`search`]). [`tune`] puts them together with the margins before and after;
+//! [`bode`] gives a setting's open loop as a Bode plot draws it.
 //!
 //! Layer: above `model` and `controller` (it reads the linear response, the modes and
 //! the controller's discretised filters), below `experiments` and the command line.
 
+pub mod bode;
 pub mod margins;
 pub mod notches;
 pub mod open_loop;

@@ -370,6 +370,14 @@ fn complex_evaluation(exp: &Experiment, plot: &Plot) -> anyhow::Result<Option<Co
         &format!("{mechanism}: {ratio}"),
         unit,
     );
+    // The phase on the gain plot's frequency axis (lines without a phase included).
+    let f = match &exp.data {
+        Data::FrequencyResponse { frequency_hz, .. } => frequency_hz.as_slice(),
+        _ => &c.frequency_hz,
+    };
+    let lo = f.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = f.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let phase = phase.spanning(lo, hi);
     let plots = [
         plot.write(&phase, "_phase")?,
         plot.write(&nyquist, "_nyquist")?,

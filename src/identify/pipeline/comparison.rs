@@ -6,6 +6,7 @@
 use crate::identify::result::comparison::{Comparison, Curve, Role};
 
 mod frequency_response;
+mod grid;
 
 use crate::experiments::fluctuation::{self, FluctuationTest};
 use crate::experiments::servo_trace::{self, ServoTrace, TraceError};

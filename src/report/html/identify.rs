@@ -225,7 +225,10 @@ fn residuals(r: &IdentifyResult) -> Result<String, FigureError> {
             continue;
         }
         let chart = Figure::new(
-            format!("residuals: {}", e.source),
+            format!(
+                "residuals: {}",
+                crate::report::identify::file_name(&e.source)
+            ),
             "index",
             "scaled residual",
         )

@@ -13,9 +13,6 @@ use crate::model::Params;
 use crate::objectives::complex_response::unwrap;
 use crate::objectives::{gain_curve, Detail, Fidelity, Source};
 
-/// Points of the model's curve over the measured frequency range.
-const CURVE_POINTS: usize = 600;
-
 /// The comparisons of one frequency response: gain; phase and Nyquist with phase.
 pub(super) fn compare(
     source: &str,
@@ -28,7 +25,7 @@ pub(super) fn compare(
         return Vec::new();
     }
     let response = measured::form(exp).response;
-    let grid = model_grid(&f);
+    let grid = model_grid(&f, response, start, fitted);
     let mut out = vec![gain(source, response, (&f, &g), &grid, start, fitted)];
     if let Some(m) = measured::complex_points(exp, |_| true) {
         // The fitted delay taken out, on the canonical ratio's sign.
@@ -62,21 +59,36 @@ pub(super) fn compare(
     out
 }
 
-/// The model's frequencies: evenly over the measured range.
-fn model_grid(f: &[f64]) -> Vec<f64> {
-    let (lo, hi) = (f[0], f[f.len() - 1]);
-    (0..=CURVE_POINTS)
-        .map(|i| lo + (hi - lo) * i as f64 / CURVE_POINTS as f64)
-        .collect()
+/// The models' frequencies over the measured range: log-spaced, refined through
+/// each resonance of either model ([`super::grid`]).
+fn model_grid(f: &[f64], response: Response, start: &Params, fitted: &Params) -> Vec<f64> {
+    let lo = f.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = f.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let mut grid = Vec::new();
+    for p in [start, fitted] {
+        let Ok(lin) = LinearResponse::new(p, channel(response)) else {
+            continue;
+        };
+        grid.extend(super::grid::model_grid(lo, hi, |f| {
+            lin.at(f).map(|h| h.norm())
+        }));
+    }
+    grid.sort_by(f64::total_cmp);
+    grid.dedup();
+    grid
+}
+
+/// The linear response's channel of a measured response.
+fn channel(response: Response) -> Channel {
+    match response {
+        Response::TableOverMotor => Channel::TableOverMotor,
+        Response::MotorCompliance => Channel::MotorOverTorque,
+    }
 }
 
 /// The model's complex response at `grid` (empty where it cannot be built).
 fn model(p: &Params, response: Response, grid: &[f64]) -> Vec<(f64, nalgebra::Complex<f64>)> {
-    let channel = match response {
-        Response::TableOverMotor => Channel::TableOverMotor,
-        Response::MotorCompliance => Channel::MotorOverTorque,
-    };
-    let Ok(lin) = LinearResponse::new(p, channel) else {
+    let Ok(lin) = LinearResponse::new(p, channel(response)) else {
         return Vec::new();
     };
     grid.iter()

@@ -1,0 +1,90 @@
+//! The figure of `rtid tune --plot`: the velocity loop's open loop before and after
+//! tuning as a Bode plot (gain in dB over phase in degrees on one log frequency
+//! axis), each setting's margins marked where they are read and named in the
+//! legend with their values.
+
+use super::figure::{Figure, Series, Style};
+use crate::tuning::bode::Bode;
+
+/// The Bode plot of `before` and `after` (named so in the legend), titled `title`.
+pub fn open_loop(before: &Bode, after: &Bode, title: &str) -> Figure {
+    let mut gain = Figure::new(title, "frequency, Hz", "|L|, dB").log_x();
+    let mut phase = Figure::new("", "", "arg L, degrees (unwrapped)");
+    for (who, b) in [("before", before), ("after", after)] {
+        let name = format!("L, {who} tuning");
+        gain = gain.with(Series::new(&name, b.gain_db.clone(), Style::Line));
+        phase = phase.with(Series::new(&name, b.phase_deg.clone(), Style::Line));
+    }
+    for (who, b) in [("before", before), ("after", after)] {
+        if let Some((f, at, pm)) = b.phase_margin {
+            let name = format!("{who}: phase margin {} at {} Hz", degrees(pm), hz(f));
+            gain = gain.with(Series::new(&name, vec![(f, 0.0)], Style::Markers));
+            phase = phase.with(Series::new(&name, vec![(f, at)], Style::Markers));
+        }
+        if let Some((f, db, at)) = b.gain_margin {
+            let name = format!("{who}: gain margin {:.1} dB at {} Hz", -db, hz(f));
+            gain = gain.with(Series::new(&name, vec![(f, db)], Style::Markers));
+            phase = phase.with(Series::new(&name, vec![(f, at)], Style::Markers));
+        }
+    }
+    let (lo, hi) = span(before, after);
+    let reference = "0 dB and −180°";
+    gain = gain.with(Series::new(
+        reference,
+        vec![(lo, 0.0), (hi, 0.0)],
+        Style::Dashed,
+    ));
+    phase = phase.with(Series::new(
+        reference,
+        vec![(lo, -180.0), (hi, -180.0)],
+        Style::Dashed,
+    ));
+    gain.above(phase)
+}
+
+/// The frequencies both curves span, Hz.
+fn span(before: &Bode, after: &Bode) -> (f64, f64) {
+    before
+        .gain_db
+        .iter()
+        .chain(&after.gain_db)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.0), b.max(p.0))
+        })
+}
+
+/// `52.3°`.
+fn degrees(v: f64) -> String {
+    format!("{v:.1}°")
+}
+
+/// A frequency with three significant digits, no trailing `.0`: `120`, `8.43`.
+fn hz(f: f64) -> String {
+    let digits = (2.0 - f.abs().log10().floor()).clamp(0.0, 12.0) as usize;
+    let s = format!("{f:.digits$}");
+    super::figure::tick_label(s.parse().unwrap_or(f))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets;
+    use crate::tuning::{bode::bode, tune, Targets};
+
+    #[test]
+    fn the_plot_shows_both_loops_and_the_margins() {
+        let p = presets::load("two-mass").unwrap();
+        let t = tune(&p, Targets::default()).unwrap();
+        let (b, a) = (bode(&p, &t.before).unwrap(), bode(&p, &t.after).unwrap());
+        let svg = open_loop(&b, &a, "two-mass: velocity loop")
+            .render()
+            .unwrap();
+        for s in ["L, before tuning", "L, after tuning", "after: phase margin"] {
+            assert!(svg.contains(s), "{s}");
+        }
+        let pm = t.after.velocity_loop.phase_margin_deg.unwrap();
+        assert!(svg.contains(&degrees(pm)), "{pm}");
+        assert_eq!(hz(119.44), "119");
+        assert_eq!(hz(8.4321), "8.43");
+    }
+}
