@@ -235,3 +235,36 @@ fn the_tuned_drives_settle_a_step_faster_on_the_nonlinear_model() {
         assert!(rest < 0.72, "{name}: moves {rest}″ at rest");
     }
 }
+
+/// `tune FIT.json --preset …` tunes the identified model: the base set with the fit's
+/// values, as `--set` of each would.
+#[test]
+fn the_command_tunes_the_model_of_an_identification() {
+    let dir = tempfile::tempdir().unwrap();
+    let fit_path = root().join("fixtures/predict/worm-gear/fit.json");
+    let fit: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&fit_path).unwrap()).unwrap();
+    let mut args = vec!["tune".to_string(), "--preset".into(), "worm-gear".into()];
+    for (name, value) in fit["parameters"].as_object().unwrap() {
+        args.extend(["--set".into(), format!("{name}={value}")]);
+    }
+    args.push("--json".into());
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    let by_set = ok(&rtid(&refs, dir.path()));
+    let by_fit = ok(&rtid(
+        &[
+            "tune",
+            fit_path.to_str().unwrap(),
+            "--preset",
+            "worm-gear",
+            "--json",
+        ],
+        dir.path(),
+    ));
+    assert_eq!(by_fit, by_set);
+    let e = err(&rtid(
+        &["tune", "missing.json", "--preset", "worm-gear"],
+        dir.path(),
+    ));
+    assert!(e.contains("missing.json"), "{e}");
+}

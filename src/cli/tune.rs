@@ -30,6 +30,7 @@ named with its value in the legend.
 
 Examples:
   rtid tune --preset worm-gear
+  rtid tune fit.json --preset worm-gear -o worm-tuned.json     (the identified model)
   rtid tune --preset two-mass --phase-margin-deg 60 --gain-margin-db 10 -o two-mass-tuned.json
   rtid tune --params fit-params.json --set encoder_delay=1e-4 --json
   rtid tune --preset two-mass --plot two-mass-loop.svg
@@ -41,6 +42,10 @@ low-pass, say) are in the \"before\" column and not carried over.";
 /// Arguments of `rtid tune`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
+    /// An identification result (`rtid identify --out`): its values set in the model
+    /// (--preset or --params, the base the fit started from).
+    #[arg(value_name = "FIT.json")]
+    pub fit: Option<PathBuf>,
     #[command(flatten)]
     pub model: ModelArgs,
     /// Target phase margin of the velocity loop, degrees.
@@ -65,18 +70,25 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    if let (Some(out), Some(input)) = (&a.out, &a.model.params) {
-        refuse_overwrite("-o", out, &[input])?;
+    let read: Vec<&Path> = a
+        .model
+        .params
+        .iter()
+        .chain(&a.fit)
+        .map(PathBuf::as_path)
+        .collect();
+    if let Some(out) = &a.out {
+        refuse_overwrite("-o", out, &read)?;
     }
     let plot = match &a.plot {
         Some(path) => {
-            let mut inputs: Vec<&Path> = a.model.params.iter().map(PathBuf::as_path).collect();
+            let mut inputs = read.clone();
             inputs.extend(a.out.as_deref());
             Plot::at(path.clone(), &inputs)?
         }
         None => Plot::none(),
     };
-    let p = a.model.load()?;
+    let p = crate::cli::common::model_args::fitted(&a.model, a.fit.as_deref(), None)?;
     let targets = Targets {
         phase_margin_deg: a.phase_margin_deg,
         gain_margin_db: a.gain_margin_db,
