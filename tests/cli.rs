@@ -1433,9 +1433,8 @@ fn a_multisine_record_with_a_wrong_period_is_one_clear_error() {
 /// limit (issue 13). Numbers in the messages stay short.
 #[test]
 fn absurd_sizes_and_values_are_refused_before_any_work() {
-    let dir = tempdir();
     let sine = "sine:freq_hz=100,amp_nm=5";
-    let cases: &[(&[&str], &[&str])] = &[
+    refused_at_once(&[
         (
             &[
                 "experiment",
@@ -1528,6 +1527,14 @@ fn absurd_sizes_and_values_are_refused_before_any_work() {
             ],
             &["--duration-s", "integration steps"],
         ),
+    ]);
+}
+
+/// More of the same: absurd sizes and values of the other commands.
+#[test]
+fn absurd_sizes_and_values_of_other_commands_are_refused_before_any_work() {
+    let sine = "sine:freq_hz=100,amp_nm=5";
+    refused_at_once(&[
         (
             &[
                 "simulate",
@@ -1625,7 +1632,13 @@ fn absurd_sizes_and_values_are_refused_before_any_work() {
             ],
             &["--sample-rate-hz -5", "positive"],
         ),
-    ];
+    ]);
+}
+
+/// Each of `cases` fails at once with one short line holding its needles, and
+/// writes nothing.
+fn refused_at_once(cases: &[(&[&str], &[&str])]) {
+    let dir = tempdir();
     for (args, needles) in cases {
         let out = rtid(args, dir.path());
         let line = assert_one_line_error(&out, needles);

@@ -726,7 +726,16 @@ fn records_and_values_out_of_range_are_met_at_their_root() {
         assert_eq!(run.code, Some(1), "{args:?}: {}", run.stderr);
         check(args, &run, culprit);
     }
-    // A checkpoint resumed with another parameter held, or with a corrupted stage.
+}
+
+/// A checkpoint resumed with another parameter held, or with a corrupted stage, or a
+/// field nested thousands deep, is refused naming it; a start whose cost was emptied
+/// runs again.
+#[test]
+fn checkpoints_of_other_runs_or_corrupted_are_met_at_their_root() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let worm = fixture("worm-gear/frequency_response.json");
     let fit = |extra: &[&str]| {
         let mut args = strings(&[
             "identify",

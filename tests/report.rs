@@ -73,6 +73,35 @@ impl Runs {
     }
 }
 
+/// The worm gear's virtual positioning test in `d`/pos, evaluated with a plot; its
+/// bidirectional accuracy A, arc-seconds.
+fn positioning_accuracy(d: &Path) -> f64 {
+    rtid_ok(
+        &[
+            "experiment",
+            "positioning",
+            "--preset",
+            "worm-gear",
+            "--out",
+            "pos",
+        ],
+        d,
+    );
+    let eval: serde_json::Value = serde_json::from_str(&rtid_ok(
+        &[
+            "evaluate",
+            "pos/positioning.json",
+            "--json",
+            "--plot",
+            "pos.svg",
+        ],
+        d,
+    ))
+    .unwrap();
+    assert_eq!(eval["unit"], "arcsec");
+    eval["axis"]["A"].as_f64().unwrap()
+}
+
 fn runs() -> &'static Runs {
     static RUNS: OnceLock<Runs> = OnceLock::new();
     RUNS.get_or_init(|| {
@@ -122,30 +151,7 @@ fn runs() -> &'static Runs {
             "intervals.json",
         ]);
         gain_curve(&["--fit", "Kw", "--set", "Kg=800", "--out", "kw-only.json"]);
-        rtid_ok(
-            &[
-                "experiment",
-                "positioning",
-                "--preset",
-                "worm-gear",
-                "--out",
-                "pos",
-            ],
-            d,
-        );
-        let eval: serde_json::Value = serde_json::from_str(&rtid_ok(
-            &[
-                "evaluate",
-                "pos/positioning.json",
-                "--json",
-                "--plot",
-                "pos.svg",
-            ],
-            d,
-        ))
-        .unwrap();
-        assert_eq!(eval["unit"], "arcsec");
-        let accuracy_arcsec = eval["axis"]["A"].as_f64().unwrap();
+        let accuracy_arcsec = positioning_accuracy(d);
         let sweep = serde_json::from_str(&rtid_ok(
             &[
                 "sweep",

@@ -268,3 +268,31 @@ fn the_command_tunes_the_model_of_an_identification() {
     ));
     assert!(e.contains("missing.json"), "{e}");
 }
+
+/// The command's own check on the nonlinear model: the tuned worm gear settles a 1°
+/// step faster, follows a constant speed closer (v/Kpp), and says so in its JSON.
+#[test]
+fn the_command_checks_both_settings_on_the_nonlinear_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = ok(&rtid(
+        &["tune", "--preset", "worm-gear", "--json"],
+        dir.path(),
+    ));
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (b, a) = (&v["verification"]["before"], &v["verification"]["after"]);
+    let f = |x: &serde_json::Value, k: &str| x[k].as_f64().unwrap();
+    assert!(
+        f(a, "step_settling_s") < f(b, "step_settling_s") / 3.0,
+        "{v}"
+    );
+    let kpp = |x: &serde_json::Value| x["Kpp"].as_f64().unwrap();
+    for (r, setting) in [(b, &v["before"]), (a, &v["after"])] {
+        // 10°/s over Kpp, in arc-seconds.
+        let expected = 36000.0 / kpp(setting);
+        let got = f(r, "following_error");
+        assert!(
+            (got / expected - 1.0).abs() < 0.05,
+            "{got} against {expected}″"
+        );
+    }
+}

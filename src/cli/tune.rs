@@ -9,7 +9,7 @@ use crate::cli::common::inputs::refuse_overwrite;
 use crate::cli::common::plot::Plot;
 use crate::cli::ModelArgs;
 use rtid::io::params_file;
-use rtid::tuning::{self, bode, Setting, Targets, Tuned};
+use rtid::tuning::{self, bode, verify, Setting, Targets, Tuned};
 
 pub const LONG_ABOUT: &str = "\
 Tune the cascade from the model (docs/tuning.md): notch filters (−20 dB) at the resonances \
@@ -27,6 +27,11 @@ the --params input). With --plot the velocity loop's open loop before and after 
 drawn as a Bode plot (SVG: gain in dB over phase in degrees on a log frequency axis from \
 0.1 Hz to 0.99·Nyquist), each phase margin and gain margin marked where it is read and \
 named with its value in the legend.
+
+Then both settings run on the nonlinear model (backlash, friction, quantised encoders, \
+the torque limit, which the margins leave out): a 1° step (1 mm on a linear axis) — \
+overshoot, time to settle within 20″ (20 µm), peak torque — and a move 5° out and back \
+at 10°/s — the following error at constant speed and the reversal spike beyond it.
 
 Examples:
   rtid tune --preset worm-gear
@@ -109,12 +114,54 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
         plot.write(&figure, "")?;
     }
+    let checked = [verify::responses(&p)?, verify::responses(&t.params)?];
     if a.json {
-        println!("{}", rtid::io::json::pretty(&t)?);
+        let mut v = rtid::io::json::value(&t)?;
+        v["verification"] = serde_json::json!({"before": checked[0], "after": checked[1]});
+        println!("{}", rtid::io::json::pretty(&v)?);
     } else {
         print_table(&p.name, &t);
+        print_verification(&checked);
     }
     Ok(())
+}
+
+/// The step and the out-and-back move on the nonlinear model, before and after.
+fn print_verification(r: &[verify::Responses; 2]) {
+    let u = r[0].unit;
+    println!(
+        "on the nonlinear model (backlash, friction, quantised encoders, torque limit), the motor encoder × the ratio: {}",
+        if u == "″" {
+            "a 1° step; 5° out and back at 10°/s"
+        } else {
+            "a 1 mm step; 5 mm out and back at 10 mm/s"
+        }
+    );
+    let mut table = Table::new();
+    table.load_preset(UTF8_FULL_CONDENSED);
+    table.set_header(vec!["", "before", "after"]);
+    let row =
+        |label: String, f: &dyn Fn(&verify::Responses) -> String| vec![label, f(&r[0]), f(&r[1])];
+    table.add_row(row("step overshoot".into(), &|x| {
+        format!("{:.1} %", x.step_overshoot_percent)
+    }));
+    table.add_row(row(
+        format!("step settled within {}{u}", verify::SETTLED),
+        &|x| {
+            x.step_settling_s
+                .map_or("not within 1 s".into(), |t| format!("{:.0} ms", t * 1e3))
+        },
+    ));
+    table.add_row(row(format!("following error, {u}"), &|x| {
+        format!("{:.1}", x.following_error)
+    }));
+    table.add_row(row(format!("reversal spike, {u}"), &|x| {
+        format!("{:.1}", x.reversal_spike)
+    }));
+    table.add_row(row("peak effort".into(), &|x| {
+        format!("{:.2}", x.peak_effort)
+    }));
+    println!("{table}");
 }
 
 fn print_table(name: &str, t: &Tuned) {

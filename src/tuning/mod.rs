@@ -14,6 +14,7 @@ pub mod notches;
 pub mod open_loop;
 pub mod position;
 pub mod search;
+pub mod verify;
 
 use serde::Serialize;
 
