@@ -145,8 +145,9 @@ fn print_verification(r: &[verify::Responses; 2]) {
     table.add_row(row("step overshoot".into(), &|x| {
         format!("{:.1} %", x.step_overshoot_percent)
     }));
+    let gap = if u == "″" { "" } else { " " };
     table.add_row(row(
-        format!("step settled within {}{u}", verify::SETTLED),
+        format!("step settled within {}{gap}{u}", verify::SETTLED),
         &|x| {
             x.step_settling_s
                 .map_or("not within 1 s".into(), |t| format!("{:.0} ms", t * 1e3))
@@ -158,9 +159,12 @@ fn print_verification(r: &[verify::Responses; 2]) {
     table.add_row(row(format!("reversal spike, {u}"), &|x| {
         format!("{:.1}", x.reversal_spike)
     }));
-    table.add_row(row("peak effort".into(), &|x| {
-        format!("{:.2}", x.peak_effort)
-    }));
+    let effort = if u == "″" {
+        "peak torque, N·m"
+    } else {
+        "peak force, N"
+    };
+    table.add_row(row(effort.into(), &|x| format!("{:.2}", x.peak_effort)));
     println!("{table}");
 }
 
