@@ -223,7 +223,7 @@ fn bad_predict_options_are_named() {
     let cases: [(&[&str], &str); 5] = [
         (&["--draws", "3"], "--draws 3"),
         (&["--hold", "Kw"], "--hold Kw: not a parameter of the fit"),
-        (&["--tests", "servo"], "--tests servo"),
+        (&["--tests", "fluctuation"], "--tests fluctuation"),
         (&["--level", "1.5"], "level 1.5"),
         (&["--from", "bootstrap"], "no bootstrap replicates"),
     ];
@@ -307,4 +307,52 @@ fn the_report_puts_the_prediction_beside_the_records() {
     assert!(page.contains("Before, after and predicted"));
     assert!(page.contains("after predicted (prediction.json)"));
     assert!(page.contains("measured (real/positioning.json)"));
+}
+
+/// `--tests servo` predicts `rtid tune`'s own check: its value at the fit is the
+/// check of the tuned identified model, the interval around it.
+#[test]
+fn the_servo_check_of_a_tuning_is_predicted() {
+    let dir = tempfile::tempdir().unwrap();
+    let fit = fit();
+    let f = fit.to_str().unwrap();
+    let tune = |extra: &[&str]| {
+        let mut args = vec!["tune", f, "--preset", "worm-gear"];
+        args.extend_from_slice(extra);
+        ok(&rtid(&args, dir.path()))
+    };
+    tune(&["-o", "tuned.json"]);
+    let checked: serde_json::Value = serde_json::from_str(&tune(&["--json"])).unwrap();
+    let p = json(&rtid(
+        &[
+            "predict",
+            f,
+            "--preset",
+            "worm-gear",
+            "--tune",
+            "tuned.json",
+            "--tests",
+            "servo",
+            "--draws",
+            "10",
+            "--json",
+        ],
+        dir.path(),
+    ));
+    for name in [
+        "following_error",
+        "reversal_spike",
+        "step_overshoot_percent",
+    ] {
+        let (at_fit, lo, hi) = predicted(&p, "after", name);
+        let want = checked["verification"]["after"][name].as_f64().unwrap();
+        assert!(
+            (at_fit - want).abs() < 1e-9,
+            "{name}: {at_fit} against {want}"
+        );
+        assert!(lo <= hi, "{name}: [{lo} … {hi}]");
+    }
+    let (before, _, _) = predicted(&p, "before", "following_error");
+    let (after, _, _) = predicted(&p, "after", "following_error");
+    assert!(after < before / 3.0, "{before} → {after}″");
 }

@@ -33,8 +33,10 @@ every other parameter keeps its value, and the output names them. A fitted param
 the data did not determine (no standard error) cannot be drawn: the command refuses \
 until it is held at its value (--hold NAME), and then says so.
 
-Tests: positioning (ISO 230-2: B̄, B, E, M, R, A in arc-seconds or µm; --runs per \
-direction). The draws run in parallel; Ctrl-C stops them and the prediction is made \
+Tests (--tests, comma-separated): positioning (ISO 230-2: B̄, B, E, M, R, A in \
+arc-seconds or µm; --runs per direction) and servo (the check of `rtid tune`: a 1° step's \
+overshoot in %, the following error at 10°/s and the reversal spike in arc-seconds or \
+µm, the peak torque or force). The draws run in parallel; Ctrl-C stops them and the prediction is made \
 from those done.
 
 Examples:
@@ -205,21 +207,43 @@ fn cases(a: &Args, p: &Params) -> anyhow::Result<Vec<Case>> {
         .as_deref()
         .map(|t| model_args::tuned_controller(t, p))
         .transpose()?;
+    let mut out = Vec::new();
     for test in a.tests.split(',').map(str::trim) {
-        if test != "positioning" {
-            bail!("--tests {test}: not a test prediction runs (positioning)");
+        let (before, after) = match test {
+            "positioning" => (
+                Test::Positioning {
+                    test: before.clone(),
+                    axis: p.axis,
+                },
+                Test::Positioning {
+                    test: after.clone(),
+                    axis: p.axis,
+                },
+            ),
+            "servo" => (
+                Test::Servo {
+                    compensation: Default::default(),
+                    axis: p.axis,
+                },
+                Test::Servo {
+                    compensation: after.compensation.clone(),
+                    axis: p.axis,
+                },
+            ),
+            _ => bail!("--tests {test}: not a test prediction runs (positioning, servo)"),
+        };
+        out.push(Case {
+            label: "before".into(),
+            test: before,
+            controller: None,
+        });
+        if a.compensation.is_some() || tuned.is_some() {
+            out.push(Case {
+                label: "after".into(),
+                test: after,
+                controller: tuned.clone(),
+            });
         }
-    }
-    let case = |label: &str, test: PositioningTest| Case {
-        label: label.to_string(),
-        test: Test::Positioning { test, axis: p.axis },
-        controller: None,
-    };
-    let mut out = vec![case("before", before)];
-    if a.compensation.is_some() || tuned.is_some() {
-        let mut c = case("after", after);
-        c.controller = tuned;
-        out.push(c);
     }
     Ok(out)
 }
@@ -238,24 +262,26 @@ fn print(a: &Args, p: &Prediction, params: &Params) {
         p.drawn.join(", "),
         Num(p.level * 100.0)
     );
-    println!("{}", table(p));
+    print_tables(p);
     if !a.quiet {
         notes(p, params);
     }
 }
 
-fn table(p: &Prediction) -> Table {
-    let mut t = Table::new();
-    t.load_preset(UTF8_FULL_CONDENSED);
-    let mut header = vec![format!("positioning, {}", p.cases[0].unit)];
-    header.extend(p.cases.iter().map(|c| c.case.clone()));
-    t.set_header(header);
-    for (k, v) in p.cases[0].values.iter().enumerate() {
-        let mut row = vec![v.name.replace("B_mean", "B̄")];
-        row.extend(p.cases.iter().map(|c| cell(&c.values[k])));
-        t.add_row(row);
+fn print_tables(p: &Prediction) {
+    for (test, cases) in p.by_test() {
+        let mut t = Table::new();
+        t.load_preset(UTF8_FULL_CONDENSED);
+        let mut header = vec![format!("{test}, {}", cases[0].unit)];
+        header.extend(cases.iter().map(|c| c.case.clone()));
+        t.set_header(header);
+        for (k, v) in cases[0].values.iter().enumerate() {
+            let mut row = vec![v.name.replace("B_mean", "B̄")];
+            row.extend(cases.iter().map(|c| cell(&c.values[k])));
+            t.add_row(row);
+        }
+        println!("{t}");
     }
-    t
 }
 
 fn cell(v: &prediction::Predicted) -> String {

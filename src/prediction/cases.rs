@@ -1,11 +1,13 @@
 //! The virtual tests a prediction runs on each parameter set, and the values it reads
 //! from them, in the units the field reports them in.
 
+use crate::controller::Compensation;
 use crate::experiments::positioning::iso230::{self, Iso230Error, ReportUnits};
 use crate::experiments::positioning::{self, PositioningTest};
 use crate::model::params::ControllerParams;
 use crate::model::{Axis, Params};
 use crate::sim::SimError;
+use crate::tuning::verify;
 
 /// One output of a case.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +31,12 @@ pub struct Case {
 pub enum Test {
     /// The ISO 230-2 positioning test: B̄, B, E, M, R, A of the axis.
     Positioning { test: PositioningTest, axis: Axis },
+    /// The servo's responses (`tuning::verify`): a step's overshoot, the following
+    /// error at constant speed, the reversal spike, the peak effort.
+    Servo {
+        compensation: Compensation,
+        axis: Axis,
+    },
 }
 
 /// Why a case did not give its outputs.
@@ -72,13 +80,35 @@ impl Case {
                 .map(|(name, value)| Output { name, value })
                 .collect())
             }
+            Test::Servo { compensation, .. } => {
+                let r = verify::responses_with(p, compensation)?;
+                Ok([
+                    ("step_overshoot_percent", r.step_overshoot_percent),
+                    ("following_error", r.following_error),
+                    ("reversal_spike", r.reversal_spike),
+                    ("peak_effort", r.peak_effort),
+                ]
+                .into_iter()
+                .map(|(name, value)| Output { name, value })
+                .collect())
+            }
+        }
+    }
+
+    /// The test's name (`positioning`, `servo`).
+    pub fn test_name(&self) -> &'static str {
+        match &self.test {
+            Test::Positioning { .. } => "positioning",
+            Test::Servo { .. } => "servo",
         }
     }
 
     /// The outputs' unit (`″`, `µm`).
     pub fn unit(&self) -> &'static str {
         match &self.test {
-            Test::Positioning { axis, .. } => ReportUnits::of(*axis).deviation,
+            Test::Positioning { axis, .. } | Test::Servo { axis, .. } => {
+                ReportUnits::of(*axis).deviation
+            }
         }
     }
 }

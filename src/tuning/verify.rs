@@ -6,6 +6,7 @@
 
 use serde::Serialize;
 
+use crate::controller::Compensation;
 use crate::experiments::positioning::iso230::ReportUnits;
 use crate::input::{Move, Trajectory};
 use crate::model::idx::THETA_M;
@@ -40,13 +41,18 @@ pub const SETTLED: f64 = 20.0;
 
 /// The step and the out-and-back move of `p` on the nonlinear model.
 pub fn responses(p: &Params) -> Result<Responses, SimError> {
+    responses_with(p, &Compensation::default())
+}
+
+/// The same with the controller's compensations `c` on.
+pub fn responses_with(p: &Params, c: &Compensation) -> Result<Responses, SimError> {
     let u = ReportUnits::of(p.axis);
     let k = u.deviation_per_si;
     let (step, speed) = match p.axis {
         Axis::Rotary => (1f64.to_radians(), 10f64.to_radians()),
         Axis::Linear => (1e-3, 10e-3),
     };
-    let samples = run(p, &[(0.0, step, None, 1.0)])?;
+    let samples = run(p, c, &[(0.0, step, None, 1.0)])?;
     let peak_step = samples.iter().map(|s| s.1).fold(f64::MIN, f64::max);
     let settled = samples
         .iter()
@@ -56,6 +62,7 @@ pub fn responses(p: &Params) -> Result<Responses, SimError> {
     let leg = 5.0 * step / speed;
     let out_and_back = run(
         p,
+        c,
         &[
             (0.0, 5.0 * step, Some(speed), leg),
             (5.0 * step, 0.0, Some(speed), leg),
@@ -86,9 +93,14 @@ pub fn responses(p: &Params) -> Result<Responses, SimError> {
 type Sample = (f64, f64, f64, f64);
 
 /// Runs the moves (from, to, speed, duration) one after the other from rest.
-fn run(p: &Params, moves: &[(f64, f64, Option<f64>, f64)]) -> Result<Vec<Sample>, SimError> {
+fn run(
+    p: &Params,
+    c: &Compensation,
+    moves: &[(f64, f64, Option<f64>, f64)],
+) -> Result<Vec<Sample>, SimError> {
     let mut sim = Simulation::with_default_step(p)?;
     let mut controller = sim.controller(p)?;
+    controller.set_compensation(c.clone());
     let mut out = Vec::new();
     for &(from, to, speed, duration) in moves {
         let m = Move { from, to, speed };

@@ -7,7 +7,7 @@ use std::path::Path;
 use super::markup::{escape, facts, fixed, table};
 use super::{HtmlError, Kind, Section};
 use crate::experiments::positioning::iso230::AxisStats;
-use crate::prediction::{DrawSource, Predicted, Prediction};
+use crate::prediction::{CasePrediction, DrawSource, Predicted, Prediction};
 
 /// The section of the prediction `value` read from `path`.
 pub fn section(path: &Path, value: serde_json::Value) -> Result<(Section, Prediction), HtmlError> {
@@ -46,7 +46,7 @@ pub fn section(path: &Path, value: serde_json::Value) -> Result<(Section, Predic
     let section = Section {
         kind: Kind::Prediction,
         file: path.to_path_buf(),
-        title: "Prediction: positioning before and after the settings".into(),
+        title: "Prediction: before and after the settings".into(),
         body,
     };
     Ok((section, p))
@@ -61,19 +61,24 @@ fn none_or(names: &[String]) -> String {
 }
 
 fn values_table(p: &Prediction) -> String {
-    let mut header = vec!["output".to_string()];
-    header.extend(p.cases.iter().map(|c| c.case.clone()));
-    let rows: Vec<Vec<String>> = p.cases[0]
-        .values
-        .iter()
-        .enumerate()
-        .map(|(k, v)| {
-            let mut row = vec![label(&v.name)];
-            row.extend(p.cases.iter().map(|c| cell(&c.values[k])));
-            row
+    p.by_test()
+        .into_iter()
+        .map(|(test, cases)| {
+            let mut header = vec![format!("{test}, {}", cases[0].unit)];
+            header.extend(cases.iter().map(|c| c.case.clone()));
+            let rows: Vec<Vec<String>> = cases[0]
+                .values
+                .iter()
+                .enumerate()
+                .map(|(k, v)| {
+                    let mut row = vec![label(&v.name)];
+                    row.extend(cases.iter().map(|c| cell(&c.values[k])));
+                    row
+                })
+                .collect();
+            table(&header, &rows)
         })
-        .collect();
-    table(&header, &rows)
+        .collect()
 }
 
 fn label(name: &str) -> String {
@@ -84,6 +89,10 @@ fn label(name: &str) -> String {
         "M" => "mean deviation M".into(),
         "R" => "repeatability R".into(),
         "A" => "accuracy A".into(),
+        "step_overshoot_percent" => "step overshoot, %".into(),
+        "following_error" => "following error".into(),
+        "reversal_spike" => "reversal spike".into(),
+        "peak_effort" => "peak torque or force (N·m, N)".into(),
         other => other.into(),
     }
 }
@@ -112,7 +121,7 @@ pub fn comparison(predictions: &[(String, Prediction)], records: &[Measured]) ->
     let mut header = vec!["output".to_string()];
     for (file, p) in predictions {
         header.extend(
-            p.cases
+            positioning(p)
                 .iter()
                 .map(|c| format!("{} predicted ({file})", c.case)),
         );
@@ -123,7 +132,7 @@ pub fn comparison(predictions: &[(String, Prediction)], records: &[Measured]) ->
         .map(|&name| {
             let mut row = vec![label(name)];
             for (_, p) in predictions {
-                row.extend(p.cases.iter().map(|c| {
+                row.extend(positioning(p).iter().map(|c| {
                     c.values
                         .iter()
                         .find(|v| v.name == name)
@@ -145,6 +154,11 @@ pub fn comparison(predictions: &[(String, Prediction)], records: &[Measured]) ->
         title: "Before, after and predicted".into(),
         body,
     })
+}
+
+/// A prediction's positioning cases (the ones a record can be set beside).
+fn positioning(p: &Prediction) -> Vec<&CasePrediction> {
+    p.cases.iter().filter(|c| c.test == "positioning").collect()
 }
 
 /// A file's name for a table heading: its folder and name (records are often all
