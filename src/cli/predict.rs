@@ -104,7 +104,8 @@ const MAX_DRAWS: usize = 100_000;
 pub fn run(a: Args) -> anyhow::Result<()> {
     refuse_outputs(&a)?;
     let fit = model_args::read_fit(&a.fit)?;
-    let params = model(&a)?;
+    let mut params = a.model.load()?;
+    model_args::apply_fit(&mut params, &fit, &a.fit)?;
     let (source, draws) = draws(&a, &fit)?;
     let cases = cases(&a, &params)?;
     let stop = Arc::new(AtomicBool::new(false));
@@ -141,11 +142,6 @@ fn refuse_outputs(a: &Args) -> anyhow::Result<()> {
     inputs.extend(a.compensation.as_deref());
     inputs.extend(a.tune.as_deref());
     refuse_overwrite("-o", out, &inputs)
-}
-
-/// The base set with the fit's values, and the tuned controller with --tune.
-fn model(a: &Args) -> anyhow::Result<Params> {
-    model_args::fitted(&a.model, Some(&a.fit), None)
 }
 
 fn draws(a: &Args, fit: &IdentifyResult) -> anyhow::Result<(DrawSource, draws::Draws)> {

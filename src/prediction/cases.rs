@@ -63,12 +63,12 @@ impl Case {
             }
             None => p,
         };
-        match &self.test {
+        let values: Vec<(&'static str, f64)> = match &self.test {
             Test::Positioning { test, axis } => {
                 let readings = positioning::run(p, test, |_, _| {})?;
                 let stats = iso230::evaluate(&readings)?.axis;
                 let s = stats.scaled(ReportUnits::of(*axis).deviation_per_si);
-                Ok([
+                vec![
                     ("B_mean", s.b_mean),
                     ("B", s.b),
                     ("E", s.e),
@@ -76,23 +76,21 @@ impl Case {
                     ("R", s.r),
                     ("A", s.a),
                 ]
-                .into_iter()
-                .map(|(name, value)| Output { name, value })
-                .collect())
             }
             Test::Servo { compensation, .. } => {
                 let r = verify::responses_with(p, compensation)?;
-                Ok([
+                vec![
                     ("step_overshoot_percent", r.step_overshoot_percent),
                     ("following_error", r.following_error),
                     ("reversal_spike", r.reversal_spike),
                     ("peak_effort", r.peak_effort),
                 ]
-                .into_iter()
-                .map(|(name, value)| Output { name, value })
-                .collect())
             }
-        }
+        };
+        Ok(values
+            .into_iter()
+            .map(|(name, value)| Output { name, value })
+            .collect())
     }
 
     /// The test's name (`positioning`, `servo`).

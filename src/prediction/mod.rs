@@ -59,7 +59,6 @@ pub struct Predicted {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CasePrediction {
     /// The test (`positioning`, `servo`).
-    #[serde(default = "positioning")]
     pub test: String,
     pub case: String,
     pub unit: String,
@@ -83,10 +82,6 @@ pub struct Prediction {
     pub cases: Vec<CasePrediction>,
     /// What the interval does not include, and why draws are missing.
     pub notes: Vec<String>,
-}
-
-fn positioning() -> String {
-    "positioning".into()
 }
 
 impl Prediction {

@@ -61,15 +61,19 @@ pub fn fitted(
 ) -> anyhow::Result<Params> {
     let mut p = model.load()?;
     if let Some(path) = fit {
-        read_fit(path)?
-            .apply_to(&mut p)
-            .and_then(|()| p.validate())
-            .with_context(|| format!("{}: its values on the model", path.display()))?;
+        apply_fit(&mut p, &read_fit(path)?, path)?;
     }
     if let Some(path) = tune {
         p.controller = tuned_controller(path, &p)?;
     }
     Ok(p)
+}
+
+/// Sets the values of the identification result `fit` (read from `path`) in `p`.
+pub fn apply_fit(p: &mut Params, fit: &IdentifyResult, path: &Path) -> anyhow::Result<()> {
+    fit.apply_to(p)
+        .and_then(|()| p.validate())
+        .with_context(|| format!("{}: its values on the model", path.display()))
 }
 
 /// An identification result (`rtid identify --out`).

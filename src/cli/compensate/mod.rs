@@ -523,14 +523,7 @@ pub fn evaluate(
     let u = ReportUnits::of(axis);
     let corrected = compensate::apply(&measurements, &comp.compensation);
     let report = positioning::iso230::evaluate(&corrected)?;
-    let title = format!(
-        "{}: ISO 230-2 positioning, compensated",
-        exp.manifest.mechanism.as_deref().unwrap_or("table")
-    );
-    plot.write(
-        &rtid::report::positioning::deviations(&report, &title, u),
-        "",
-    )?;
+    crate::cli::experiment::positioning::plot_deviations(exp, &report, u, plot, ", compensated")?;
     let runs_used = runs_text(&compensate::run_numbers(&measurements));
     let k = u.deviation_per_si;
     if json {

@@ -241,15 +241,28 @@ pub fn report_runs(
     let units = ReportUnits::of(exp.data.axis().unwrap_or_default());
     let report =
         iso230::evaluate(&readings).map_err(|e| anyhow::anyhow!("{}: {e}", exp.path.display()))?;
+    plot_deviations(exp, &report, units, plot, "")?;
+    print_positioning(&report, units, json, &exp.path)
+}
+
+/// Writes the deviation chart (Fig. 10) of `report`, a record of `exp`, to `plot`,
+/// titled "MECHANISM: ISO 230-2 positioning" and `what` (`, compensated`).
+pub fn plot_deviations(
+    exp: &Experiment,
+    report: &iso230::Iso230Report,
+    units: ReportUnits,
+    plot: &Plot,
+    what: &str,
+) -> anyhow::Result<()> {
     let title = format!(
-        "{}: ISO 230-2 positioning",
+        "{}: ISO 230-2 positioning{what}",
         exp.manifest.mechanism.as_deref().unwrap_or("table")
     );
     plot.write(
-        &rtid::report::positioning::deviations(&report, &title, units),
+        &rtid::report::positioning::deviations(report, &title, units),
         "",
     )?;
-    print_positioning(&report, units, json, &exp.path)
+    Ok(())
 }
 
 /// Prints an ISO 230-2 evaluation, as a table or JSON, in `u`.
