@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use rtid::controller::{Controller, Gains};
 use rtid::estimation::inverse_dynamics::IdimSettings;
 use rtid::experiments::servo_trace::{
-    replay, simulation_error, virtual_trace, MoveTo, ServoTrace, TrapezoidalMoves,
+    replay, simulation_error, virtual_trace, MoveTo, ServoTrace, TraceError, TrapezoidalMoves,
 };
 use rtid::experiments::torque_curve::idim_fit;
 use rtid::experiments::torque_curve::{self, TorqueTest};
@@ -172,6 +172,30 @@ fn a_recorded_control_period_is_divided_evenly_not_by_a_vanishing_step() {
     let trace = virtual_trace(&p, &moves, None).unwrap();
     let e = simulation_error(&trace, &replay(&p, &trace).unwrap()).unwrap();
     assert_eq!((e.position_max, e.force_rms), (0.0, 0.0));
+}
+
+/// A record whose replay would take more steps than a replay may (three samples
+/// 10 000 s apart, on the direct drive's step of 10 µs or less: 2e9 steps and more)
+/// is refused before any step is taken, with its cost.
+#[test]
+fn a_replay_too_long_to_run_is_refused_up_front() {
+    let p = presets::load("direct-drive").unwrap();
+    let trace = ServoTrace {
+        time_s: vec![0.0, 1e4, 2e4],
+        reference: vec![0.0; 3],
+        position: vec![0.0; 3],
+        table_position: None,
+        force: vec![0.0; 3],
+        controller_output: None,
+        controller_added: None,
+        drive_functions: None,
+    };
+    let e = replay(&p, &trace).expect_err("2e9 steps and more");
+    assert!(
+        matches!(e, TraceError::TooLong { steps, .. } if steps > 1.99e9),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("steps of the model"), "{e}");
 }
 
 #[test]

@@ -117,7 +117,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let checked = [verify::responses(&p)?, verify::responses(&t.params)?];
     if a.json {
         let mut v = rtid::io::json::value(&t)?;
-        v["verification"] = serde_json::json!({"before": checked[0], "after": checked[1]});
+        v["verification"] = serde_json::json!({
+            "before": rtid::io::json::value(&checked[0])?,
+            "after": rtid::io::json::value(&checked[1])?,
+        });
         println!("{}", rtid::io::json::pretty(&v)?);
     } else {
         print_table(&p.name, &t);

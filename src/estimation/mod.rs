@@ -5,7 +5,7 @@
 //!   coherence), [`stepped_sine`] (demodulation dwell by dwell), [`periodic`] (a
 //!   periodic multisine: its design, the record cut into periods, the estimate with
 //!   per-line noise and the nonlinear distortion);
-//! - what a gain curve shows: [`peaks`] (the one peak finder), [`extrema`]
+//! - what a gain curve shows: [`curve_noise`] (its noise read off the curve), [`peaks`] (the one peak finder), [`extrema`]
 //!   (resonances and antiresonances above the noise), [`local_mode_fit`] (frequency
 //!   and damping by a local rational fit), [`two_mass_ratios`] (what a two-mass
 //!   drive's resonance and antiresonance determine);
@@ -20,6 +20,7 @@
 //! - [`information`]: AIC, AICc, BIC, Akaike weights and nested F-tests of fits of the
 //!   same data, from plain figures.
 
+pub mod curve_noise;
 pub mod extrema;
 pub mod friction_law;
 pub mod information;

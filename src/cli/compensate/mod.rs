@@ -332,24 +332,26 @@ const MODEL_SOURCE: &str =
 fn print_json(o: &Origin, c: &Computed) -> anyhow::Result<()> {
     let u = ReportUnits::of(c.axis);
     let k = u.deviation_per_si;
-    let scaled = |b: &BeforeAfter| {
-        serde_json::json!({
-            "before": b.before.scaled(k),
-            "backlash_only": b.backlash_only.scaled(k),
-            "after": b.after.scaled(k),
-        })
+    // Every number through the finite check: `json!` would write a NaN as null.
+    let num = |x: f64| rtid::io::json::value(&x);
+    let scaled = |b: &BeforeAfter| -> anyhow::Result<serde_json::Value> {
+        Ok(serde_json::json!({
+            "before": rtid::io::json::value(&b.before.scaled(k))?,
+            "backlash_only": rtid::io::json::value(&b.backlash_only.scaled(k))?,
+            "after": rtid::io::json::value(&b.after.scaled(k))?,
+        }))
     };
     let targets: Vec<_> = c
         .targets
         .iter()
         .map(|t| {
-            serde_json::json!({
-                format!("target_{}", u.target_key): t.target * u.target_per_si,
-                "mean_up": t.mean_up * k, "mean_down": t.mean_down * k,
-                "reversal": t.reversal * k, "table": t.table * k,
-            })
+            Ok(serde_json::json!({
+                format!("target_{}", u.target_key): num(t.target * u.target_per_si)?,
+                "mean_up": num(t.mean_up * k)?, "mean_down": num(t.mean_down * k)?,
+                "reversal": num(t.reversal * k)?, "table": num(t.table * k)?,
+            }))
         })
-        .collect();
+        .collect::<anyhow::Result<_>>()?;
     let warnings: Vec<_> = c
         .warnings
         .iter()
@@ -365,27 +367,32 @@ fn print_json(o: &Origin, c: &Computed) -> anyhow::Result<()> {
         "unit": u.deviation_key,
         "build_runs": c.build_runs,
         "check_runs": c.check_runs,
-        "backlash": c.compensation.backlash.unwrap_or(0.0) * k,
-        "friction": c.compensation.friction.as_ref().map(friction_json),
+        "backlash": num(c.compensation.backlash.unwrap_or(0.0) * k)?,
+        "friction": c.compensation.friction.as_ref().map(friction_json).transpose()?,
         "targets": targets,
-        "build": scaled(&c.build),
-        "check": c.check.as_ref().map(scaled),
+        "build": scaled(&c.build)?,
+        "check": c.check.as_ref().map(scaled).transpose()?,
         "warnings": warnings,
     });
     println!("{}", rtid::io::json::pretty(&value)?);
     Ok(())
 }
 
-/// A friction compensation in JSON, SI at the motor.
-fn friction_json(f: &FrictionCompensation) -> serde_json::Value {
-    serde_json::json!({
-        "coulomb": f.law.coulomb,
-        "viscous": f.law.viscous,
-        "stribeck": f.law.rise.map(|r| serde_json::json!({
-            "rise": r.rise, "speed": r.speed, "shape": r.shape,
+/// A friction compensation in JSON, SI at the motor (through the finite check).
+fn friction_json(f: &FrictionCompensation) -> Result<serde_json::Value, rtid::io::json::JsonError> {
+    let num = |x: f64| rtid::io::json::value(&x);
+    let stribeck = match f.law.rise {
+        Some(r) => Some(serde_json::json!({
+            "rise": num(r.rise)?, "speed": num(r.speed)?, "shape": num(r.shape)?,
         })),
-        "offset": f.offset,
-    })
+        None => None,
+    };
+    Ok(serde_json::json!({
+        "coulomb": num(f.law.coulomb)?,
+        "viscous": num(f.law.viscous)?,
+        "stribeck": stribeck,
+        "offset": num(f.offset)?,
+    }))
 }
 
 /// The friction compensation in words.
@@ -533,9 +540,9 @@ pub fn evaluate(
             "compensation": file,
             "runs": compensate::run_numbers(&measurements),
             "unit": u.deviation_key,
-            "uncompensated": b.before.scaled(k),
-            "backlash_only": b.backlash_only.scaled(k),
-            "compensated": b.after.scaled(k),
+            "uncompensated": rtid::io::json::value(&b.before.scaled(k))?,
+            "backlash_only": rtid::io::json::value(&b.backlash_only.scaled(k))?,
+            "compensated": rtid::io::json::value(&b.after.scaled(k))?,
         });
         println!("{}", rtid::io::json::pretty(&value)?);
         return Ok(());

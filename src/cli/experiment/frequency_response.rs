@@ -297,7 +297,8 @@ pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
             "points": frequency_hz.len(),
         });
         if let Some(c) = &complex {
-            value["modes"] = rtid::io::json::value(&c.modes)?;
+            value["modes"] = rtid::io::json::value(&c.modes.modes)?;
+            value["prominent_peaks"] = c.modes.prominent.into();
             value["response"] = c.form.response.name().into();
             value["noise_stated"] = c.noise_stated.into();
             if let [Some(phase), Some(nyquist)] = &c.plots {
@@ -333,7 +334,7 @@ pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
 /// written.
 struct ComplexEvaluation {
     form: ResponseForm,
-    modes: Vec<modal::Mode>,
+    modes: modal::ModeSearch,
     noise_stated: bool,
     /// The phase and Nyquist plots, where plots are written.
     plots: [Option<PathBuf>; 2],
@@ -403,10 +404,19 @@ fn print_modes(c: &ComplexEvaluation) {
              delay's phase lag biases the damping ratios"
         );
     }
-    if c.modes.is_empty() {
+    if c.modes.modes.is_empty() {
         println!("  no resonance stands out of the gain");
     }
-    for m in &c.modes {
+    if c.modes.prominent > c.modes.modes.len() {
+        println!(
+            "  {} peaks stand out of the gain's noise: more than a drive's few \
+             resonances, the curve is noise-like at its resolution; its {} highest \
+             are fitted, and none is a resonance unless its fit says so",
+            c.modes.prominent,
+            c.modes.modes.len()
+        );
+    }
+    for m in &c.modes.modes {
         let head = format!(
             "  peak {:7.2} Hz  band {:.1}–{:.1} Hz ({} lines)",
             m.peak.frequency_hz, m.band_hz.0, m.band_hz.1, m.lines

@@ -292,7 +292,7 @@ pub fn report_with(
         value["source"] = serde_json::json!(exp.path);
         if let Evaluation::Periodic(p) = &e {
             if let (Some(v), serde_json::Value::Object(keys)) =
-                (value.as_object_mut(), super::periodic_summary::hz_keys(p))
+                (value.as_object_mut(), super::periodic_summary::hz_keys(p)?)
             {
                 v.extend(keys);
             }

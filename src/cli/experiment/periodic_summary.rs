@@ -142,13 +142,15 @@ fn class(
     }
 }
 
-/// The channels' mode frequencies as flat `*_hz` keys, for scripts.
-pub fn hz_keys(p: &PeriodicEvaluation) -> serde_json::Value {
-    let hz = |m: &[Mode]| m.iter().map(|m| m.frequency_hz).collect::<Vec<_>>();
-    serde_json::json!({
-        "table_resonances_hz": hz(&p.table.resonances),
-        "table_antiresonances_hz": hz(&p.table.antiresonances),
-        "motor_resonances_hz": hz(&p.motor.resonances),
-        "motor_antiresonances_hz": hz(&p.motor.antiresonances),
-    })
+/// The channels' mode frequencies as flat `*_hz` keys, for scripts (through the
+/// finite check: `json!` would write a NaN as null).
+pub fn hz_keys(p: &PeriodicEvaluation) -> Result<serde_json::Value, rtid::io::json::JsonError> {
+    let hz =
+        |m: &[Mode]| rtid::io::json::value(&m.iter().map(|m| m.frequency_hz).collect::<Vec<_>>());
+    Ok(serde_json::json!({
+        "table_resonances_hz": hz(&p.table.resonances)?,
+        "table_antiresonances_hz": hz(&p.table.antiresonances)?,
+        "motor_resonances_hz": hz(&p.motor.resonances)?,
+        "motor_antiresonances_hz": hz(&p.motor.antiresonances)?,
+    }))
 }

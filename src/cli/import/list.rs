@@ -227,8 +227,9 @@ fn channel_json(c: &Channel) -> Value {
         o["unit_in_name"] = json!(unit);
     }
     match sample_period_s(c) {
-        Some(p) => o["sample_period_s"] = json!(p),
-        None => o["abscissa"] = json!(abscissa_text(c, None)),
+        // A period is finite (a time base's step); said as text otherwise, never null.
+        Some(p) if p.is_finite() => o["sample_period_s"] = json!(p),
+        _ => o["abscissa"] = json!(abscissa_text(c, None)),
     }
     o
 }

@@ -3,7 +3,10 @@
 //! around it ([`crate::estimation::local_mode_fit`]).
 //!
 //! **Resonances.** The prominent peaks ([`peaks::prominent`], at least
-//! [`PROMINENCE_DB`] plus twice the gain's stated noise) of the gain with the
+//! [`PROMINENCE_DB`] plus twice the gain's noise at the peak and at its base: the
+//! stated noise, or where the file states none the curve's own
+//! ([`curve_noise::second_difference`]), so that a noisy curve's ripples are not
+//! resonances) of the gain with the
 //! integrators removed (|H|·ω^p: p = 0 for the table over the motor, 2 for a
 //! compliance, whose 1/ω² slope would otherwise tilt the peaks).
 //!
@@ -31,6 +34,7 @@ use rustfft::num_complex::Complex;
 use serde::Serialize;
 
 use super::measured::{ComplexPoints, DB_PER_NEPER, PROMINENCE_DB};
+use crate::estimation::curve_noise;
 use crate::estimation::local_mode_fit::{fit, ModeFitOptions, SecondOrder};
 use crate::estimation::peaks::{self, Peak};
 
@@ -57,10 +61,25 @@ pub struct Mode {
 /// Relative half-width of the band around a peak.
 pub const BAND: f64 = 0.2;
 
+/// The most resonances fitted: a drive shows a few; a curve with more prominent
+/// peaks than this is noise-like at its resolution, and its highest are fitted.
+pub const MOST_MODES: usize = 12;
+
+/// The modes found, and how many prominent peaks the gain has.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ModeSearch {
+    /// The modes fitted, ascending in frequency: every prominent peak's, or the
+    /// [`MOST_MODES`] highest.
+    pub modes: Vec<Mode>,
+    /// The gain's prominent peaks: more than [`MOST_MODES`] says the curve is
+    /// noise-like, and that the modes are its highest peaks only.
+    pub prominent: usize,
+}
+
 /// The modes of `points` (any order of lines), `integrators` as in
 /// [`ModeFitOptions`]: 0 for an angle over an angle, 2 for an angle over a torque.
 /// Ascending in frequency; empty when the gain has no prominent peak.
-pub fn modes(points: &ComplexPoints, integrators: u32) -> Vec<Mode> {
+pub fn modes(points: &ComplexPoints, integrators: u32) -> ModeSearch {
     let mut order: Vec<usize> = (0..points.frequency_hz.len())
         .filter(|&k| {
             points.frequency_hz[k] > 0.0
@@ -99,10 +118,16 @@ pub fn modes(points: &ComplexPoints, integrators: u32) -> Vec<Mode> {
             (x, DB_PER_NEPER * (g.norm().ln() + p * w.ln()))
         })
         .collect();
-    let sigma_db: Option<Vec<f64>> =
-        stated.then(|| sigma.iter().map(|s| DB_PER_NEPER * s).collect());
+    let sigma_db: Option<Vec<f64>> = if stated {
+        Some(sigma.iter().map(|s| DB_PER_NEPER * s).collect())
+    } else {
+        let gain: Vec<f64> = curve.iter().map(|c| c.1).collect();
+        curve_noise::second_difference(&gain).map(|noise| vec![noise; gain.len()])
+    };
     let found = peaks::prominent(&curve, sigma_db.as_deref(), PROMINENCE_DB);
-    (0..found.len())
+    let prominent = found.len();
+    let found = peaks::highest(found, MOST_MODES);
+    let modes = (0..found.len())
         .map(|k| {
             let centre = found[k].frequency_hz;
             let mut lo = (1.0 - BAND) * centre;
@@ -116,7 +141,8 @@ pub fn modes(points: &ComplexPoints, integrators: u32) -> Vec<Mode> {
             let first = one(&f, &h, &sigma, found[k], (lo, hi), integrators);
             narrowed(&f, &h, &sigma, first, integrators)
         })
-        .collect()
+        .collect();
+    ModeSearch { modes, prominent }
 }
 
 /// Bandwidths (2ζ·f, the half-power width) on each side of the pole in the second fit.
@@ -248,7 +274,7 @@ mod tests {
         let f: Vec<f64> = (20..=300).map(|i| f64::from(i) * 0.5).collect();
         for seed in 0..5 {
             let (points, f0, zeta) = response(&f, seed, 1.0);
-            let found = modes(&points, 0);
+            let found = modes(&points, 0).modes;
             assert_eq!(found.len(), 1, "{found:?}");
             let m = &found[0];
             let pole = m.pole.expect("a pole pair");
@@ -281,7 +307,7 @@ mod tests {
         let (mut points, f0, _) = response(&f, 7, 2.0);
         points.sigma_ln = Some(vec![0.02; f.len()]);
         points.sigma_phase = Some(vec![0.02; f.len()]);
-        let m = &modes(&points, 0)[0];
+        let m = &modes(&points, 0).modes[0];
         let pole = m.pole.unwrap();
         assert!((pole.frequency_hz - f0).abs() < 3.0 * pole.frequency_se_hz);
         assert!((0.7..1.3).contains(&m.residual_rms), "{m:?}");
@@ -291,7 +317,7 @@ mod tests {
     fn an_exact_response_is_exact_and_a_flat_one_has_no_mode() {
         let f: Vec<f64> = (20..=300).map(|i| f64::from(i) * 0.5).collect();
         let (points, f0, zeta) = response(&f, 0, 0.0);
-        let pole = modes(&points, 0)[0].pole.unwrap();
+        let pole = modes(&points, 0).modes[0].pole.unwrap();
         assert!((pole.frequency_hz - f0).abs() < 1e-6 * f0, "{pole:?}");
         assert!((pole.damping_ratio - zeta).abs() < 1e-6 * zeta, "{pole:?}");
         let flat = ComplexPoints {
@@ -301,7 +327,7 @@ mod tests {
             sigma_ln: None,
             sigma_phase: None,
         };
-        assert!(modes(&flat, 0).is_empty());
+        assert!(modes(&flat, 0).modes.is_empty());
     }
 
     /// The exact damped poles of the worm-gear preset's motor-held model (the
@@ -343,7 +369,7 @@ mod tests {
                 sigma_phase: None,
             };
             let exact = motor_held_poles(name);
-            let found = modes(&points, 0);
+            let found = modes(&points, 0).modes;
             assert_eq!(found.len(), exact.len(), "{name}: {found:?}");
             for (m, &(f0, zeta)) in found.iter().zip(&exact) {
                 let pole = m.pole.unwrap();

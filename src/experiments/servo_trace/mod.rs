@@ -89,6 +89,19 @@ pub enum TraceError {
         value: f64,
         reason: &'static str,
     },
+    #[error(
+        "replaying the trace takes {steps:.2e} steps of the model ({duration_s} s of \
+         record at its integration step of {step_s:.3e} s), more than the {limit:.0e} \
+         (about 100 s at 10 M steps/s) a replay may take, and an identification replays \
+         it many times: cut the record to the stretch needed (its file's rows), or take \
+         a model whose stiffest mode allows a longer step (rtid modes)"
+    )]
+    TooLong {
+        steps: f64,
+        duration_s: f64,
+        step_s: f64,
+        limit: f64,
+    },
     #[error(transparent)]
     Simulation(#[from] SimError),
 }

@@ -33,6 +33,11 @@ pub struct Replay {
     pub controller_output: Vec<f64>,
 }
 
+/// The most integration steps a replay may take: about 100 s at the kernel's rate of
+/// about 10 M steps/s (docs/performance.md). A longer one is refused up front with its
+/// cost, before any step is taken, instead of running for hours.
+pub const MAX_REPLAY_STEPS: f64 = 1e9;
+
 /// The benchmark's simulation error of a replay against its record (SI units).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Misfit {
@@ -65,6 +70,7 @@ pub fn replay(params: &Params, trace: &ServoTrace) -> Result<Replay, TraceError>
         functions.apply(&mut p.controller);
         p.validate().map_err(TraceError::DriveFunctions)?;
     }
+    affordable(&p, &trace.time_s)?;
     let velocity = (trace.position[1] - trace.position[0]) / period;
     let start = Start {
         position: trace.position[0],
@@ -77,6 +83,22 @@ pub fn replay(params: &Params, trace: &ServoTrace) -> Result<Replay, TraceError>
         trace.controller_added.as_deref(),
         start,
     )?)
+}
+
+/// The replay's cost in integration steps, refused above [`MAX_REPLAY_STEPS`].
+fn affordable(p: &Params, time_s: &[f64]) -> Result<(), TraceError> {
+    let step_s = crate::sim::default_step(p)?;
+    let duration_s = time_s[time_s.len() - 1] - time_s[0];
+    let steps = duration_s / step_s;
+    if steps > MAX_REPLAY_STEPS {
+        return Err(TraceError::TooLong {
+            steps,
+            duration_s,
+            step_s,
+            limit: MAX_REPLAY_STEPS,
+        });
+    }
+    Ok(())
 }
 
 /// The simulation error of `replay` against `trace`: RMS and largest position

@@ -8,15 +8,17 @@
 //! reproduces the measurement, so a difference is what the linear model cannot
 //! explain — backlash and friction shifting the peaks, or resonances the linear fit
 //! itself misses. A stiffness goes with the square of a frequency, so a miss of
-//! [`ESCALATE_ABOVE`] (0.5 %) is a bias of about 1 % in the stiffnesses: beyond it the
-//! result is the nonlinear fit (the corrections of [`crate::identify::pipeline::correction`]), and a
+//! [`ESCALATE_ABOVE`] (0.5 %) is a bias of about 1 % in the stiffnesses: beyond it,
+//! and beyond [`MISS_SIGMAS`] standard errors of the measured peak (its frequency's
+//! uncertainty under the curve's noise: a peak picked from a noisy gain moves by
+//! more than 0.5 % on its own), the result is the nonlinear fit (the corrections of [`crate::identify::pipeline::correction`]), and a
 //! warning says so.
 //!
 //! **Only where the data ask.** A linear fit that explains the gain curve within the
 //! curve's own noise ([`EXPLAINED_WITHIN`] times it) stands whatever the nonlinear
 //! test says: the test runs with backlash and friction the record does not
 //! determine (a preset's, say), and its disagreement is then the assumption's, not
-//! the data's. The noise is estimated from the curve itself ([`noise_db`]), so a
+//! the data's. The noise is estimated from the curve itself ([`curve_noise::second_difference`]), so a
 //! file without stated noise is judged too. A complex FRF of a linear drive made by
 //! an independent model with 2 % complex noise (fixtures/frf) is explained by the
 //! linear fit (misfit 0.17 dB, noise 0.17 dB) and stays linear; before, the
@@ -30,7 +32,8 @@
 
 use rayon::prelude::*;
 
-use crate::estimation::peaks::vertex;
+use crate::estimation::curve_noise;
+use crate::estimation::peaks::{vertex, vertex_se_hz};
 use crate::experiments::frequency_response::measured::{self, fits_whole_curve};
 use crate::experiments::frequency_response::{simulate_point, FrequencyTest};
 use crate::identify::config::Config;
@@ -38,7 +41,6 @@ use crate::identify::error::IdentifyError;
 use crate::identify::result::warning::Warning;
 use crate::identify::result::NonlinearCheck;
 use crate::io::experiment_file::Experiment;
-use crate::io::import::glitches::median;
 use crate::model::linear_response::{Channel, LinearResponse};
 use crate::model::Params;
 use crate::objectives::measured_peaks::measured_peaks;
@@ -50,6 +52,10 @@ use crate::objectives::{sum_of_squares, ObjectiveError, Source};
 /// measurement) beyond which `auto` goes on to the nonlinear fit.
 pub const ESCALATE_ABOVE: f64 = 5e-3;
 
+/// Standard errors of the measured peak within which the nonlinear test's miss is
+/// the measurement's uncertainty, not a disagreement (99.7 % of a normal).
+pub const MISS_SIGMAS: f64 = 3.0;
+
 /// The RMS misfit of the linear model's gain curve, dB, beyond which `auto` goes on
 /// to the nonlinear fit: far above the noise of any gain measurement (1 % amplitude
 /// noise is 0.09 dB) — a peak friction flattened, or one the fit put elsewhere.
@@ -59,9 +65,6 @@ pub const MISFIT_ABOVE_DB: f64 = 1.0;
 /// linear fit: white noise gives a ratio of 1 (a few fitted parameters over hundreds
 /// of lines); a resonance the model puts elsewhere adds its smooth error on top.
 pub const EXPLAINED_WITHIN: f64 = 1.5;
-
-/// Lines below which the curve's noise is not estimated.
-const NOISE_LINES: usize = 20;
 
 /// The nonlinear parameters a correction takes from the base where they are not
 /// fitted: backlash and friction.
@@ -94,6 +97,7 @@ pub fn check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, Identif
             .collect::<Result<Vec<f64>, _>>()
             .map_err(ObjectiveError::from)?;
         let (linear_misfit_db, noise_db) = gain_misfit_db(&spec.experiment, p)?;
+        let measured_se_hz = peaks_se_hz(&spec.experiment, &measured, noise_db);
         let max_miss_hz = model
             .iter()
             .zip(&measured)
@@ -102,6 +106,7 @@ pub fn check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, Identif
         out.push(NonlinearCheck {
             source: spec.source.clone(),
             measured_hz: measured,
+            measured_se_hz,
             linear_hz,
             model_hz: model,
             max_miss_hz,
@@ -128,7 +133,7 @@ pub fn assumed(p: &Params, fitted: &[&str]) -> String {
 /// The RMS of the linear model's gain against the measured one, dB, over the valid
 /// lines: the gain alone, in dB whatever the file's stated noise — a phase error (a
 /// delay, say) is not one the nonlinear test could explain; and the curve's noise
-/// ([`noise_db`]).
+/// ([`curve_noise::second_difference`]).
 fn gain_misfit_db(exp: &Experiment, p: &Params) -> Result<(f64, Option<f64>), IdentifyError> {
     let lin = LinearResponse::new(p, Channel::TableOverMotor).map_err(ObjectiveError::from)?;
     let mut points: Vec<(f64, f64)> = measured::valid_points(exp)
@@ -137,23 +142,22 @@ fn gain_misfit_db(exp: &Experiment, p: &Params) -> Result<(f64, Option<f64>), Id
     points.sort_by(|a, b| a.0.total_cmp(&b.0));
     let errors: Vec<f64> = points.iter().map(|&(_, e)| e).collect();
     let rms = (sum_of_squares(&errors) / errors.len().max(1) as f64).sqrt();
-    Ok((rms, noise_db(&errors)))
+    Ok((rms, curve_noise::second_difference(&errors)))
 }
 
-/// The noise of gain errors `e` (dB, along ascending frequency), from their second
-/// differences e[k−1] − 2e[k] + e[k+1]: for white noise of σ their variance is 6σ²,
-/// and a smooth misfit adds next to nothing; the median of their magnitudes (×1.4826,
-/// a normal's σ) is not moved by the few lines where a misplaced resonance bends
-/// sharply. `None` on fewer than [`NOISE_LINES`] lines.
-pub fn noise_db(e: &[f64]) -> Option<f64> {
-    if e.len() < NOISE_LINES {
-        return None;
-    }
-    let mut d: Vec<f64> = e
-        .windows(3)
-        .map(|w| (w[0] - 2.0 * w[1] + w[2]).abs())
-        .collect();
-    Some(1.4826 * median(&mut d) / 6f64.sqrt())
+/// The standard error of each measured peak's frequency ([`vertex_se_hz`]) from the
+/// curve's noise; 0 where the record lists its peaks or its noise is unknown.
+fn peaks_se_hz(exp: &Experiment, peaks_hz: &[f64], noise_db: Option<f64>) -> Vec<f64> {
+    let mut curve: Vec<(f64, f64)> = measured::valid_points(exp).collect();
+    curve.sort_by(|a, b| a.0.total_cmp(&b.0));
+    peaks_hz
+        .iter()
+        .map(|&f| {
+            noise_db
+                .and_then(|sigma| vertex_se_hz(&curve, f, sigma))
+                .unwrap_or(0.0)
+        })
+        .collect()
 }
 
 /// Whether the linear fit explains a check's curve within its noise.
@@ -268,7 +272,10 @@ fn misfit_fails(db: f64) -> bool {
     db.is_nan() || db > MISFIT_ABOVE_DB
 }
 
-/// The largest |model − measured| / measured of a check (a NaN counts as infinite).
+/// The largest |model − measured| / measured of a check (a NaN counts as infinite)
+/// among the peaks the test misses by more than [`MISS_SIGMAS`] standard errors of
+/// the measured peak: a miss within the measurement's own uncertainty is not the
+/// data's.
 /// The linear fit's own miss (`linear_hz`, where it fitted the whole curve) is
 /// reported, not subtracted: a whole-curve linear fit that misses a clean peak by
 /// 1 % is itself the sign of what the test shows (the worm fixture: its own 0.95 %,
@@ -277,7 +284,15 @@ fn worst_relative_miss(c: &NonlinearCheck) -> f64 {
     c.model_hz
         .iter()
         .zip(&c.measured_hz)
-        .map(|(m, f)| ((m - f) / f).abs())
+        .enumerate()
+        .map(|(k, (m, f))| {
+            let se = c.measured_se_hz.get(k).copied().unwrap_or(0.0);
+            if (m - f).abs() <= MISS_SIGMAS * se {
+                0.0
+            } else {
+                ((m - f) / f).abs()
+            }
+        })
         .fold(
             0.0,
             |a: f64, b| if b.is_nan() { f64::INFINITY } else { a.max(b) },
@@ -292,6 +307,7 @@ mod tests {
         NonlinearCheck {
             source: "fr.json".into(),
             measured_hz: vec![200.0, 250.0],
+            measured_se_hz: Vec::new(),
             linear_hz: Vec::new(),
             model_hz,
             max_miss_hz: 0.0,
@@ -324,6 +340,17 @@ mod tests {
         assert!(verdict(&[check(vec![200.0, f64::NAN])], "").is_some());
     }
 
+    /// A miss within three standard errors of the measured peak is the measurement's
+    /// uncertainty: it does not escalate, however many per cent it is.
+    #[test]
+    fn a_miss_within_the_peak_s_own_uncertainty_does_not_escalate() {
+        let mut c = check(vec![200.0, 255.0]);
+        c.measured_se_hz = vec![0.1, 2.0];
+        assert!(verdict(&[c.clone()], "").is_none(), "5 Hz within 3 × 2 Hz");
+        c.measured_se_hz = vec![0.1, 1.0];
+        assert!(verdict(&[c], "").is_some(), "5 Hz beyond 3 × 1 Hz");
+    }
+
     /// A miss the linear fit explains within the curve's noise is not the data's:
     /// the fit stands, with a note naming what the test assumed.
     #[test]
@@ -348,23 +375,5 @@ mod tests {
             "misfit beyond the noise"
         );
         assert!(stands(&[c], "").is_empty());
-    }
-
-    /// White noise of σ reads as σ; a smooth misfit as next to nothing; a bend at
-    /// one line does not move it.
-    #[test]
-    fn the_noise_of_a_curve_is_its_second_differences_spread() {
-        use rand::{rngs::StdRng, SeedableRng};
-        use rand_distr::{Distribution, Normal};
-        let mut rng = StdRng::seed_from_u64(7);
-        let normal = Normal::new(0.0, 0.17).unwrap();
-        let mut e: Vec<f64> = (0..2000).map(|_| normal.sample(&mut rng)).collect();
-        let sigma = noise_db(&e).unwrap();
-        assert!((sigma / 0.17 - 1.0).abs() < 0.06, "{sigma}");
-        let smooth: Vec<f64> = (0..2000).map(|k| (k as f64 / 300.0).sin()).collect();
-        assert!(noise_db(&smooth).unwrap() < 1e-4);
-        e[1000] += 20.0;
-        assert!((noise_db(&e).unwrap() / sigma - 1.0).abs() < 0.01);
-        assert_eq!(noise_db(&e[..19]), None);
     }
 }

@@ -47,6 +47,12 @@ pub struct ExperimentResidual {
 pub struct NonlinearCheck {
     pub source: String,
     pub measured_hz: Vec<f64>,
+    /// The standard error of each measured peak's frequency from the curve's noise
+    /// (0 where unknown): a miss within [`MISS_SIGMAS`] of them does not count.
+    ///
+    /// [`MISS_SIGMAS`]: crate::identify::pipeline::escalation::MISS_SIGMAS
+    #[serde(default)]
+    pub measured_se_hz: Vec<f64>,
     pub model_hz: Vec<f64>,
     pub max_miss_hz: f64,
     /// RMS of the linear model's gain against the measured curve, dB (at the same

@@ -165,7 +165,7 @@ fn escalated(
     linear_misfit_db: f64,
 ) -> String {
     format!(
-        "{source}: the linear fit does not explain the data — the nonlinear virtual test at its parameters puts the resonances at {} Hz (measured {} Hz{}), up to {max_miss_hz:.2} Hz ({max_miss_percent:.2} %) off, and the linear model's gain misses the measured curve by {linear_misfit_db:.2} dB RMS — beyond 0.5 % (a stiffness biased twice as much) or 1 dB (a flattened or misplaced peak): backlash or friction at the test's amplitude. So the result is the nonlinear fit, the linear one corrected by the nonlinear test",
+        "{source}: the linear fit does not explain the data — the nonlinear virtual test at its parameters puts the resonances at {} Hz (measured {} Hz{}), up to {max_miss_hz:.2} Hz ({max_miss_percent:.2} %) off, and the linear model's gain misses the measured curve by {linear_misfit_db:.2} dB RMS — beyond 0.5 % (a stiffness biased twice as much) and three standard errors of the measured peak, or 1 dB (a flattened or misplaced peak): backlash or friction at the test's amplitude. So the result is the nonlinear fit, the linear one corrected by the nonlinear test",
         hz(model_hz),
         hz(measured_hz),
         if linear_hz.is_empty() {
