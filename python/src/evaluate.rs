@@ -12,7 +12,7 @@ use rtid::estimation::inverse_dynamics::IdimSettings;
 use rtid::experiments::frequency_response as fr;
 use rtid::experiments::servo_trace::ServoTrace;
 use rtid::experiments::torque_curve::{self, TorqueTest};
-use rtid::io::experiment_file::{Data, Experiment, Kind};
+use rtid::io::experiment_file::{Data, Experiment, Kind, Response};
 
 /// The evaluation of the experiment at `path` as JSON, `source` naming it.
 #[pyfunction]
@@ -51,12 +51,27 @@ fn frequency_response(exp: &Experiment, source: &str) -> PyResult<Value> {
         ));
     };
     let peaks = fr::evaluate(frequency_hz, gain_db).peaks;
-    Ok(json!({
+    let mut value = json!({
         "kind": "frequency_response",
         "source": source,
         "peaks": rtid::io::json::value(&peaks).map_err(|e| rtid_error(&e))?,
         "points": frequency_hz.len(),
-    }))
+    });
+    // With the phase: the modes of the complex response, as the command line adds them.
+    if let Some(c) =
+        fr::measured::complex_points(exp, |_| true).filter(|c| !c.frequency_hz.is_empty())
+    {
+        let form = fr::measured::form(exp);
+        let integrators = match form.response {
+            Response::TableOverMotor => 0,
+            Response::MotorCompliance => 2,
+        };
+        let modes = fr::modal::modes(&c, integrators);
+        value["modes"] = rtid::io::json::value(&modes).map_err(|e| rtid_error(&e))?;
+        value["response"] = form.response.name().into();
+        value["noise_stated"] = (c.sigma_ln.is_some() || c.sigma_phase.is_some()).into();
+    }
+    Ok(value)
 }
 
 /// RMS and peak torque, the reversals and the friction law of a torque curve.
