@@ -387,9 +387,11 @@ def _as_experiment(e, argument: str) -> Experiment:
 
 
 def evaluate(experiment) -> dict:
-    """The statistics ``rtid evaluate --json`` gives of an experiment: the resonances
-    of a frequency response, the torque curve's friction and reversals, a servo
-    trace's friction law by IDIM-LS. (Other kinds: the command line for now.)"""
+    """The statistics ``rtid evaluate --json`` gives of an experiment, as a dict: the
+    resonances (and with the phase the modes) of a frequency response, a torque
+    curve's friction and reversals, a positioning record's ISO 230-2 values, the
+    friction laws of a friction map, a servo trace's friction law by IDIM-LS.
+    (Fluctuation, unbalance and raw time records: the command line for now.)"""
     exp = _as_experiment(experiment, "experiment")
     with tempfile.TemporaryDirectory(prefix="rtid-") as d:
         return json.loads(_rtid.evaluate(exp._written(d), exp.name))

@@ -10,6 +10,8 @@ use serde_json::{json, Value};
 use crate::errors::{bad_argument, rtid_error, with_context};
 use rtid::estimation::inverse_dynamics::IdimSettings;
 use rtid::experiments::frequency_response as fr;
+use rtid::experiments::positioning as pos;
+use rtid::experiments::positioning::iso230::{self, ReportUnits};
 use rtid::experiments::servo_trace::ServoTrace;
 use rtid::experiments::torque_curve::{self, TorqueTest};
 use rtid::io::experiment_file::{Data, Experiment, Kind, Response};
@@ -22,6 +24,8 @@ pub fn evaluate(py: Python<'_>, path: PathBuf, source: String) -> PyResult<Strin
         Kind::FrequencyResponse => frequency_response(&exp, &source),
         Kind::TorqueCurve => torque(&exp, &source),
         Kind::ServoTrace => servo_trace(&exp, &source),
+        Kind::Positioning => positioning(&exp, &source),
+        Kind::FrictionMap => friction(&exp, &source),
         other => Err(bad_argument(
             "experiment",
             format!("evaluating a `{}` experiment from Python is not part of this version yet: run `rtid evaluate`", other.name()),
@@ -86,6 +90,49 @@ fn torque(exp: &Experiment, source: &str) -> PyResult<Value> {
     let report = torque_curve::evaluate(&curve, &test).map_err(|e| with_context(source, &e))?;
     let mut value = rtid::io::json::value(&report).map_err(|e| rtid_error(&e))?;
     value["kind"] = json!("torque_curve");
+    value["source"] = json!(source);
+    Ok(value)
+}
+
+/// The ISO 230-2 values of a positioning record, in the command line's units
+/// (arc-seconds or µm).
+fn positioning(exp: &Experiment, source: &str) -> PyResult<Value> {
+    let Some(readings) = pos::from_data(&exp.data) else {
+        return Err(bad_argument(
+            "experiment",
+            format!("{source}: not a positioning experiment"),
+        ));
+    };
+    let u = ReportUnits::of(exp.data.axis().unwrap_or_default());
+    let report = iso230::evaluate(&readings).map_err(|e| with_context(source, &e))?;
+    let k = u.deviation_per_si;
+    let mut targets = Vec::with_capacity(report.targets.len());
+    for t in &report.targets {
+        let mut v = rtid::io::json::value(&t.scaled(k)).map_err(|e| rtid_error(&e))?;
+        v[format!("target_{}", u.target_key)] = json!(t.target * u.target_per_si);
+        targets.push(v);
+    }
+    Ok(json!({
+        "kind": "positioning",
+        "source": source,
+        "unit": u.deviation_key,
+        "axis": rtid::io::json::value(&report.axis.scaled(k)).map_err(|e| rtid_error(&e))?,
+        "targets": targets,
+    }))
+}
+
+/// The friction laws fitted to a friction map, and the one the data support.
+fn friction(exp: &Experiment, source: &str) -> PyResult<Value> {
+    let Data::FrictionMap(map) = &exp.data else {
+        return Err(bad_argument(
+            "experiment",
+            format!("{source}: not a friction map"),
+        ));
+    };
+    let e = rtid::friction_map::evaluate(map)
+        .map_err(|m| bad_argument("experiment", format!("{source}: {m}")))?;
+    let mut value = rtid::io::json::value(&e).map_err(|e| rtid_error(&e))?;
+    value["kind"] = json!("friction_map");
     value["source"] = json!(source);
     Ok(value)
 }

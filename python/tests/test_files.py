@@ -32,6 +32,7 @@ def test_import_of_a_missing_file_names_the_path(tmp_path):
     "fixtures/real/emps/emps_estimation.json",
     "fixtures/worm-gear/frequency_response.json",
     "fixtures/worm-gear/torque_curve.json",
+    "fixtures/compensate/worm-gear/positioning.json",
 ])
 def test_evaluate_gives_the_cli_evaluation(cli, root, manifest):
     expected = cli("evaluate", manifest, "--json", json_out=True)
@@ -39,6 +40,14 @@ def test_evaluate_gives_the_cli_evaluation(cli, root, manifest):
     expected.pop("source")
     got.pop("source")
     assert got == expected
+
+
+def test_evaluate_of_a_friction_map_is_the_cli_evaluation(cli, tmp_path):
+    cli("experiment", "friction-map", "--preset", "two-mass", "--out", tmp_path)
+    manifest = tmp_path / "friction_map.json"
+    expected = cli("evaluate", manifest, "--json", json_out=True)
+    got = rtid.evaluate(manifest)
+    assert got == expected  # the source too: the path as given
 
 
 def test_evaluate_refuses_a_kind_it_does_not_wrap_yet(root):
