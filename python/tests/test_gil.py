@@ -17,7 +17,7 @@ def test_another_thread_runs_python_while_one_simulates():
     def long_run():
         started.set()
         window["start"] = time.perf_counter()
-        rtid.simulate(p, "sine:freq_hz=230,amp_nm=5", duration_s=10.0, dt_s=1e-5, sample_s=1.0)
+        rtid.simulate(p, "sine:freq_hz=230,amp_nm=5", duration_s=30.0, dt_s=1e-5, sample_s=1.0)
         window["end"] = time.perf_counter()
 
     worker = threading.Thread(target=long_run)
