@@ -41,7 +41,9 @@ pub fn identify(
     params: PyRef<'_, PyParams>,
     options: Options,
 ) -> PyResult<(String, PyParams)> {
-    let config = config(&experiments, params.inner.clone(), &options)?;
+    let base = params.inner.clone();
+    drop(params);
+    let config = config(&experiments, base, &options)?;
     let monitor = Monitor::default();
     let outcome = std::thread::scope(|s| {
         let search = s.spawn(|| rtid::identify(&config, &monitor));

@@ -78,6 +78,8 @@ pub fn simulate<'py>(
         }
     };
     let p = params.inner.clone();
+    // Not borrowed while the GIL is released: another thread may change the set.
+    drop(params);
     let mut sim = match dt_s {
         Some(dt) => Simulation::new(&p, dt).map_err(|e| with_context("dt_s", &e))?,
         None => Simulation::with_default_step(&p).map_err(|e| rtid_error(&e))?,

@@ -36,7 +36,9 @@ pub fn sweep<'py>(
     options: Options,
     out: PathBuf,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let s = build(params.inner.clone(), &options)?;
+    let base = params.inner.clone();
+    drop(params);
+    let s = build(base, &options)?;
     let (design, rows, indices) = py.detach(|| -> PyResult<_> {
         let design = s.design().map_err(|e| rtid_error(&e))?;
         let opts = RunOptions {

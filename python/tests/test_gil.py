@@ -52,3 +52,27 @@ def test_two_threads_simulate_at_once_with_the_same_numbers():
         t.join()
     for r in results:
         assert all((r[k] == serial[k]).all() for k in serial)
+
+
+def test_a_set_can_change_while_a_simulation_of_it_runs():
+    p = rtid.params("worm-gear")
+    before = rtid.simulate(p, "sine:freq_hz=230,amp_nm=5", duration_s=0.2)
+    stiffer = rtid.simulate(rtid.params("worm-gear", Kw=3.0e5), "sine:freq_hz=230,amp_nm=5", duration_s=0.2)
+    started = threading.Event()
+    result = {}
+
+    def run():
+        started.set()
+        result["run"] = rtid.simulate(p, "sine:freq_hz=230,amp_nm=5", duration_s=0.2)
+
+    worker = threading.Thread(target=run)
+    worker.start()
+    started.wait()
+    for _ in range(50):
+        p["Kw"] = 3.0e5
+        p["Kw"] = before_kw = rtid.params("worm-gear")["Kw"]
+    worker.join()
+    assert p["Kw"] == before_kw
+    # The run took the set as it was at one instant: one of the two.
+    same = [all((result["run"][k] == r[k]).all() for k in r) for r in (before, stiffer)]
+    assert any(same)
