@@ -1,0 +1,168 @@
+//! `rtid.evaluate`: the statistics `rtid evaluate --json` prints for an experiment, for
+//! the kinds whose evaluation is the library's alone (frequency response, torque
+//! curve, servo trace without a model to replay it on).
+
+use std::path::PathBuf;
+
+use pyo3::prelude::*;
+use serde_json::{json, Value};
+
+use crate::errors::{bad_argument, rtid_error, with_context};
+use rtid::estimation::inverse_dynamics::IdimSettings;
+use rtid::experiments::frequency_response as fr;
+use rtid::experiments::positioning as pos;
+use rtid::experiments::positioning::iso230::{self, ReportUnits};
+use rtid::experiments::servo_trace::ServoTrace;
+use rtid::experiments::torque_curve::{self, TorqueTest};
+use rtid::io::experiment_file::{Data, Experiment, Kind, Response};
+
+/// The evaluation of the experiment at `path` as JSON, `source` naming it.
+#[pyfunction]
+pub fn evaluate(py: Python<'_>, path: PathBuf, source: String) -> PyResult<String> {
+    let exp = rtid::read_experiment(&path).map_err(|e| with_context("experiment", &e))?;
+    let value = py.detach(|| match exp.manifest.kind {
+        Kind::FrequencyResponse => frequency_response(&exp, &source),
+        Kind::TorqueCurve => torque(&exp, &source),
+        Kind::ServoTrace => servo_trace(&exp, &source),
+        Kind::Positioning => positioning(&exp, &source),
+        Kind::FrictionMap => friction(&exp, &source),
+        other => Err(bad_argument(
+            "experiment",
+            format!("evaluating a `{}` experiment from Python is not part of this version yet: run `rtid evaluate`", other.name()),
+        )),
+    })?;
+    rtid::io::json::pretty(&value).map_err(|e| rtid_error(&e))
+}
+
+/// Reads the experiment at `path` as `rtid` reads it: its kind and number of rows.
+#[pyfunction]
+pub fn read_experiment(path: PathBuf) -> PyResult<(&'static str, usize)> {
+    let exp = rtid::read_experiment(&path).map_err(|e| with_context("experiment", &e))?;
+    Ok((exp.manifest.kind.name(), exp.data.len()))
+}
+
+/// The resonances of a gain curve.
+fn frequency_response(exp: &Experiment, source: &str) -> PyResult<Value> {
+    let Data::FrequencyResponse {
+        frequency_hz,
+        gain_db,
+        ..
+    } = &exp.data
+    else {
+        return Err(bad_argument(
+            "experiment",
+            format!("{source}: not a frequency-response experiment"),
+        ));
+    };
+    let peaks = fr::evaluate(frequency_hz, gain_db).peaks;
+    let mut value = json!({
+        "kind": "frequency_response",
+        "source": source,
+        "peaks": rtid::io::json::value(&peaks).map_err(|e| rtid_error(&e))?,
+        "points": frequency_hz.len(),
+    });
+    // With the phase: the modes of the complex response, as the command line adds them.
+    if let Some(c) =
+        fr::measured::complex_points(exp, |_| true).filter(|c| !c.frequency_hz.is_empty())
+    {
+        let form = fr::measured::form(exp);
+        let integrators = match form.response {
+            Response::TableOverMotor => 0,
+            Response::MotorCompliance => 2,
+        };
+        let modes = fr::modal::modes(&c, integrators);
+        value["modes"] = rtid::io::json::value(&modes).map_err(|e| rtid_error(&e))?;
+        value["response"] = form.response.name().into();
+        value["noise_stated"] = (c.sigma_ln.is_some() || c.sigma_phase.is_some()).into();
+    }
+    Ok(value)
+}
+
+/// RMS and peak torque, the reversals and the friction law of a torque curve.
+fn torque(exp: &Experiment, source: &str) -> PyResult<Value> {
+    let Some(curve) = torque_curve::from_data(&exp.data) else {
+        return Err(bad_argument(
+            "experiment",
+            format!("{source}: not a torque curve"),
+        ));
+    };
+    let test = TorqueTest::from_conditions(&exp.manifest.conditions);
+    let report = torque_curve::evaluate(&curve, &test).map_err(|e| with_context(source, &e))?;
+    let mut value = rtid::io::json::value(&report).map_err(|e| rtid_error(&e))?;
+    value["kind"] = json!("torque_curve");
+    value["source"] = json!(source);
+    Ok(value)
+}
+
+/// The ISO 230-2 values of a positioning record, in the command line's units
+/// (arc-seconds or µm).
+fn positioning(exp: &Experiment, source: &str) -> PyResult<Value> {
+    let Some(readings) = pos::from_data(&exp.data) else {
+        return Err(bad_argument(
+            "experiment",
+            format!("{source}: not a positioning experiment"),
+        ));
+    };
+    let u = ReportUnits::of(exp.data.axis().unwrap_or_default());
+    let report = iso230::evaluate(&readings).map_err(|e| with_context(source, &e))?;
+    let k = u.deviation_per_si;
+    let mut targets = Vec::with_capacity(report.targets.len());
+    for t in &report.targets {
+        let mut v = rtid::io::json::value(&t.scaled(k)).map_err(|e| rtid_error(&e))?;
+        v[format!("target_{}", u.target_key)] = json!(t.target * u.target_per_si);
+        targets.push(v);
+    }
+    Ok(json!({
+        "kind": "positioning",
+        "source": source,
+        "unit": u.deviation_key,
+        "axis": rtid::io::json::value(&report.axis.scaled(k)).map_err(|e| rtid_error(&e))?,
+        "targets": targets,
+    }))
+}
+
+/// The friction laws fitted to a friction map, and the one the data support.
+fn friction(exp: &Experiment, source: &str) -> PyResult<Value> {
+    let Data::FrictionMap(map) = &exp.data else {
+        return Err(bad_argument(
+            "experiment",
+            format!("{source}: not a friction map"),
+        ));
+    };
+    let e = rtid::friction_map::evaluate(map)
+        .map_err(|m| bad_argument("experiment", format!("{source}: {m}")))?;
+    let mut value = rtid::io::json::value(&e).map_err(|e| rtid_error(&e))?;
+    value["kind"] = json!("friction_map");
+    value["source"] = json!(source);
+    Ok(value)
+}
+
+/// The friction law of a servo trace by IDIM-LS (the default settings).
+fn servo_trace(exp: &Experiment, source: &str) -> PyResult<Value> {
+    let (Data::ServoTrace(file), Some(trace)) = (&exp.data, ServoTrace::from_experiment(exp))
+    else {
+        return Err(bad_argument(
+            "experiment",
+            format!("{source}: not a servo trace"),
+        ));
+    };
+    let period = trace.check().map_err(|e| with_context(source, &e))?;
+    let settings = IdimSettings::for_sample_period(period);
+    let ratio = exp.manifest.conditions.ratio;
+    let fit = match ratio {
+        Some(r) => trace.fit_friction_at_motor(r, &settings),
+        None => trace.fit_friction(&settings),
+    }
+    .map_err(|e| with_context(&format!("{source}: inverse dynamics"), &e))?;
+    Ok(json!({
+        "kind": "servo_trace",
+        "source": source,
+        "axis": rtid::io::json::value(&file.axis).map_err(|e| rtid_error(&e))?,
+        "samples": trace.len(),
+        "sample_period_s": period,
+        "inverse_dynamics": rtid::io::json::value(&fit).map_err(|e| rtid_error(&e))?,
+        "frame": if ratio.is_some() { "motor" } else { "as_recorded" },
+        "ratio": ratio,
+        "simulation_error": Value::Null,
+    }))
+}

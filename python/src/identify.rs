@@ -1,0 +1,199 @@
+//! `rtid.identify`: the configuration `rtid identify` builds from its options, the
+//! search run on a thread of its own while this one waits with the GIL released and
+//! looks for Ctrl-C (which stops the search: the best point so far is the result).
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use pyo3::prelude::*;
+
+use crate::errors::{bad_argument, rtid_error, with_context};
+use crate::params::PyParams;
+use rtid::identify::{
+    Bound, Config, ExperimentSpec, FidelityChoice, Identified, Method, Monitor, SearchOptions,
+    StartChoice,
+};
+use rtid::objectives::ObjectiveKind;
+
+/// Options of the search, as `rtid identify`'s flags give them.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct Options {
+    fit: Vec<String>,
+    bounds: Vec<(String, f64, f64)>,
+    method: Option<String>,
+    fidelity: String,
+    starts: Option<usize>,
+    seed: u64,
+    max_iters: u64,
+    start: String,
+    weights: Option<Vec<f64>>,
+    objectives: Option<Vec<String>>,
+}
+
+/// Identifies the parameters of `options.fit` from the experiment manifests
+/// `experiments` (path, name to report it by); returns the result file's JSON and the
+/// identified parameter set.
+#[pyfunction]
+pub fn identify(
+    py: Python<'_>,
+    experiments: Vec<(PathBuf, String)>,
+    params: PyRef<'_, PyParams>,
+    options: Options,
+) -> PyResult<(String, PyParams)> {
+    let base = params.inner.clone();
+    drop(params);
+    let config = config(&experiments, base, &options)?;
+    let monitor = Monitor::default();
+    let outcome = std::thread::scope(|s| {
+        let search = s.spawn(|| rtid::identify(&config, &monitor));
+        while !search.is_finished() {
+            py.detach(|| std::thread::sleep(Duration::from_millis(20)));
+            if py.check_signals().is_err() {
+                // Ctrl-C (KeyboardInterrupt): end the search, keep its best point.
+                monitor.stop();
+            }
+        }
+        search.join()
+    });
+    let Identified { result, params, .. } = match outcome {
+        Ok(r) => r.map_err(|e| rtid_error(&e))?,
+        Err(_) => return Err(bad_argument("identify", "the search panicked")),
+    };
+    let json = rtid::io::json::pretty(&result).map_err(|e| rtid_error(&e))?;
+    Ok((json, PyParams { inner: params }))
+}
+
+/// The configuration, checked before any work as the command line checks it.
+fn config(experiments: &[(PathBuf, String)], base: rtid::Params, o: &Options) -> PyResult<Config> {
+    if experiments.is_empty() {
+        return Err(bad_argument("experiments", "no experiment given"));
+    }
+    if let Some(w) = &o.weights {
+        if w.len() != experiments.len() {
+            return Err(bad_argument(
+                "weights",
+                format!(
+                    "{} weights for {} experiments: give one per experiment, in order",
+                    w.len(),
+                    experiments.len()
+                ),
+            ));
+        }
+    }
+    let chosen: Option<Vec<ObjectiveKind>> = o
+        .objectives
+        .as_ref()
+        .map(|v| v.iter().map(|n| ObjectiveKind::named(n)).collect())
+        .transpose()
+        .map_err(|e| with_context("objectives", &e))?;
+    let mut specs = Vec::new();
+    for (i, (path, source)) in experiments.iter().enumerate() {
+        let exp = rtid::read_experiment(path).map_err(|e| with_context("experiments", &e))?;
+        let mut spec = ExperimentSpec::new(source.clone(), exp);
+        if let Some(&w) = o.weights.as_ref().and_then(|w| w.get(i)) {
+            if !rtid::identify::config::WEIGHTS.contains(&w) {
+                return Err(bad_argument(
+                    "weights",
+                    format!("{w}: a weight is relative (default 1): give one within 1e-6..1e6"),
+                ));
+            }
+            spec.weight = w;
+        }
+        if let Some(all) = &chosen {
+            spec.objectives = Some(usable(all, &spec)?);
+        }
+        specs.push(spec);
+    }
+    if o.fit.iter().any(|n| n.trim().is_empty()) {
+        return Err(bad_argument("fit", "an empty name in the list"));
+    }
+    if o.starts == Some(0) {
+        return Err(bad_argument("starts", "0: at least one start is needed"));
+    }
+    if o.max_iters == 0 {
+        return Err(bad_argument(
+            "max_iters",
+            "0: each local search needs at least one iteration",
+        ));
+    }
+    let bounds = o
+        .bounds
+        .iter()
+        .map(|(n, lo, hi)| (n.clone(), Bound { lo: *lo, hi: *hi }));
+    Ok(Config {
+        experiments: specs,
+        base,
+        fit: o.fit.iter().map(|s| s.trim().to_string()).collect(),
+        bounds: bounds.collect(),
+        fidelity: fidelity(&o.fidelity)?,
+        search: SearchOptions {
+            method: o.method.as_deref().map(method).transpose()?,
+            starts: o.starts,
+            seed: o.seed,
+            max_iters: o.max_iters,
+            max_evaluations: None,
+        },
+        checkpoint: None,
+        resume: false,
+        start: start(&o.start)?,
+    })
+}
+
+/// The objectives of `all` that `spec`'s experiment can feed.
+fn usable(all: &[ObjectiveKind], spec: &ExperimentSpec) -> PyResult<Vec<ObjectiveKind>> {
+    let kind = spec.experiment.manifest.kind;
+    let mine: Vec<ObjectiveKind> = all.iter().copied().filter(|o| o.reads(kind)).collect();
+    if mine.is_empty() {
+        return Err(bad_argument(
+            "objectives",
+            format!(
+                "{} is a {kind} experiment, which none of them reads",
+                spec.source
+            ),
+        ));
+    }
+    Ok(mine)
+}
+
+fn method(name: &str) -> PyResult<Method> {
+    Ok(match name.replace('_', "-").as_str() {
+        "lsq" => Method::Lsq,
+        "lm" => Method::Lm,
+        "nelder-mead" => Method::NelderMead,
+        "pso" => Method::Pso,
+        other => {
+            return Err(bad_argument(
+                "method",
+                format!("unknown method `{other}`: expected lsq, lm, nelder-mead or pso"),
+            ))
+        }
+    })
+}
+
+fn fidelity(name: &str) -> PyResult<FidelityChoice> {
+    Ok(match name {
+        "auto" => FidelityChoice::Auto,
+        "linear" => FidelityChoice::Linear,
+        "nonlinear" => FidelityChoice::Nonlinear,
+        other => {
+            return Err(bad_argument(
+                "model",
+                format!("unknown model `{other}`: expected auto, linear or nonlinear"),
+            ))
+        }
+    })
+}
+
+fn start(name: &str) -> PyResult<StartChoice> {
+    Ok(match name {
+        "estimate" => StartChoice::Estimate,
+        "given" => StartChoice::Given,
+        other => {
+            return Err(bad_argument(
+                "start",
+                format!("unknown start `{other}`: expected estimate or given"),
+            ))
+        }
+    })
+}

@@ -1,0 +1,35 @@
+//! rtid's library front for Python (issue 40): the extension `rtid._rtid`, wrapped by
+//! the package `rtid/` (docstrings, argument checks, result objects).
+//!
+//! Each function makes the library calls the command line makes for the same job, so
+//! that Python gets the CLI's numbers; the long ones (simulation, identification,
+//! sweep) run with the GIL released.
+
+mod errors;
+mod evaluate;
+mod identify;
+mod import;
+mod input_spec;
+mod params;
+mod simulate;
+mod sweep;
+
+use pyo3::prelude::*;
+
+/// The extension module.
+#[pymodule]
+fn _rtid(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("RtidError", m.py().get_type::<errors::RtidError>())?;
+    m.add("VERSION", rtid::VERSION)?;
+    m.add_class::<params::PyParams>()?;
+    m.add_function(wrap_pyfunction!(params::load_params, m)?)?;
+    m.add_function(wrap_pyfunction!(params::preset_names, m)?)?;
+    m.add_function(wrap_pyfunction!(params::modes, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(import::import_file, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::read_experiment, m)?)?;
+    m.add_function(wrap_pyfunction!(identify::identify, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
+    Ok(())
+}

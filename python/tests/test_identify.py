@@ -1,0 +1,121 @@
+"""rtid.identify against `rtid identify --out` on the EMPS benchmark's record: from
+the manifest, from arrays, from the MAT-file through scipy — the CLI's parameters to
+1e-12 — and Ctrl-C keeping the best point."""
+
+import json
+import math
+import os
+import signal
+import threading
+
+import numpy as np
+import pytest
+import scipy.io
+
+import rtid
+
+EMPS = "fixtures/real/emps/emps_estimation.json"
+AXIS = "fixtures/real/emps/axis.json"
+CONDITIONS = {"drive_gain": 35.15065188248547, "loop_period_s": 0.001}
+
+
+@pytest.fixture(scope="module")
+def cli_fit(cli, root, tmp_path_factory):
+    out = tmp_path_factory.mktemp("fit") / "emps-fit.json"
+    cli("identify", EMPS, "--params", AXIS, "--out", out)
+    return json.loads(out.read_text())
+
+
+def assert_cli_parameters(result, cli_fit):
+    assert set(result.values) == set(cli_fit["parameters"])
+    for name, expected in cli_fit["parameters"].items():
+        assert result.values[name] == pytest.approx(expected, rel=1e-12, abs=0), name
+    errors = dict(cli_fit["uncertainty"]["standard_errors"])
+    for name, expected in errors.items():
+        assert result.standard_errors[name] == pytest.approx(expected, rel=1e-12, abs=0), name
+
+
+def test_identify_from_the_manifest_is_the_cli_fit(root, cli_fit):
+    result = rtid.identify(root / EMPS, rtid.params(path=root / AXIS))
+    assert_cli_parameters(result, cli_fit)
+    names = cli_fit["uncertainty"]["names"]
+    assert result.names == names
+    assert result.correlation.dtype == np.float64 and result.correlation.shape == (len(names), len(names))
+    assert np.array_equal(result.correlation, np.array(cli_fit["uncertainty"]["correlation"]))
+    assert [w["code"] for w in result.warnings] == [w["code"] for w in cli_fit["warnings"]]
+    assert not result.interrupted
+    for name, (lo, hi) in result.intervals.items():
+        assert lo < result.values[name] < hi
+    d = result.to_dict()
+    assert d["parameters"] == result.values and d["evaluations"] == cli_fit["evaluations"]
+    for name, value in result.values.items():
+        assert result.params[name] == value
+
+
+def test_identify_from_arrays_is_the_cli_fit(root, cli_fit):
+    table = np.loadtxt(root / "fixtures/real/emps/emps_estimation.csv", delimiter=",", skiprows=3)
+    t, qm, qg, vir, force = table.T
+    exp = rtid.experiment("servo_trace", conditions=CONDITIONS, time_s=t, motor_position_m=qm,
+                          reference_position_m=qg, controller_output_v=vir, force_n=force)
+    result = rtid.identify([exp], rtid.params(path=root / AXIS))
+    assert_cli_parameters(result, cli_fit)
+
+
+def test_identify_from_the_mat_file_through_scipy_is_the_cli_fit(root, cli_fit):
+    mat = scipy.io.loadmat(root / "fixtures/formats/matlab/DATA_EMPS.mat")
+    gtau = mat["gtau"].item()
+    vir = mat["vir"].ravel()
+    exp = rtid.experiment("servo_trace", conditions={"drive_gain": gtau, "loop_period_s": 0.001},
+                          time_s=mat["t"].ravel(), motor_position_m=mat["qm"].ravel(),
+                          reference_position_m=mat["qg"].ravel(), controller_output_v=vir,
+                          force_n=gtau * vir)
+    assert_cli_parameters(rtid.identify(exp, rtid.params(path=root / AXIS)), cli_fit)
+
+
+def test_ctrl_c_ends_the_search_with_the_best_point(root):
+    # A search of minutes (Nelder–Mead, each evaluation a replay of the whole
+    # trace), interrupted after 0.3 s as a notebook's interrupt would.
+    budget = 5000
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.warns(RuntimeWarning, match="interrupted"):
+            result = rtid.identify(root / EMPS, rtid.params(path=root / AXIS),
+                                   method="nelder-mead", max_iters=budget)
+    finally:
+        timer.cancel()
+    assert result.interrupted
+    assert result.to_dict()["evaluations"] < budget
+    assert all(math.isfinite(v) for v in result.values.values())
+    assert result.params["Jt"] == result.values["Jt"]
+
+
+@pytest.mark.parametrize("kwargs, argument", [
+    (dict(fit=["Jt", "Kx"]), "Kx"),
+    (dict(fit=["Jt"], bounds={"Jt": (1.0, float("nan"))}), "bounds"),
+    (dict(method="newton"), "method"),
+    (dict(model="exact"), "model"),
+    (dict(starts=0), "starts"),
+    (dict(weights=[1.0, 2.0]), "weights"),
+    (dict(objectives=["resonance"]), "objectives"),
+])
+def test_bad_options_raise_value_error_naming_them(root, kwargs, argument):
+    with pytest.raises(ValueError, match=argument):
+        rtid.identify(root / EMPS, rtid.params(path=root / AXIS), **kwargs)
+
+
+@pytest.mark.parametrize("columns, argument", [
+    (dict(force_n=np.array([1.0, np.nan, 3.0])), r"force_n\[1\]"),
+    (dict(force_n=np.zeros(3), time_s=np.zeros(4)), "time_s"),
+    (dict(force_n=np.array(["1", "2"])), "force_n: dtype"),
+    (dict(force_n=[[1.0, 2.0]]), "force_n: 2-dimensional"),
+])
+def test_bad_arrays_raise_value_error_naming_the_column(columns, argument):
+    with pytest.raises(ValueError, match=argument):
+        rtid.experiment("servo_trace", conditions=CONDITIONS, **columns)
+
+
+def test_a_missing_column_is_named_by_rtid_reader():
+    with pytest.raises(ValueError, match="missing column"):
+        rtid.experiment("servo_trace", conditions=CONDITIONS, time_s=np.arange(5) * 1e-3,
+                        force_n=np.zeros(5))
