@@ -73,6 +73,8 @@ pub mod identify;
 #[doc(hidden)]
 pub mod input;
 #[doc(hidden)]
+pub mod input_spec;
+#[doc(hidden)]
 pub mod io;
 #[doc(hidden)]
 pub mod model;

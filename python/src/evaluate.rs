@@ -70,8 +70,9 @@ fn frequency_response(exp: &Experiment, source: &str) -> PyResult<Value> {
             Response::TableOverMotor => 0,
             Response::MotorCompliance => 2,
         };
-        let modes = fr::modal::modes(&c, integrators);
-        value["modes"] = rtid::io::json::value(&modes).map_err(|e| rtid_error(&e))?;
+        let found = fr::modal::modes(&c, integrators);
+        value["modes"] = rtid::io::json::value(&found.modes).map_err(|e| rtid_error(&e))?;
+        value["prominent_peaks"] = found.prominent.into();
         value["response"] = form.response.name().into();
         value["noise_stated"] = (c.sigma_ln.is_some() || c.sigma_phase.is_some()).into();
     }

@@ -9,7 +9,6 @@ mod errors;
 mod evaluate;
 mod identify;
 mod import;
-mod input_spec;
 mod params;
 mod simulate;
 mod sweep;

@@ -5,9 +5,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{bad_argument, rtid_error, with_context};
-use crate::input_spec::{self, InputSpec};
 use crate::params::PyParams;
 use rtid::input::{Move, NoTorque, Samples, Sine, Step, Trajectory};
+use rtid::input_spec::{self, InputSpec};
 use rtid::io::torque_file;
 use rtid::model::{Params, NSTATE};
 use rtid::recorder::Recorder;

@@ -31,6 +31,7 @@ def test_import_of_a_missing_file_names_the_path(tmp_path):
 @pytest.mark.parametrize("manifest", [
     "fixtures/real/emps/emps_estimation.json",
     "fixtures/worm-gear/frequency_response.json",
+    "fixtures/frf/worm_frf.json",
     "fixtures/worm-gear/torque_curve.json",
     "fixtures/compensate/worm-gear/positioning.json",
 ])

@@ -9,7 +9,7 @@ use proptest::prelude::*;
 use super::Cli;
 use crate::cli::common::model_args::parse_assignment;
 use crate::cli::identify::parse_bound;
-use crate::cli::model::simulate::InputSpec;
+use rtid::input_spec::InputSpec;
 
 /// Every (subcommand path, long option taking a value) of the command line.
 fn options() -> Vec<(Vec<String>, String)> {

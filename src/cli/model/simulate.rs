@@ -2,7 +2,6 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::str::FromStr;
 use std::time::Instant;
 
 use anyhow::{bail, Context};
@@ -11,8 +10,9 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use crate::cli::experiment::check;
 use crate::cli::ModelArgs;
 use rtid::input::{Move, NoTorque, Samples, Sine, Step};
+use rtid::input_spec::InputSpec;
 use rtid::io::{atomic, torque_file};
-use rtid::model::{idx::*, LoopMode, NSTATE};
+use rtid::model::{idx::*, NSTATE};
 use rtid::recorder::Recorder;
 use rtid::sim::{Simulation, STATE_NAMES};
 
@@ -77,120 +77,6 @@ pub struct Args {
     /// No progress bar (shown on a terminal, with the simulated time and the time left).
     #[arg(long)]
     pub quiet: bool,
-}
-
-/// A parsed `--input`.
-#[derive(Debug, Clone, PartialEq)]
-pub enum InputSpec {
-    Sine {
-        freq_hz: f64,
-        amp_nm: f64,
-        offset_nm: f64,
-    },
-    Step {
-        torque_nm: f64,
-        at_s: f64,
-    },
-    File(PathBuf),
-    Move {
-        target_deg: f64,
-        speed_deg_per_min: Option<f64>,
-        loop_mode: Option<LoopMode>,
-    },
-    None,
-}
-
-impl FromStr for InputSpec {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, String> {
-        let (kind, rest) = s.split_once(':').unwrap_or((s, ""));
-        if kind == "file" {
-            return if rest.is_empty() {
-                Err("file: needs a path, e.g. file:torque.csv".into())
-            } else {
-                Ok(InputSpec::File(rest.into()))
-            };
-        }
-        let mut fields = Fields::parse(kind, rest)?;
-        let spec = match kind {
-            "sine" => InputSpec::Sine {
-                freq_hz: fields.number("freq_hz")?,
-                amp_nm: fields.number("amp_nm")?,
-                offset_nm: fields.optional("offset_nm")?.unwrap_or(0.0),
-            },
-            "step" => InputSpec::Step {
-                torque_nm: fields.number("torque_nm")?,
-                at_s: fields.optional("at_s")?.unwrap_or(0.0),
-            },
-            "move" => InputSpec::Move {
-                target_deg: fields.number("target_deg")?,
-                speed_deg_per_min: fields.optional("speed_deg_per_min")?,
-                loop_mode: fields
-                    .take("loop")
-                    .map(|v| v.parse())
-                    .transpose()
-                    .map_err(|e: rtid::names::UnknownName| e.to_string())?,
-            },
-            "none" => InputSpec::None,
-            other => {
-                return Err(format!(
-                    "unknown input `{other}`: expected sine:, step:, file:, move: or none"
-                ))
-            }
-        };
-        fields.finish()?;
-        Ok(spec)
-    }
-}
-
-/// `key=value,…` fields of an input specification.
-struct Fields {
-    kind: String,
-    pairs: Vec<(String, String)>,
-}
-
-impl Fields {
-    fn parse(kind: &str, rest: &str) -> Result<Self, String> {
-        let mut pairs = Vec::new();
-        for part in rest.split(',').filter(|p| !p.trim().is_empty()) {
-            let (k, v) = part
-                .split_once('=')
-                .ok_or_else(|| format!("{kind}: `{part}` is not KEY=VALUE"))?;
-            pairs.push((k.trim().to_string(), v.trim().to_string()));
-        }
-        Ok(Fields {
-            kind: kind.into(),
-            pairs,
-        })
-    }
-
-    fn take(&mut self, key: &str) -> Option<String> {
-        let i = self.pairs.iter().position(|(k, _)| k == key)?;
-        Some(self.pairs.remove(i).1)
-    }
-
-    fn optional(&mut self, key: &str) -> Result<Option<f64>, String> {
-        let Some(v) = self.take(key) else {
-            return Ok(None);
-        };
-        match v.parse::<f64>() {
-            Ok(x) if x.is_finite() => Ok(Some(x)),
-            _ => Err(format!("{}: {key}=`{v}` is not a finite number", self.kind)),
-        }
-    }
-
-    fn number(&mut self, key: &str) -> Result<f64, String> {
-        self.optional(key)?
-            .ok_or_else(|| format!("{}: missing {key}=VALUE", self.kind))
-    }
-
-    fn finish(self) -> Result<(), String> {
-        match self.pairs.first() {
-            None => Ok(()),
-            Some((k, _)) => Err(format!("{}: unknown field `{k}`", self.kind)),
-        }
-    }
 }
 
 /// Streams every `every`-th sample into a CSV.
@@ -434,54 +320,4 @@ fn write_csv(
         Ok(())
     });
     result.with_context(|| format!("writing {}", path.display()))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn input_specs_parse() {
-        assert_eq!(
-            "sine:freq_hz=100,amp_nm=5".parse::<InputSpec>().unwrap(),
-            InputSpec::Sine {
-                freq_hz: 100.0,
-                amp_nm: 5.0,
-                offset_nm: 0.0
-            }
-        );
-        assert_eq!(
-            "move:target_deg=30,loop=full_closed"
-                .parse::<InputSpec>()
-                .unwrap(),
-            InputSpec::Move {
-                target_deg: 30.0,
-                speed_deg_per_min: None,
-                loop_mode: Some(LoopMode::FullClosed)
-            }
-        );
-        assert_eq!(
-            "file:a/b.csv".parse::<InputSpec>().unwrap(),
-            InputSpec::File("a/b.csv".into())
-        );
-        assert_eq!("none".parse::<InputSpec>().unwrap(), InputSpec::None);
-    }
-
-    #[test]
-    fn bad_input_specs_say_what_is_wrong() {
-        for (spec, expect) in [
-            ("sine:freq_hz=100", "missing amp_nm"),
-            (
-                "sine:freq_hz=abc,amp_nm=5",
-                "freq_hz=`abc` is not a finite number",
-            ),
-            ("sine:freq_hz=1,amp_nm=5,phase=3", "unknown field `phase`"),
-            ("chirp:f=1", "unknown input `chirp`"),
-            ("move:target_deg=30,loop=open", "unknown loop `open`"),
-            ("step:torque_nm", "`torque_nm` is not KEY=VALUE"),
-        ] {
-            let err = spec.parse::<InputSpec>().unwrap_err();
-            assert!(err.contains(expect), "{spec}: {err}");
-        }
-    }
 }

@@ -1,9 +1,13 @@
-//! The command line's `--input` specifications (`rtid simulate --help`), parsed as
-//! `src/cli/model/simulate.rs` parses them, with the same messages.
+//! The `--input` specifications of a simulation (`rtid simulate --help`):
+//! `sine:freq_hz=100,amp_nm=5`, `step:torque_nm=T[,at_s=S]`, `file:PATH`,
+//! `move:target_deg=D[,speed_deg_per_min=V][,loop=…]` or `none`, parsed into an
+//! [`InputSpec`] — one parser for the command line and the Python module.
 
-use rtid::model::LoopMode;
+use std::str::FromStr;
 
-/// A parsed input specification.
+use crate::model::LoopMode;
+
+/// A parsed input specification (units in the field names).
 #[derive(Debug, Clone, PartialEq)]
 pub enum InputSpec {
     Sine {
@@ -24,17 +28,18 @@ pub enum InputSpec {
     None,
 }
 
-/// Why a specification does not parse (the CLI's message).
-#[derive(Debug)]
-pub struct SpecError(pub String);
+/// Why a specification does not parse: the message names the kind and the field.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct SpecError(String);
 
-impl std::fmt::Display for SpecError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
+impl FromStr for InputSpec {
+    type Err = SpecError;
+
+    fn from_str(s: &str) -> Result<Self, SpecError> {
+        parse(s)
     }
 }
-
-impl std::error::Error for SpecError {}
 
 /// Parses `sine:freq_hz=100,amp_nm=5`, `step:…`, `file:PATH`, `move:…` or `none`.
 pub fn parse(s: &str) -> Result<InputSpec, SpecError> {
@@ -64,7 +69,7 @@ pub fn parse(s: &str) -> Result<InputSpec, SpecError> {
                 .take("loop")
                 .map(|v| v.parse())
                 .transpose()
-                .map_err(|e: rtid::names::UnknownName| SpecError(e.to_string()))?,
+                .map_err(|e: crate::names::UnknownName| SpecError(e.to_string()))?,
         },
         "none" => InputSpec::None,
         other => {
@@ -125,6 +130,56 @@ impl Fields {
         match self.pairs.first() {
             None => Ok(()),
             Some((k, _)) => Err(SpecError(format!("{}: unknown field `{k}`", self.kind))),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn input_specs_parse() {
+        assert_eq!(
+            "sine:freq_hz=100,amp_nm=5".parse::<InputSpec>().unwrap(),
+            InputSpec::Sine {
+                freq_hz: 100.0,
+                amp_nm: 5.0,
+                offset_nm: 0.0
+            }
+        );
+        assert_eq!(
+            "move:target_deg=30,loop=full_closed"
+                .parse::<InputSpec>()
+                .unwrap(),
+            InputSpec::Move {
+                target_deg: 30.0,
+                speed_deg_per_min: None,
+                loop_mode: Some(LoopMode::FullClosed)
+            }
+        );
+        assert_eq!(
+            "file:a/b.csv".parse::<InputSpec>().unwrap(),
+            InputSpec::File("a/b.csv".into())
+        );
+        assert_eq!("none".parse::<InputSpec>().unwrap(), InputSpec::None);
+    }
+
+    #[test]
+    fn bad_input_specs_say_what_is_wrong() {
+        for (spec, expect) in [
+            ("sine:freq_hz=100", "missing amp_nm"),
+            (
+                "sine:freq_hz=abc,amp_nm=5",
+                "freq_hz=`abc` is not a finite number",
+            ),
+            ("sine:freq_hz=1,amp_nm=5,phase=3", "unknown field `phase`"),
+            ("chirp:f=1", "unknown input `chirp`"),
+            ("move:target_deg=30,loop=open", "unknown loop `open`"),
+            ("step:torque_nm", "`torque_nm` is not KEY=VALUE"),
+        ] {
+            let err = spec.parse::<InputSpec>().unwrap_err().to_string();
+            assert!(err.contains(expect), "{spec}: {err}");
         }
     }
 }
