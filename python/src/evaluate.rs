@@ -15,6 +15,7 @@ use rtid::experiments::positioning::iso230::{self, ReportUnits};
 use rtid::experiments::servo_trace::ServoTrace;
 use rtid::experiments::torque_curve::{self, TorqueTest};
 use rtid::io::experiment_file::{Data, Experiment, Kind, Response};
+use rtid::report::evaluation::{self, TraceReport};
 
 /// The evaluation of the experiment at `path` as JSON, `source` naming it.
 #[pyfunction]
@@ -89,10 +90,8 @@ fn torque(exp: &Experiment, source: &str) -> PyResult<Value> {
     };
     let test = TorqueTest::from_conditions(&exp.manifest.conditions);
     let report = torque_curve::evaluate(&curve, &test).map_err(|e| with_context(source, &e))?;
-    let mut value = rtid::io::json::value(&report).map_err(|e| rtid_error(&e))?;
-    value["kind"] = json!("torque_curve");
-    value["source"] = json!(source);
-    Ok(value)
+    let axis = exp.data.axis().unwrap_or_default();
+    evaluation::torque_curve(&report, axis, source).map_err(|e| rtid_error(&e))
 }
 
 /// The ISO 230-2 values of a positioning record, in the command line's units
@@ -106,20 +105,7 @@ fn positioning(exp: &Experiment, source: &str) -> PyResult<Value> {
     };
     let u = ReportUnits::of(exp.data.axis().unwrap_or_default());
     let report = iso230::evaluate(&readings).map_err(|e| with_context(source, &e))?;
-    let k = u.deviation_per_si;
-    let mut targets = Vec::with_capacity(report.targets.len());
-    for t in &report.targets {
-        let mut v = rtid::io::json::value(&t.scaled(k)).map_err(|e| rtid_error(&e))?;
-        v[format!("target_{}", u.target_key)] = json!(t.target * u.target_per_si);
-        targets.push(v);
-    }
-    Ok(json!({
-        "kind": "positioning",
-        "source": source,
-        "unit": u.deviation_key,
-        "axis": rtid::io::json::value(&report.axis.scaled(k)).map_err(|e| rtid_error(&e))?,
-        "targets": targets,
-    }))
+    evaluation::positioning(&report, u, source).map_err(|e| rtid_error(&e))
 }
 
 /// The friction laws fitted to a friction map, and the one the data support.
@@ -132,10 +118,7 @@ fn friction(exp: &Experiment, source: &str) -> PyResult<Value> {
     };
     let e = rtid::friction_map::evaluate(map)
         .map_err(|m| bad_argument("experiment", format!("{source}: {m}")))?;
-    let mut value = rtid::io::json::value(&e).map_err(|e| rtid_error(&e))?;
-    value["kind"] = json!("friction_map");
-    value["source"] = json!(source);
-    Ok(value)
+    evaluation::friction_map(&e, source).map_err(|e| rtid_error(&e))
 }
 
 /// The friction law of a servo trace by IDIM-LS (the default settings).
@@ -155,15 +138,13 @@ fn servo_trace(exp: &Experiment, source: &str) -> PyResult<Value> {
         None => trace.fit_friction(&settings),
     }
     .map_err(|e| with_context(&format!("{source}: inverse dynamics"), &e))?;
-    Ok(json!({
-        "kind": "servo_trace",
-        "source": source,
-        "axis": rtid::io::json::value(&file.axis).map_err(|e| rtid_error(&e))?,
-        "samples": trace.len(),
-        "sample_period_s": period,
-        "inverse_dynamics": rtid::io::json::value(&fit).map_err(|e| rtid_error(&e))?,
-        "frame": if ratio.is_some() { "motor" } else { "as_recorded" },
-        "ratio": ratio,
-        "simulation_error": Value::Null,
-    }))
+    let report = TraceReport::new(
+        source.to_string(),
+        file.axis,
+        (trace.len(), period),
+        fit,
+        ratio,
+        None,
+    );
+    rtid::io::json::value(&report).map_err(|e| rtid_error(&e))
 }

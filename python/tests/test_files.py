@@ -51,6 +51,16 @@ def test_evaluate_of_a_friction_map_is_the_cli_evaluation(cli, tmp_path):
     assert got == expected  # the source too: the path as given
 
 
+def test_evaluate_of_a_linear_axis_torque_curve_is_in_newtons_as_the_cli(cli, root, tmp_path):
+    axis = root / "fixtures/real/emps/axis.json"
+    cli("experiment", "torque-curve", "--params", axis, "--periods", "1", "--out", tmp_path)
+    manifest = tmp_path / "torque_curve.json"
+    expected = cli("evaluate", manifest, "--json", json_out=True)
+    got = rtid.evaluate(manifest)
+    assert "rms_n" in got and "rms_nm" not in got
+    assert got == expected
+
+
 def test_evaluate_refuses_a_kind_it_does_not_wrap_yet(root):
     with pytest.raises(ValueError, match="not part of this version yet"):
         rtid.evaluate(root / "fixtures/worm-gear/unbalance.json")

@@ -227,9 +227,9 @@ pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
         "-residuals",
     )?;
     if json {
-        let mut value = rtid::io::json::value(&e).context("the evaluation as JSON")?;
-        value["kind"] = serde_json::json!("friction_map");
-        value["source"] = serde_json::json!(exp.path);
+        let source = exp.path.display().to_string();
+        let value = rtid::report::evaluation::friction_map(&e, &source)
+            .context("the evaluation as JSON")?;
         println!("{}", rtid::io::json::pretty(&value)?);
     } else {
         println!("{}: friction map, {} runs", exp.path.display(), map.len());

@@ -272,22 +272,9 @@ fn print_positioning(
     json: bool,
     source: &Path,
 ) -> anyhow::Result<()> {
-    let k = u.deviation_per_si;
     if json {
-        let mut targets = Vec::with_capacity(report.targets.len());
-        for t in &report.targets {
-            let mut v = rtid::io::json::value(&t.scaled(k))?;
-            v[format!("target_{}", u.target_key)] =
-                rtid::io::json::value(&(t.target * u.target_per_si))?;
-            targets.push(v);
-        }
-        let value = serde_json::json!({
-            "kind": "positioning",
-            "source": source,
-            "unit": u.deviation_key,
-            "axis": rtid::io::json::value(&report.axis.scaled(k))?,
-            "targets": targets,
-        });
+        let source = source.display().to_string();
+        let value = rtid::report::evaluation::positioning(report, u, &source)?;
         println!("{}", rtid::io::json::pretty(&value)?);
     } else {
         println!(

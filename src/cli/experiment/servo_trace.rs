@@ -6,14 +6,14 @@ use crate::cli::common::plot::Plot;
 
 use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
-use serde::Serialize;
 
-use rtid::estimation::inverse_dynamics::{IdimFit, IdimSettings};
+use rtid::estimation::inverse_dynamics::IdimSettings;
 use rtid::experiments::servo_trace::{
-    replay, simulation_error, virtual_trace, Misfit, MoveTo, ServoTrace, TrapezoidalMoves,
+    replay, simulation_error, virtual_trace, MoveTo, ServoTrace, TrapezoidalMoves,
 };
 use rtid::io::experiment_file::{Axis, CommandUnit, Data, Experiment, Kind, Manifest};
 use rtid::model::Params;
+use rtid::report::evaluation::TraceReport;
 use rtid::report::servo_trace as figures;
 
 use super::{check, Common};
@@ -191,27 +191,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         })
 }
 
-/// What the evaluation of a trace reports (SI units).
-#[derive(Serialize)]
-struct TraceReport {
-    kind: &'static str,
-    source: String,
-    axis: Axis,
-    samples: usize,
-    sample_period_s: f64,
-    /// M, Fv, Fc, OF of F = M·a + Fv·v + Fc·sign(v) + OF (OF = −Tload).
-    inverse_dynamics: IdimFit,
-    /// Where they are: `motor` (the positions divided by `ratio`) or `as_recorded`
-    /// (the effort over the loop encoder's position: on a geared axis neither the
-    /// motor's frame nor the table's).
-    frame: &'static str,
-    /// Table turns per motor turn the positions were divided by.
-    ratio: Option<f64>,
-    /// The trace replayed on `--preset`/`--params`: position in m or rad, force in N
-    /// or N·m.
-    simulation_error: Option<Misfit>,
-}
-
 /// Evaluates the trace `exp`; replays it on `model` when one is given.
 pub fn report(
     exp: &Experiment,
@@ -246,21 +225,14 @@ pub fn report(
         "",
     )?;
     plot.write(&figures::effort(&trace, run.as_ref(), file.axis), "-effort")?;
-    let report = TraceReport {
-        kind: "servo_trace",
+    let report = TraceReport::new(
         source,
-        axis: file.axis,
-        samples: trace.len(),
-        sample_period_s,
-        inverse_dynamics: fit,
-        frame: if ratio.is_some() {
-            "motor"
-        } else {
-            "as_recorded"
-        },
+        file.axis,
+        (trace.len(), sample_period_s),
+        fit,
         ratio,
-        simulation_error: misfit,
-    };
+        misfit,
+    );
     if json {
         println!("{}", rtid::io::json::pretty(&report)?);
     } else {

@@ -158,12 +158,9 @@ pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
         plot.write(&figure, "-vs-angle")?;
     }
     if json {
-        let mut value = rtid::io::json::value(&report)?;
-        if linear {
-            in_newtons(&mut value);
-        }
-        value["kind"] = serde_json::json!("torque_curve");
-        value["source"] = serde_json::json!(exp.path);
+        let axis = exp.data.axis().unwrap_or_default();
+        let source = exp.path.display().to_string();
+        let value = rtid::report::evaluation::torque_curve(&report, axis, &source)?;
         println!("{}", rtid::io::json::pretty(&value)?);
     } else {
         let amplitude = if linear {
@@ -180,26 +177,6 @@ pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
         println!("{}", table(&report, if linear { "N" } else { "N·m" }));
     }
     Ok(())
-}
-
-/// A linear axis's report: the `_nm` keys (N·m) renamed `_n`, as its values are
-/// forces in N.
-fn in_newtons(value: &mut serde_json::Value) {
-    match value {
-        serde_json::Value::Object(map) => {
-            let old = std::mem::take(map);
-            for (k, mut v) in old {
-                in_newtons(&mut v);
-                let key = match k.strip_suffix("_nm") {
-                    Some(stem) => format!("{stem}_n"),
-                    None => k,
-                };
-                map.insert(key, v);
-            }
-        }
-        serde_json::Value::Array(items) => items.iter_mut().for_each(in_newtons),
-        _ => {}
-    }
 }
 
 /// A readable summary, efforts in `unit` (N·m, or N on a linear axis).

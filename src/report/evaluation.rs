@@ -1,0 +1,126 @@
+//! The evaluations as `rtid evaluate --json` prints them, one function per kind: the
+//! command line prints them, the Python module returns them, so both give the same
+//! keys and units (report units: arc-seconds or µm for positioning, N for a linear
+//! axis's efforts).
+
+use serde::Serialize;
+use serde_json::{json, Value};
+
+use crate::estimation::inverse_dynamics::IdimFit;
+use crate::experiments::friction_map::MapEvaluation;
+use crate::experiments::positioning::iso230::{Iso230Report, ReportUnits};
+use crate::experiments::servo_trace::Misfit;
+use crate::experiments::torque_curve::TorqueReport;
+use crate::io::experiment_file::Axis;
+use crate::io::json::{value, JsonError};
+
+/// A torque curve's report; on a linear axis its `_nm` keys are `_n` (forces in N).
+pub fn torque_curve(report: &TorqueReport, axis: Axis, source: &str) -> Result<Value, JsonError> {
+    let mut v = value(report)?;
+    if axis == Axis::Linear {
+        in_newtons(&mut v);
+    }
+    v["kind"] = json!("torque_curve");
+    v["source"] = json!(source);
+    Ok(v)
+}
+
+/// A linear axis's report: the `_nm` keys (N·m) renamed `_n`, as its values are
+/// forces in N.
+fn in_newtons(value: &mut Value) {
+    match value {
+        Value::Object(map) => {
+            let old = std::mem::take(map);
+            for (k, mut v) in old {
+                in_newtons(&mut v);
+                let key = match k.strip_suffix("_nm") {
+                    Some(stem) => format!("{stem}_n"),
+                    None => k,
+                };
+                map.insert(key, v);
+            }
+        }
+        Value::Array(items) => items.iter_mut().for_each(in_newtons),
+        _ => {}
+    }
+}
+
+/// An ISO 230-2 evaluation in the report units `u`: each target's statistics with
+/// its position (`target_deg` or `target_mm`), and the axis values.
+pub fn positioning(
+    report: &Iso230Report,
+    u: ReportUnits,
+    source: &str,
+) -> Result<Value, JsonError> {
+    let k = u.deviation_per_si;
+    let mut targets = Vec::with_capacity(report.targets.len());
+    for t in &report.targets {
+        let mut v = value(&t.scaled(k))?;
+        v[format!("target_{}", u.target_key)] = value(&(t.target * u.target_per_si))?;
+        targets.push(v);
+    }
+    Ok(json!({
+        "kind": "positioning",
+        "source": source,
+        "unit": u.deviation_key,
+        "axis": value(&report.axis.scaled(k))?,
+        "targets": targets,
+    }))
+}
+
+/// A friction map's laws and the one the data support.
+pub fn friction_map(e: &MapEvaluation, source: &str) -> Result<Value, JsonError> {
+    let mut v = value(e)?;
+    v["kind"] = json!("friction_map");
+    v["source"] = json!(source);
+    Ok(v)
+}
+
+/// What the evaluation of a servo trace reports (SI units).
+#[derive(Clone, Debug, Serialize)]
+pub struct TraceReport {
+    pub kind: &'static str,
+    pub source: String,
+    pub axis: Axis,
+    pub samples: usize,
+    pub sample_period_s: f64,
+    /// M, Fv, Fc, OF of F = M·a + Fv·v + Fc·sign(v) + OF (OF = −Tload).
+    pub inverse_dynamics: IdimFit,
+    /// Where they are: `motor` (the positions divided by `ratio`) or `as_recorded`
+    /// (the effort over the loop encoder's position: on a geared axis neither the
+    /// motor's frame nor the table's).
+    pub frame: &'static str,
+    /// Table turns per motor turn the positions were divided by.
+    pub ratio: Option<f64>,
+    /// The trace replayed on a model: position in m or rad, force in N or N·m.
+    pub simulation_error: Option<Misfit>,
+}
+
+impl TraceReport {
+    /// The report of a trace of `samples` samples every `sample_period_s` on `axis`,
+    /// its law fitted at the motor when `ratio` is given.
+    pub fn new(
+        source: String,
+        axis: Axis,
+        (samples, sample_period_s): (usize, f64),
+        inverse_dynamics: IdimFit,
+        ratio: Option<f64>,
+        simulation_error: Option<Misfit>,
+    ) -> Self {
+        TraceReport {
+            kind: "servo_trace",
+            source,
+            axis,
+            samples,
+            sample_period_s,
+            inverse_dynamics,
+            frame: if ratio.is_some() {
+                "motor"
+            } else {
+                "as_recorded"
+            },
+            ratio,
+            simulation_error,
+        }
+    }
+}
