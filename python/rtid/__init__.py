@@ -390,8 +390,9 @@ def evaluate(experiment) -> dict:
     """The statistics ``rtid evaluate --json`` gives of an experiment, as a dict: the
     resonances (and with the phase the modes) of a frequency response, a torque
     curve's friction and reversals, a positioning record's ISO 230-2 values, the
-    friction laws of a friction map, a servo trace's friction law by IDIM-LS.
-    (Fluctuation, unbalance and raw time records: the command line for now.)"""
+    friction laws of a friction map, a servo trace's friction law by IDIM-LS, a
+    fluctuation or unbalance test's deviations in arc-seconds. (Raw time records
+    and the paper's resonance lists: the command line for now.)"""
     exp = _as_experiment(experiment, "experiment")
     with tempfile.TemporaryDirectory(prefix="rtid-") as d:
         return json.loads(_rtid.evaluate(exp._written(d), exp.name))

@@ -27,6 +27,7 @@ pub fn evaluate(py: Python<'_>, path: PathBuf, source: String) -> PyResult<Strin
         Kind::ServoTrace => servo_trace(&exp, &source),
         Kind::Positioning => positioning(&exp, &source),
         Kind::FrictionMap => friction(&exp, &source),
+        Kind::Fluctuation | Kind::Unbalance => fluctuation(&exp, &source),
         other => Err(bad_argument(
             "experiment",
             format!("evaluating a `{}` experiment from Python is not part of this version yet: run `rtid evaluate`", other.name()),
@@ -106,6 +107,12 @@ fn positioning(exp: &Experiment, source: &str) -> PyResult<Value> {
     let u = ReportUnits::of(exp.data.axis().unwrap_or_default());
     let report = iso230::evaluate(&readings).map_err(|e| with_context(source, &e))?;
     evaluation::positioning(&report, u, source).map_err(|e| rtid_error(&e))
+}
+
+/// The deviation statistics of a fluctuation or unbalance test, in arc-seconds.
+fn fluctuation(exp: &Experiment, source: &str) -> PyResult<Value> {
+    let e = rtid::fluctuation::evaluate_experiment(exp).map_err(|e| with_context(source, &e))?;
+    evaluation::fluctuation(&e, exp.manifest.kind, source).map_err(|e| rtid_error(&e))
 }
 
 /// The friction laws fitted to a friction map, and the one the data support.

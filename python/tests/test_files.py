@@ -34,6 +34,7 @@ def test_import_of_a_missing_file_names_the_path(tmp_path):
     "fixtures/frf/worm_frf.json",
     "fixtures/worm-gear/torque_curve.json",
     "fixtures/compensate/worm-gear/positioning.json",
+    "fixtures/worm-gear/unbalance.json",
 ])
 def test_evaluate_gives_the_cli_evaluation(cli, root, manifest):
     expected = cli("evaluate", manifest, "--json", json_out=True)
@@ -63,7 +64,7 @@ def test_evaluate_of_a_linear_axis_torque_curve_is_in_newtons_as_the_cli(cli, ro
 
 def test_evaluate_refuses_a_kind_it_does_not_wrap_yet(root):
     with pytest.raises(ValueError, match="not part of this version yet"):
-        rtid.evaluate(root / "fixtures/worm-gear/unbalance.json")
+        rtid.evaluate(root / "fixtures/real/two-mass/multisine_a.json")
 
 
 def read_rows(path):

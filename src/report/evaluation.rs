@@ -7,11 +7,12 @@ use serde::Serialize;
 use serde_json::{json, Value};
 
 use crate::estimation::inverse_dynamics::IdimFit;
+use crate::experiments::fluctuation::Evaluation as FluctuationEvaluation;
 use crate::experiments::friction_map::MapEvaluation;
 use crate::experiments::positioning::iso230::{Iso230Report, ReportUnits};
 use crate::experiments::servo_trace::Misfit;
 use crate::experiments::torque_curve::TorqueReport;
-use crate::io::experiment_file::Axis;
+use crate::io::experiment_file::{Axis, Kind};
 use crate::io::json::{value, JsonError};
 
 /// A torque curve's report; on a linear axis its `_nm` keys are `_n` (forces in N).
@@ -66,6 +67,19 @@ pub fn positioning(
         "axis": value(&report.axis.scaled(k))?,
         "targets": targets,
     }))
+}
+
+/// A fluctuation or unbalance test's deviation statistics, in arc-seconds.
+pub fn fluctuation(
+    e: &FluctuationEvaluation,
+    kind: Kind,
+    source: &str,
+) -> Result<Value, JsonError> {
+    let mut v = value(e)?;
+    v["kind"] = json!(kind.name());
+    v["source"] = json!(source);
+    v["unit"] = json!("arcsec");
+    Ok(v)
 }
 
 /// A friction map's laws and the one the data support.

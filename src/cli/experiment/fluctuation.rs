@@ -177,10 +177,8 @@ pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
 
 fn print(e: &Evaluation, kind: Kind, json: bool, source: &Path) -> anyhow::Result<()> {
     if json {
-        let mut value = rtid::io::json::value(e)?;
-        value["kind"] = serde_json::json!(kind.name());
-        value["source"] = serde_json::json!(source);
-        value["unit"] = serde_json::json!("arcsec");
+        let source = source.display().to_string();
+        let value = rtid::report::evaluation::fluctuation(e, kind, &source)?;
         println!("{}", rtid::io::json::pretty(&value)?);
     } else {
         println!("{}: {kind} evaluation, arc-seconds", source.display());
