@@ -1530,9 +1530,9 @@ fn absurd_sizes_and_values_are_refused_before_any_work() {
     ]);
 }
 
-/// More of the same: absurd sizes and values of the other commands.
+/// More of the same: absurd sizes and values of a simulation.
 #[test]
-fn absurd_sizes_and_values_of_other_commands_are_refused_before_any_work() {
+fn absurd_sizes_and_values_of_a_simulation_are_refused_before_any_work() {
     let sine = "sine:freq_hz=100,amp_nm=5";
     refused_at_once(&[
         (
@@ -1583,6 +1583,13 @@ fn absurd_sizes_and_values_of_other_commands_are_refused_before_any_work() {
             ],
             &["r = 1e-300", "typo"],
         ),
+    ]);
+}
+
+/// And of the experiments and modes.
+#[test]
+fn absurd_values_of_experiments_and_modes_are_refused_before_any_work() {
+    refused_at_once(&[
         (
             &[
                 "experiment",

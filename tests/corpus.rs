@@ -616,11 +616,9 @@ fn negative_values_reach_the_options_own_check() {
 /// Issue 28's classes met at their root: torque curves out of any physical range
 /// (angles or torques of ±1e308, a time step of 1e-300 s or 1e300 s) are evaluated at
 /// once with no null among the friction law's numbers (the law's least squares hung on
-/// them, or wrote null); a resonance file's non-positive or absurd peak, a parameter
-/// file's null, a weight of 1e308 and a sample rate below the band's are refused
-/// naming the field or option.
+/// them, or wrote null), or refused naming the column.
 #[test]
-fn records_and_values_out_of_range_are_met_at_their_root() {
+fn records_out_of_range_are_met_at_their_root() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let manifest = std::fs::read_to_string(fixture("worm-gear/torque_curve.json")).unwrap();
@@ -678,6 +676,14 @@ fn records_and_values_out_of_range_are_met_at_their_root() {
             );
         }
     }
+}
+
+/// A resonance file's non-positive or absurd peak, a parameter file's null, a weight
+/// of 1e308 and a sample rate below the band's are refused naming the field or option.
+#[test]
+fn values_out_of_range_are_refused_naming_their_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
     let worm = fixture("worm-gear/frequency_response.json");
     let cases: Vec<(Vec<String>, &str)> = vec![
         (
