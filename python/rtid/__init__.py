@@ -411,8 +411,12 @@ class IdentifyResult:
             Jacobian gives one.
         names: the order of ``correlation``'s rows.
         correlation: the fitted parameters' correlation matrix (float64 array).
-        intervals: ``(low, high)`` of each: ± 1.96 standard errors (the CLI's
-            ``--profile``/``--resample`` intervals are not wrapped yet).
+        intervals: ``(low, high)`` of each at 95 %: the profile's where ``profile``
+            was asked (an end the data do not bound is ``None``), else the
+            bootstrap's where ``resample`` was, else ± 1.96 standard errors.
+        interval_method: ``"profile"``, ``"bootstrap"`` or ``"standard errors"``.
+        profiles: the profiles as the result file holds them (``None`` if not asked).
+        resampling: the bootstrap as the result file holds it (``None`` if not asked).
         warnings: each ``{"code", "message"}`` rtid raised (what the data cannot tell).
         interrupted: whether Ctrl-C ended the search (the best point so far).
         params: the complete identified parameter set.
@@ -426,10 +430,21 @@ class IdentifyResult:
         self.standard_errors = dict((n, v) for n, v in u.get("standard_errors", []) if v is not None)
         self.names = list(u.get("names", []))
         self.correlation = np.array(u.get("correlation", []), dtype=np.float64).reshape(len(self.names), len(self.names))
-        self.intervals = {
-            n: (self.values[n] - 1.96 * se, self.values[n] + 1.96 * se)
-            for n, se in self.standard_errors.items()
-        }
+        self.profiles = result.get("profiles")
+        self.resampling = result.get("resampling")
+        if self.profiles:
+            self.interval_method = "profile"
+            self.intervals = {n: (p.get("lower"), p.get("upper")) for n, p in self.profiles.items()}
+        elif self.resampling and self.resampling.get("intervals"):
+            self.interval_method = "bootstrap"
+            self.intervals = {n: (i["lower"], i["upper"])
+                              for n, i in self.resampling["intervals"].items()}
+        else:
+            self.interval_method = "standard errors"
+            self.intervals = {
+                n: (self.values[n] - 1.96 * se, self.values[n] + 1.96 * se)
+                for n, se in self.standard_errors.items()
+            }
         self.warnings = list(result.get("warnings", []))
         self.interrupted = bool(result.get("interrupted", False))
         self.cost = result.get("cost")
@@ -445,10 +460,32 @@ class IdentifyResult:
         return f"<rtid.IdentifyResult {body}{' (interrupted)' if self.interrupted else ''}>"
 
 
+def _profile_names(profile):
+    """``identify``'s ``profile`` as the module takes it: None, [] (all) or names."""
+    if profile is None or profile is False:
+        return None
+    if profile is True:
+        return []
+    if isinstance(profile, str):
+        return [n.strip() for n in profile.split(",")]
+    names = list(profile)
+    if not all(isinstance(n, str) and n.strip() for n in names):
+        raise RtidError(f"profile: {profile!r}: give parameter names, or True for all")
+    return names
+
+
+def _count(n, name: str) -> int:
+    """A positive whole number argument, or a ValueError naming it."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise RtidError(f"{name}: {n!r} is not a positive whole number")
+    return int(n)
+
+
 def identify(experiments, params: Params, fit=None, *, bounds: dict | None = None,
              method: str | None = None, model: str = "auto", starts: int | None = None,
              seed: int = 1, max_iters: int = 50, start: str = "estimate",
-             weights=None, objectives=None) -> IdentifyResult:
+             weights=None, objectives=None, profile=None,
+             resample: int | None = None) -> IdentifyResult:
     """Identifies parameters from experiments (``rtid identify``).
 
     Args:
@@ -460,6 +497,9 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
         model: ``auto``, ``linear`` or ``nonlinear`` (``--model``).
         starts, seed, max_iters, start, weights, objectives: as the flags of the
             same names.
+        profile: names to profile (``True``: every fitted parameter), for intervals
+            that hold where the cost is not a bowl (``--profile``).
+        resample: bootstrap replicates of the residuals' blocks (``--resample``).
 
     Ctrl-C (KeyboardInterrupt, a notebook's interrupt) ends the search: the best point
     so far is returned, ``interrupted`` set and a warning issued. The search runs with
@@ -482,6 +522,8 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
         "start": start,
         "weights": None if weights is None else [_finite_number(w, "weights") for w in weights],
         "objectives": None if objectives is None else list(objectives),
+        "profile": _profile_names(profile),
+        "resample": None if resample is None else _count(resample, "resample"),
     }
     with tempfile.TemporaryDirectory(prefix="rtid-") as d:
         paths = [(e._written(d), e.name) for e in exps]

@@ -90,7 +90,10 @@ class IdentifyResult:
     standard_errors: dict[str, float]
     names: list[str]
     correlation: npt.NDArray[np.float64]
-    intervals: dict[str, tuple[float, float]]
+    intervals: dict[str, tuple[float | None, float | None]]
+    interval_method: Literal["profile", "bootstrap", "standard errors"]
+    profiles: dict[str, dict[str, Any]] | None
+    resampling: dict[str, Any] | None
     warnings: list[dict[str, str]]
     interrupted: bool
     cost: float | None
@@ -111,6 +114,8 @@ def identify(
     start: Literal["estimate", "given"] = "estimate",
     weights: Sequence[float] | None = None,
     objectives: Sequence[str] | None = None,
+    profile: bool | str | Sequence[str] | None = None,
+    resample: int | None = None,
 ) -> IdentifyResult: ...
 
 @dataclass

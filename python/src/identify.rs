@@ -29,6 +29,10 @@ pub struct Options {
     start: String,
     weights: Option<Vec<f64>>,
     objectives: Option<Vec<String>>,
+    /// `--profile`: the names to profile (empty: every fitted parameter).
+    profile: Option<Vec<String>>,
+    /// `--resample`: bootstrap replicates.
+    resample: Option<usize>,
 }
 
 /// Identifies the parameters of `options.fit` from the experiment manifests
@@ -44,9 +48,18 @@ pub fn identify(
     let base = params.inner.clone();
     drop(params);
     let config = config(&experiments, base, &options)?;
+    if options.resample == Some(0) {
+        return Err(bad_argument(
+            "resample",
+            "0: at least one replicate is needed",
+        ));
+    }
     let monitor = Monitor::default();
     let outcome = std::thread::scope(|s| {
-        let search = s.spawn(|| rtid::identify(&config, &monitor));
+        let search = s.spawn(|| {
+            let fit = rtid::identify(&config, &monitor).map_err(|e| rtid_error(&e))?;
+            with_intervals(fit, &options, &monitor)
+        });
         while !search.is_finished() {
             py.detach(|| std::thread::sleep(Duration::from_millis(20)));
             if py.check_signals().is_err() {
@@ -57,11 +70,56 @@ pub fn identify(
         search.join()
     });
     let Identified { result, params, .. } = match outcome {
-        Ok(r) => r.map_err(|e| rtid_error(&e))?,
+        Ok(r) => r?,
         Err(_) => return Err(bad_argument("identify", "the search panicked")),
     };
     let json = rtid::io::json::pretty(&result).map_err(|e| rtid_error(&e))?;
     Ok((json, PyParams { inner: params }))
+}
+
+/// The fit with the intervals `options` ask for, as `rtid identify --profile` and
+/// `--resample` add them (Ctrl-C stops them too: `monitor`).
+fn with_intervals(
+    mut fit: Identified,
+    options: &Options,
+    monitor: &Monitor,
+) -> PyResult<Identified> {
+    use rtid::identify::intervals::{profile, resample};
+    use rtid::identify::result::warning::Coded;
+    if let Some(names) = &options.profile {
+        let names = if names.is_empty() {
+            fit.result.parameters.keys().cloned().collect()
+        } else {
+            names.clone()
+        };
+        let request = profile::Request {
+            result: &fit.result,
+            params: &fit.params,
+            objective: fit.objective.as_ref(),
+            settings: fit.settings,
+            smoothness: fit.smoothness,
+            names,
+            stop: &|| monitor.stopped(),
+            on_point: &|| {},
+        };
+        let (profiles, warnings) = profile::profiles(&request).map_err(|e| rtid_error(&e))?;
+        fit.result.warnings.extend(warnings.into_iter().map(Coded));
+        profile::attach(&mut fit.result, profiles);
+    }
+    if let Some(replicates) = options.resample {
+        let request = resample::Request {
+            result: &fit.result,
+            params: &fit.params,
+            objective: fit.objective.as_ref(),
+            settings: fit.settings,
+            replicates,
+            stop: &|| monitor.stopped(),
+            on_replicate: &|| {},
+        };
+        let resampling = resample::resample(&request).map_err(|e| rtid_error(&e))?;
+        resample::attach(&mut fit.result, resampling);
+    }
+    Ok(fit)
 }
 
 /// The configuration, checked before any work as the command line checks it.

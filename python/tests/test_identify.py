@@ -119,3 +119,33 @@ def test_a_missing_column_is_named_by_rtid_reader():
     with pytest.raises(ValueError, match="missing column"):
         rtid.experiment("servo_trace", conditions=CONDITIONS, time_s=np.arange(5) * 1e-3,
                         force_n=np.zeros(5))
+
+
+def test_profile_and_resample_give_the_cli_intervals(cli, root, tmp_path):
+    worm = root / "fixtures/worm-gear/frequency_response.json"
+    out = tmp_path / "fit.json"
+    cli("identify", worm, "--preset", "worm-gear", "--fit", "Kw,Kg", "--model", "linear",
+        "--profile", "Kw", "--resample", "5", "--out", out)
+    expected = json.loads(out.read_text())
+    p = rtid.params("worm-gear")
+    profiled = rtid.identify(worm, p, fit="Kw,Kg", model="linear", profile=["Kw"])
+    assert profiled.interval_method == "profile"
+    lower, upper = profiled.intervals["Kw"]
+    assert lower == pytest.approx(expected["profiles"]["Kw"]["lower"], rel=1e-12, abs=0)
+    assert upper == pytest.approx(expected["profiles"]["Kw"]["upper"], rel=1e-12, abs=0)
+    boot = rtid.identify(worm, p, fit="Kw,Kg", model="linear", resample=5)
+    assert boot.interval_method == "bootstrap"
+    for name, i in expected["resampling"]["intervals"].items():
+        assert boot.intervals[name] == pytest.approx((i["lower"], i["upper"]), rel=1e-12, abs=0)
+    assert rtid.identify(worm, p, fit="Kw,Kg", model="linear").interval_method == "standard errors"
+
+
+@pytest.mark.parametrize("kwargs, argument", [
+    ({"resample": 0}, "resample"),
+    ({"resample": 2.5}, "resample"),
+    ({"profile": [""]}, "profile"),
+])
+def test_bad_interval_options_name_themselves(root, kwargs, argument):
+    worm = root / "fixtures/worm-gear/frequency_response.json"
+    with pytest.raises(ValueError, match=argument):
+        rtid.identify(worm, rtid.params("worm-gear"), fit="Kw", model="linear", **kwargs)
