@@ -386,16 +386,19 @@ def _as_experiment(e, argument: str) -> Experiment:
     raise RtidError(f"{argument}: expected an rtid.Experiment or a manifest path, got {type(e).__name__}")
 
 
-def evaluate(experiment) -> dict:
+def evaluate(experiment, params: Params | None = None) -> dict:
     """The statistics ``rtid evaluate --json`` gives of an experiment, as a dict: the
     resonances (and with the phase the modes) of a frequency response, a torque
     curve's friction and reversals, a positioning record's ISO 230-2 values, the
-    friction laws of a friction map, a servo trace's friction law by IDIM-LS, a
-    fluctuation or unbalance test's deviations in arc-seconds. (Raw time records
-    and the paper's resonance lists: the command line for now.)"""
+    friction laws of a friction map, a servo trace's friction law by IDIM-LS (with
+    ``params``, at the motor of a geared model, and the trace replayed on the model:
+    ``simulation_error``, as ``--params``), a fluctuation or unbalance test's
+    deviations in arc-seconds. (Raw time records and the paper's resonance lists:
+    the command line for now.)"""
     exp = _as_experiment(experiment, "experiment")
+    p = None if params is None else _params_arg(params)
     with tempfile.TemporaryDirectory(prefix="rtid-") as d:
-        return json.loads(_rtid.evaluate(exp._written(d), exp.name))
+        return json.loads(_rtid.evaluate(exp._written(d), exp.name, p))
 
 
 # --- identification ---------------------------------------------------------------

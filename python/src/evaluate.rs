@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 use serde_json::{json, Value};
 
 use crate::errors::{bad_argument, rtid_error, with_context};
+use crate::params::PyParams;
 use rtid::estimation::inverse_dynamics::IdimSettings;
 use rtid::experiments::frequency_response as fr;
 use rtid::experiments::positioning as pos;
@@ -19,12 +20,19 @@ use rtid::report::evaluation::{self, TraceReport};
 
 /// The evaluation of the experiment at `path` as JSON, `source` naming it.
 #[pyfunction]
-pub fn evaluate(py: Python<'_>, path: PathBuf, source: String) -> PyResult<String> {
+#[pyo3(signature = (path, source, params=None))]
+pub fn evaluate(
+    py: Python<'_>,
+    path: PathBuf,
+    source: String,
+    params: Option<PyRef<'_, PyParams>>,
+) -> PyResult<String> {
     let exp = rtid::read_experiment(&path).map_err(|e| with_context("experiment", &e))?;
+    let model = params.map(|p| p.inner.clone());
     let value = py.detach(|| match exp.manifest.kind {
         Kind::FrequencyResponse => frequency_response(&exp, &source),
         Kind::TorqueCurve => torque(&exp, &source),
-        Kind::ServoTrace => servo_trace(&exp, &source),
+        Kind::ServoTrace => servo_trace(&exp, &source, model.as_ref()),
         Kind::Positioning => positioning(&exp, &source),
         Kind::FrictionMap => friction(&exp, &source),
         Kind::Fluctuation | Kind::Unbalance => fluctuation(&exp, &source),
@@ -128,8 +136,9 @@ fn friction(exp: &Experiment, source: &str) -> PyResult<Value> {
     evaluation::friction_map(&e, source).map_err(|e| rtid_error(&e))
 }
 
-/// The friction law of a servo trace by IDIM-LS (the default settings).
-fn servo_trace(exp: &Experiment, source: &str) -> PyResult<Value> {
+/// The friction law of a servo trace by IDIM-LS (the default settings), and on
+/// `model` its replay's simulation error.
+fn servo_trace(exp: &Experiment, source: &str, model: Option<&rtid::Params>) -> PyResult<Value> {
     let (Data::ServoTrace(file), Some(trace)) = (&exp.data, ServoTrace::from_experiment(exp))
     else {
         return Err(bad_argument(
@@ -139,19 +148,8 @@ fn servo_trace(exp: &Experiment, source: &str) -> PyResult<Value> {
     };
     let period = trace.check().map_err(|e| with_context(source, &e))?;
     let settings = IdimSettings::for_sample_period(period);
-    let ratio = exp.manifest.conditions.ratio;
-    let fit = match ratio {
-        Some(r) => trace.fit_friction_at_motor(r, &settings),
-        None => trace.fit_friction(&settings),
-    }
-    .map_err(|e| with_context(&format!("{source}: inverse dynamics"), &e))?;
-    let report = TraceReport::new(
-        source.to_string(),
-        file.axis,
-        (trace.len(), period),
-        fit,
-        ratio,
-        None,
-    );
+    let e = rtid::servo_trace::evaluate(exp, (&trace, file.axis), &settings, model)
+        .map_err(|e| with_context(source, &e))?;
+    let report = TraceReport::new(source.to_string(), file.axis, (trace.len(), period), e);
     rtid::io::json::value(&report).map_err(|e| rtid_error(&e))
 }

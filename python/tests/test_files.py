@@ -62,6 +62,18 @@ def test_evaluate_of_a_linear_axis_torque_curve_is_in_newtons_as_the_cli(cli, ro
     assert got == expected
 
 
+def test_evaluate_of_a_servo_trace_on_a_model_is_the_cli_replay(cli, root):
+    manifest, axis = "fixtures/real/emps/emps_estimation.json", "fixtures/real/emps/axis.json"
+    expected = cli("evaluate", manifest, "--params", axis, "--json", json_out=True)
+    got = rtid.evaluate(root / manifest, params=rtid.params(path=root / axis))
+    expected.pop("source")
+    got.pop("source")
+    assert got["simulation_error"]["position_rms"] > 0
+    assert got == expected
+    with pytest.raises(ValueError, match="axis"):
+        rtid.evaluate(root / manifest, params=rtid.params("worm-gear"))
+
+
 def test_evaluate_refuses_a_kind_it_does_not_wrap_yet(root):
     with pytest.raises(ValueError, match="not part of this version yet"):
         rtid.evaluate(root / "fixtures/real/two-mass/multisine_a.json")

@@ -10,7 +10,7 @@ use crate::estimation::inverse_dynamics::IdimFit;
 use crate::experiments::fluctuation::Evaluation as FluctuationEvaluation;
 use crate::experiments::friction_map::MapEvaluation;
 use crate::experiments::positioning::iso230::{Iso230Report, ReportUnits};
-use crate::experiments::servo_trace::Misfit;
+use crate::experiments::servo_trace::{Misfit, TraceEvaluation};
 use crate::experiments::torque_curve::TorqueReport;
 use crate::io::experiment_file::{Axis, Kind};
 use crate::io::json::{value, JsonError};
@@ -111,30 +111,28 @@ pub struct TraceReport {
 }
 
 impl TraceReport {
-    /// The report of a trace of `samples` samples every `sample_period_s` on `axis`,
-    /// its law fitted at the motor when `ratio` is given.
+    /// The report of a trace of `samples` samples every `sample_period_s` on `axis`.
     pub fn new(
         source: String,
         axis: Axis,
         (samples, sample_period_s): (usize, f64),
-        inverse_dynamics: IdimFit,
-        ratio: Option<f64>,
-        simulation_error: Option<Misfit>,
+        e: TraceEvaluation,
     ) -> Self {
+        let TraceEvaluation { fit, ratio, replay } = e;
         TraceReport {
             kind: "servo_trace",
             source,
             axis,
             samples,
             sample_period_s,
-            inverse_dynamics,
+            inverse_dynamics: fit,
             frame: if ratio.is_some() {
                 "motor"
             } else {
                 "as_recorded"
             },
             ratio,
-            simulation_error,
+            simulation_error: replay.map(|(_, misfit)| misfit),
         }
     }
 }

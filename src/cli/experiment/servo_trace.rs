@@ -9,7 +9,7 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use rtid::estimation::inverse_dynamics::IdimSettings;
 use rtid::experiments::servo_trace::{
-    replay, simulation_error, virtual_trace, MoveTo, ServoTrace, TrapezoidalMoves,
+    evaluate, virtual_trace, MoveTo, ServoTrace, TrapezoidalMoves,
 };
 use rtid::io::experiment_file::{Axis, CommandUnit, Data, Experiment, Kind, Manifest};
 use rtid::model::Params;
@@ -205,72 +205,19 @@ pub fn report(
     };
     let source = exp.path.display().to_string();
     let sample_period_s = trace.check().with_context(|| source.clone())?;
-    let ratio = frame_ratio(exp, model.as_ref())?;
     let settings = idim.settings(sample_period_s)?;
-    let fit = match ratio {
-        Some(r) => trace.fit_friction_at_motor(r, &settings),
-        None => trace.fit_friction(&settings),
-    }
-    .with_context(|| format!("{source}: inverse dynamics"))?;
-    let run = match &model {
-        Some(p) => Some(replayed(p, &trace, file.axis, &source)?),
-        None => None,
-    };
-    let misfit = match &run {
-        Some(r) => Some(simulation_error(&trace, r).with_context(|| source.clone())?),
-        None => None,
-    };
-    plot.write(
-        &figures::following_error(&trace, run.as_ref(), file.axis),
-        "",
-    )?;
-    plot.write(&figures::effort(&trace, run.as_ref(), file.axis), "-effort")?;
-    let report = TraceReport::new(
-        source,
-        file.axis,
-        (trace.len(), sample_period_s),
-        fit,
-        ratio,
-        misfit,
-    );
+    let e = evaluate(exp, (&trace, file.axis), &settings, model.as_ref())
+        .with_context(|| source.clone())?;
+    let run = e.replay.as_ref().map(|(run, _)| run);
+    plot.write(&figures::following_error(&trace, run, file.axis), "")?;
+    plot.write(&figures::effort(&trace, run, file.axis), "-effort")?;
+    let report = TraceReport::new(source, file.axis, (trace.len(), sample_period_s), e);
     if json {
         println!("{}", rtid::io::json::pretty(&report)?);
     } else {
         print_report(&report);
     }
     Ok(())
-}
-
-/// The ratio that takes the trace's (table-side) positions to the motor:
-/// `conditions.ratio`, else the model's when it is geared; none for a direct or
-/// ungeared axis, or when neither says.
-fn frame_ratio(exp: &Experiment, model: Option<&Params>) -> anyhow::Result<Option<f64>> {
-    if let Some(r) = exp.manifest.conditions.ratio {
-        if !(r.is_finite() && r > 0.0) {
-            bail!(
-                "{}: `conditions.ratio` is {r}: it must be positive (table turns per motor turn, Rg·Rw)",
-                exp.path.display()
-            );
-        }
-        return Ok(Some(r));
-    }
-    Ok(model.map(Params::ratio).filter(|&r| r != 1.0))
-}
-
-/// The trace replayed on `p`, which must be of the trace's axis.
-fn replayed(
-    p: &Params,
-    trace: &ServoTrace,
-    axis: Axis,
-    source: &str,
-) -> anyhow::Result<rtid::experiments::servo_trace::Replay> {
-    if p.axis != axis {
-        bail!(
-            "{source}: the trace is of a {axis} axis, the parameters (--preset/--params) of a {} one",
-            p.axis
-        );
-    }
-    replay(p, trace).with_context(|| format!("{source}: replay"))
 }
 
 fn print_report(r: &TraceReport) {

@@ -26,9 +26,11 @@
 //! Reference: A. Janot, M. Gautier, M. Brunot, "Data Set and Reference Models of EMPS",
 //! Nonlinear System Identification Benchmarks workshop, Eindhoven, 2019.
 
+mod evaluate;
 mod replay;
 mod virtual_trace;
 
+pub use evaluate::{evaluate, EvaluateError, TraceEvaluation};
 pub use replay::{replay, simulation_error, Misfit, Replay};
 pub use virtual_trace::{virtual_trace, MoveTo, TrapezoidalMoves};
 
