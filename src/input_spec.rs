@@ -5,7 +5,10 @@
 
 use std::str::FromStr;
 
-use crate::model::LoopMode;
+use crate::input::{Move, NoTorque, Samples, Sine, Step};
+use crate::model::{LoopMode, Params};
+use crate::recorder::Recorder;
+use crate::sim::{SimError, Simulation};
 
 /// A parsed input specification (units in the field names).
 #[derive(Debug, Clone, PartialEq)]
@@ -32,6 +35,71 @@ pub enum InputSpec {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{0}")]
 pub struct SpecError(String);
+
+impl InputSpec {
+    /// The commanded table trajectory of a `move:` specification (from 0, rad).
+    pub fn reference(&self) -> Option<Move> {
+        match *self {
+            InputSpec::Move {
+                target_deg,
+                speed_deg_per_min,
+                ..
+            } => Some(move_to(target_deg, speed_deg_per_min)),
+            _ => None,
+        }
+    }
+
+    /// Runs `duration` s of this input on `sim` (the model `p`) into `rec`. `torques`,
+    /// when given, drive it open loop: the samples a `file:` specification names
+    /// (read by the caller, which reports the file's errors), or an array's; a
+    /// `file:` specification without them runs free. A move's reference is
+    /// [`InputSpec::reference`].
+    pub fn run<R: Recorder>(
+        &self,
+        sim: &mut Simulation,
+        p: &Params,
+        torques: Option<Samples>,
+        duration: f64,
+        rec: &mut R,
+    ) -> Result<(), SimError> {
+        if let Some(mut samples) = torques {
+            return sim.run_open_loop(&mut samples, duration, rec);
+        }
+        match *self {
+            InputSpec::Sine {
+                freq_hz,
+                amp_nm,
+                offset_nm,
+            } => sim.run_open_loop(&mut Sine::new(freq_hz, amp_nm, offset_nm), duration, rec),
+            InputSpec::Step { torque_nm, at_s } => {
+                sim.run_open_loop(&mut Step { torque_nm, at_s }, duration, rec)
+            }
+            InputSpec::File(_) | InputSpec::None => sim.run_open_loop(&mut NoTorque, duration, rec),
+            InputSpec::Move {
+                target_deg,
+                speed_deg_per_min,
+                loop_mode,
+            } => {
+                let mut q = p.clone();
+                if let Some(m) = loop_mode {
+                    q.controller.loop_mode = m;
+                }
+                let mut controller = sim.controller(&q)?;
+                let reference = move_to(target_deg, speed_deg_per_min);
+                sim.run_closed_loop(&mut controller, &reference, duration, rec)
+            }
+        }
+    }
+}
+
+/// The move of the table from 0 to `target_deg`: a step command, or a ramp.
+fn move_to(target_deg: f64, speed_deg_per_min: Option<f64>) -> Move {
+    Move {
+        from: 0.0,
+        to: target_deg.to_radians(),
+        speed: speed_deg_per_min.map(|v| v.to_radians() / 60.0),
+    }
+}
 
 impl FromStr for InputSpec {
     type Err = SpecError;

@@ -6,7 +6,7 @@ use pyo3::types::PyDict;
 
 use crate::errors::{bad_argument, rtid_error, with_context};
 use crate::params::PyParams;
-use rtid::input::{Move, NoTorque, Samples, Sine, Step, Trajectory};
+use rtid::input::{Move, Samples, Trajectory};
 use rtid::input_spec::{self, InputSpec};
 use rtid::io::torque_file;
 use rtid::model::{Params, NSTATE};
@@ -204,7 +204,8 @@ fn recorded(time: &[f64], torque: &[f64]) -> PyResult<Drive> {
     Ok(Drive::Torques(time.to_vec(), torque.to_vec()))
 }
 
-/// The run, as `rtid simulate` drives it.
+/// The run, as `rtid simulate` drives it (a move's reference recorded beside the
+/// states).
 fn run(
     sim: &mut Simulation,
     p: &Params,
@@ -212,37 +213,13 @@ fn run(
     duration: f64,
     rec: &mut Columns,
 ) -> Result<(), SimError> {
-    let spec = match drive {
-        Drive::Torques(t, q) => return sim.run_open_loop(&mut Samples::new(t, q), duration, rec),
-        Drive::Spec(spec) => spec,
-    };
-    match spec {
-        InputSpec::Sine {
-            freq_hz,
-            amp_nm,
-            offset_nm,
-        } => sim.run_open_loop(&mut Sine::new(freq_hz, amp_nm, offset_nm), duration, rec),
-        InputSpec::Step { torque_nm, at_s } => {
-            sim.run_open_loop(&mut Step { torque_nm, at_s }, duration, rec)
+    match drive {
+        Drive::Torques(t, q) => {
+            InputSpec::None.run(sim, p, Some(Samples::new(t, q)), duration, rec)
         }
-        InputSpec::None | InputSpec::File(_) => sim.run_open_loop(&mut NoTorque, duration, rec),
-        InputSpec::Move {
-            target_deg,
-            speed_deg_per_min,
-            loop_mode,
-        } => {
-            let mut q = p.clone();
-            if let Some(m) = loop_mode {
-                q.controller.loop_mode = m;
-            }
-            let mut controller = sim.controller(&q)?;
-            let m = Move {
-                from: 0.0,
-                to: target_deg.to_radians(),
-                speed: speed_deg_per_min.map(|v| v.to_radians() / 60.0),
-            };
-            rec.reference = Some(m);
-            sim.run_closed_loop(&mut controller, &m, duration, rec)
+        Drive::Spec(spec) => {
+            rec.reference = spec.reference();
+            spec.run(sim, p, None, duration, rec)
         }
     }
 }

@@ -9,7 +9,7 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::experiment::check;
 use crate::cli::ModelArgs;
-use rtid::input::{Move, NoTorque, Samples, Sine, Step};
+use rtid::input::{Move, Samples};
 use rtid::input_spec::InputSpec;
 use rtid::io::{atomic, torque_file};
 use rtid::model::{idx::*, NSTATE};
@@ -193,7 +193,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     print_summary(&a, &sim, p.ratio(), wall)
 }
 
-/// Runs `duration` s of `input` (`recorded`: the torque file's samples) on `sim`.
+/// Runs `duration` s of `input` (`recorded`: the torque file's samples) on `sim`,
+/// a move's reference recorded beside the states.
 fn drive<W: Write>(
     sim: &mut Simulation,
     p: &rtid::model::Params,
@@ -202,43 +203,9 @@ fn drive<W: Write>(
     duration: f64,
     rec: &mut CsvRecorder<W>,
 ) -> Result<(), rtid::sim::SimError> {
-    match input {
-        InputSpec::Sine {
-            freq_hz,
-            amp_nm,
-            offset_nm,
-        } => sim.run_open_loop(&mut Sine::new(*freq_hz, *amp_nm, *offset_nm), duration, rec),
-        InputSpec::Step { torque_nm, at_s } => {
-            let mut input = Step {
-                torque_nm: *torque_nm,
-                at_s: *at_s,
-            };
-            sim.run_open_loop(&mut input, duration, rec)
-        }
-        InputSpec::File(_) => {
-            let (t, q) = recorded.expect("run() reads an --input file before the run");
-            sim.run_open_loop(&mut Samples::new(t, q), duration, rec)
-        }
-        InputSpec::None => sim.run_open_loop(&mut NoTorque, duration, rec),
-        InputSpec::Move {
-            target_deg,
-            speed_deg_per_min,
-            loop_mode,
-        } => {
-            let mut q = p.clone();
-            if let Some(m) = loop_mode {
-                q.controller.loop_mode = *m;
-            }
-            let mut controller = sim.controller(&q)?;
-            let m = Move {
-                from: 0.0,
-                to: target_deg.to_radians(),
-                speed: speed_deg_per_min.map(|v| v.to_radians() / 60.0),
-            };
-            rec.reference = Some((m, 0.0));
-            sim.run_closed_loop(&mut controller, &m, duration, rec)
-        }
-    }
+    rec.reference = input.reference().map(|m| (m, 0.0));
+    let torques = recorded.map(|(t, q)| Samples::new(t, q));
+    input.run(sim, p, torques, duration, rec)
 }
 
 /// The run's summary: steps, wall time, final angles; a table or JSON.
