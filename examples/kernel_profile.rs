@@ -15,7 +15,7 @@
 //! rad or m) through `Simulation::run_closed_loop`, one lane.
 
 use rtid::input::{Move, Sine, TorqueInput};
-use rtid::model::{presets, Drive, Kernel, NSTATE};
+use rtid::model::{presets, Drive, Kernel, LaneDrive, NSTATE};
 use rtid::recorder::NullRecorder;
 use rtid::sim::Simulation;
 
@@ -23,6 +23,7 @@ const DT: f64 = 1e-5;
 
 /// Lane-steps per second of `L` sines through a `Kernel<L>`, and the events.
 fn lanes<const L: usize>(d: &Drive, seconds: f64) -> (f64, f64, u64) {
+    let lanes = LaneDrive::<L>::splat(d);
     let mut kernel = Kernel::<L>::default();
     let mut y = [[0.0; L]; NSTATE];
     let mut inputs: [Sine; L] =
@@ -38,7 +39,7 @@ fn lanes<const L: usize>(d: &Drive, seconds: f64) -> (f64, f64, u64) {
                 motor[s][l] = m[s];
             }
         }
-        kernel.step(d, &mut y, &motor, &[d.tload(); L], DT);
+        kernel.step(&lanes, &mut y, &motor, &[d.tload(); L], DT);
     }
     let wall = started.elapsed().as_secs_f64();
     std::hint::black_box(y);

@@ -10,7 +10,7 @@ use crate::controller::{Controller, ControllerError, Gains};
 use crate::input::{TorqueInput, Trajectory};
 use crate::model::drive::idx::*;
 use crate::model::lanes::Lanes;
-use crate::model::{Drive, Kernel, ParamError, Params, States, NSTATE};
+use crate::model::{Drive, Kernel, LaneDrive, LaneMismatch, ParamError, Params, States, NSTATE};
 use crate::recorder::Recorder;
 
 /// The RK4 step is chosen so that |λ|·dt ≤ this for the fastest eigenvalue λ of the
@@ -50,6 +50,10 @@ pub enum SimError {
     ControlPeriod { tc: f64, dt: f64 },
     #[error("simulation diverged at t = {time:.6} s: {state}")]
     Diverged { time: f64, state: String },
+    #[error(transparent)]
+    Lanes(#[from] LaneMismatch),
+    #[error("lane {lane} is integrated with dt = {dt} s, lane 0 with {dt0} s: lanes of one batch share the step")]
+    LaneStep { lane: usize, dt: f64, dt0: f64 },
 }
 
 /// The default integration step for `params`: the largest of 1e-5 s, 5e-6 s, 2e-6 s,
@@ -88,6 +92,8 @@ fn whole_steps(period: f64, dt: f64) -> Option<usize> {
 #[derive(Clone, Debug)]
 pub struct Simulation {
     drive: Drive,
+    /// The drive as the kernel reads it.
+    lane: LaneDrive<1>,
     dt: f64,
     steps: u64,
     y: States<1>,
@@ -102,6 +108,7 @@ impl Simulation {
         let drive = checked_drive(params, dt)?;
         Ok(Simulation {
             drive,
+            lane: LaneDrive::splat(&drive),
             dt,
             steps: 0,
             y: [[0.0]; NSTATE],
@@ -248,7 +255,7 @@ impl Simulation {
     /// One step, then the divergence check.
     #[inline]
     fn advance<const RIGID: bool>(&mut self, motor: &[[f64; 1]; 3]) -> Result<(), SimError> {
-        let (d, y, load) = (&self.drive, &mut self.y, &[self.load]);
+        let (d, y, load) = (&self.lane, &mut self.y, &[self.load]);
         if RIGID {
             self.kernel.step_rigid(d, y, motor, load, self.dt);
         } else {
@@ -308,15 +315,17 @@ fn diverged<const L: usize>(y: &States<L>) -> Option<usize> {
     }
 }
 
-/// `L` independent simulations of one model, advanced together one step at a time
-/// (`Kernel<L>` lanes, so that the compiler vectorises them). Each lane has its own
-/// state, clock, table load and motor torque, and can be restarted on its own; lane
-/// `l` computes bit for bit what a [`Simulation`] computes for the same run alone.
-/// Every step checks every lane for divergence; an idle lane (at rest, no torque)
-/// stays at rest.
+/// `L` independent simulations, advanced together one step at a time (`Kernel<L>`
+/// lanes, so that the compiler vectorises them): of one model
+/// ([`LaneSimulation::new`]), or of `L` parameter sets whose equations have one
+/// shape ([`LaneSimulation::of`]). Each lane has its own state, clock, table load
+/// and motor torque, and can be restarted on its own; lane `l` computes bit for bit
+/// what a [`Simulation`] computes for the same run alone. Every step checks every
+/// lane for divergence; an idle lane (at rest, no torque) stays at rest.
 #[derive(Clone, Debug)]
 pub struct LaneSimulation<const L: usize> {
-    drive: Drive,
+    drives: [Drive; L],
+    lanes: LaneDrive<L>,
     dt: f64,
     steps: [u64; L],
     y: States<L>,
@@ -328,14 +337,31 @@ impl<const L: usize> LaneSimulation<L> {
     /// `L` tables at rest at zero angles, integrated with step `dt` (checked as by
     /// [`Simulation::new`]).
     pub fn new(params: &Params, dt: f64) -> Result<Self, SimError> {
-        let drive = checked_drive(params, dt)?;
+        Self::with_drives([checked_drive(params, dt)?; L], dt)
+    }
+
+    /// `params[l]` in lane `l`, every lane at rest at zero angles and integrated with
+    /// step `dt` (checked for each as by [`Simulation::new`]). The parameter sets
+    /// must give equations of one shape ([`crate::model::LaneKey`]); an error names
+    /// the first that does not.
+    pub fn of(params: &[Params; L], dt: f64) -> Result<Self, SimError> {
+        let mut drives = Vec::with_capacity(L);
+        for p in params {
+            drives.push(checked_drive(p, dt)?);
+        }
+        let drives: [Drive; L] = drives.try_into().expect("one drive per parameter set");
+        Self::with_drives(drives, dt)
+    }
+
+    fn with_drives(drives: [Drive; L], dt: f64) -> Result<Self, SimError> {
         Ok(LaneSimulation {
-            drive,
+            lanes: LaneDrive::gather(&drives)?,
+            drives,
             dt,
             steps: [0; L],
             y: [[0.0; L]; NSTATE],
             kernel: Kernel::default(),
-            load: [drive.tload(); L],
+            load: drives.map(|d| d.tload()),
         })
     }
 
@@ -344,9 +370,9 @@ impl<const L: usize> LaneSimulation<L> {
         self.dt
     }
 
-    /// The compiled model.
-    pub fn drive(&self) -> &Drive {
-        &self.drive
+    /// The compiled model of lane `l`.
+    pub fn drive(&self, l: usize) -> &Drive {
+        &self.drives[l]
     }
 
     /// Starts a new run in lane `l` at t = 0 from state `y` (slots the topology does
@@ -354,13 +380,13 @@ impl<const L: usize> LaneSimulation<L> {
     /// (N·m; `Tload` adds to it), as a new [`Simulation`] with
     /// [`Simulation::set_state`] and [`Simulation::set_load`] would.
     pub fn start(&mut self, l: usize, mut y: [f64; NSTATE], load: f64) {
-        self.drive.mirror(&mut y);
+        self.drives[l].mirror(&mut y);
         for (i, v) in y.into_iter().enumerate() {
             self.y[i][l] = v;
         }
         self.kernel.reset_lane(l);
         self.steps[l] = 0;
-        self.load[l] = load + self.drive.tload();
+        self.load[l] = load + self.drives[l].tload();
     }
 
     /// Simulated time of lane `l`, s.
@@ -384,7 +410,7 @@ impl<const L: usize> LaneSimulation<L> {
     #[inline]
     pub fn step(&mut self, motor: &[[f64; L]; 3]) -> Result<(), SimError> {
         self.kernel
-            .step(&self.drive, &mut self.y, motor, &self.load, self.dt);
+            .step(&self.lanes, &mut self.y, motor, &self.load, self.dt);
         for s in &mut self.steps {
             *s += 1;
         }

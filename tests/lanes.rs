@@ -1,7 +1,9 @@
 //! Lockstep lanes compute exactly what lone simulations compute: a `LaneSimulation<8>`
-//! (a `Kernel<8>`) against eight `Simulation`s (`Kernel<1>`), with contact events,
-//! stick and fluctuation resynchronisations happening in different lanes at
-//! different steps; and a batched sweep against `simulate_point`.
+//! (a `Kernel<8>`) against eight `Simulation`s (`Kernel<1>`), bit for bit, with
+//! contact events, stick and fluctuation resynchronisations happening in different
+//! lanes at different steps — of one model, and of eight parameter sets (every
+//! number of the model different in every lane); and a batched sweep against
+//! `simulate_point`.
 
 use rtid::experiments::frequency_response::{simulate_point, sweep, FrequencyTest};
 use rtid::input::{Sine, TorqueInput};
@@ -55,14 +57,30 @@ fn lone(p: &Params, c: &Case, steps: usize) -> Lone {
     }
 }
 
+/// Eight sines from rest: lane `l` at `hz + l·dhz` Hz with amplitude `a + l·da`.
+fn sines(hz: f64, dhz: f64, a: f64, da: f64) -> [Case; 8] {
+    std::array::from_fn(|l| Case {
+        hz: hz + dhz * l as f64,
+        amplitude: a + da * l as f64,
+        offset: 0.0,
+        load: 0.0,
+        y0: [0.0; NSTATE],
+    })
+}
+
 fn compare(p: &Params, cases: &[Case; 8], steps: usize) -> Vec<Lone> {
-    let mut lanes = LaneSimulation::<8>::new(p, DT).unwrap();
+    compare_sets(&std::array::from_fn(|_| p.clone()), cases, steps)
+}
+
+/// Lane `l` runs `params[l]` on `cases[l]`; every state of every step must equal
+/// the lone run's bit for bit.
+fn compare_sets(params: &[Params; 8], cases: &[Case; 8], steps: usize) -> Vec<Lone> {
+    let mut lanes = LaneSimulation::<8>::of(params, DT).unwrap();
     for (l, c) in cases.iter().enumerate() {
         lanes.start(l, c.y0, c.load);
     }
     let mut inputs = cases.map(|c| Sine::new(c.hz, c.amplitude, c.offset));
-    let lone: Vec<Lone> = cases.iter().map(|c| lone(p, c, steps)).collect();
-    let mut worst = 0.0f64;
+    let lone: Vec<Lone> = (0..8).map(|l| lone(&params[l], &cases[l], steps)).collect();
     for k in 0..steps {
         let mut motor = [[0.0; 8]; 3];
         for (l, input) in inputs.iter_mut().enumerate() {
@@ -74,13 +92,10 @@ fn compare(p: &Params, cases: &[Case; 8], steps: usize) -> Vec<Lone> {
         lanes.step(&motor).unwrap();
         for (l, run) in lone.iter().enumerate() {
             let (a, b) = (lanes.state(l), run.states[k]);
-            for i in 0..NSTATE {
-                let scale = b[i].abs().max(1e-300);
-                worst = worst.max((a[i] - b[i]).abs() / scale);
-            }
+            let same = (0..NSTATE).all(|i| a[i].to_bits() == b[i].to_bits());
+            assert!(same, "step {k}, lane {l}: {a:?} in lanes, {b:?} alone");
         }
     }
-    assert!(worst <= 1e-12, "lanes differ from lone runs by {worst:.3e}");
     let events: u64 = lone.iter().map(|r| r.events).sum();
     assert_eq!(lanes.contact_events(), events, "same contact events");
     lone
@@ -252,14 +267,87 @@ fn lanes_with_a_stribeck_law_equal_lone_simulations() {
     assert!(stuck.windows(2).any(|w| w[0] != w[1]), "{stuck:?}");
     let mut direct = presets::load("direct-drive").unwrap();
     (direct.fst, direct.vst) = (0.5, 0.2);
-    let cases: [Case; 8] = std::array::from_fn(|l| Case {
-        hz: 2.0 + 3.0 * l as f64,
-        amplitude: 0.5 + 1.5 * l as f64,
-        offset: 0.0,
-        load: 0.0,
-        y0: [0.0; NSTATE],
-    });
+    let cases: [Case; 8] = sines(2.0, 3.0, 0.5, 1.5);
     let lone = compare(&direct, &cases, 20_000);
     let stuck: Vec<usize> = lone.iter().map(|r| r.stuck_steps).collect();
     assert!(stuck.iter().any(|&s| s > 0), "{stuck:?}");
+}
+
+/// The worm-gear preset with every number scaled in lane `l`'s own way: stiffnesses,
+/// dampings, inertias, gaps, friction levels, fluctuation, unbalance and load.
+fn varied_worm(l: usize) -> Params {
+    let mut p = presets::load("worm-gear").unwrap();
+    let f = 1.0 + 0.07 * l as f64;
+    let g = 1.0 - 0.05 * l as f64;
+    p.kw *= f;
+    p.kg = p.kg.map(|k| k * g);
+    p.kb *= g;
+    p.ciw *= f;
+    p.cig = p.cig.map(|c| c * f);
+    (p.cm, p.cw, p.ct) = (p.cm * g, p.cw * f, p.ct * g);
+    (p.jm, p.jw, p.jt) = (p.jm * f, p.jw * g, p.jt * f);
+    (p.fm, p.fw, p.ft) = (p.fm * g, p.fw * f, p.ft * (1.0 + 0.3 * l as f64));
+    p.theta_bw *= f;
+    p.theta_bg = p.theta_bg.map(|b| b * g);
+    p.w = 2e-5 * f;
+    p.fluct_phase = 0.3 * l as f64;
+    p.unbalance_mass = 5.0 + l as f64;
+    p.unbalance_radius = 0.05;
+    p.unbalance_phase = 0.2 * l as f64;
+    p.tload = 0.1 * l as f64 - 0.35;
+    p
+}
+
+#[test]
+fn lanes_of_eight_parameter_sets_equal_their_lone_simulations() {
+    // Every number of the worm-gear model differs between lanes; the lanes also
+    // differ in their inputs, so events, stick and resynchronisations fall at
+    // different steps.
+    let params: [Params; 8] = std::array::from_fn(varied_worm);
+    let cases: [Case; 8] = std::array::from_fn(|l| Case {
+        hz: [230.0, 180.0, 60.0, 95.0, 250.0, 300.0, 20.0, 410.0][l],
+        amplitude: [5.0, 5.0, 0.3, 0.12, 5.0, 8.0, 0.05, 2.0][l],
+        offset: if l == 4 { 0.1 } else { 0.0 },
+        load: if l == 6 { 0.1 } else { 0.0 },
+        y0: [0.0; NSTATE],
+    });
+    let lone = compare_sets(&params, &cases, 20_000);
+    let events: Vec<u64> = lone.iter().map(|r| r.events).collect();
+    let stuck: Vec<usize> = lone.iter().map(|r| r.stuck_steps).collect();
+    assert!(events.iter().filter(|&&e| e > 0).count() >= 4, "{events:?}");
+    assert!(stuck.windows(2).any(|w| w[0] != w[1]), "{stuck:?}");
+}
+
+#[test]
+fn lanes_of_different_stribeck_laws_and_direct_drives_equal_their_lone_simulations() {
+    let worm: [Params; 8] = std::array::from_fn(|l| {
+        let mut p = varied_worm(l);
+        (p.fsm, p.vsm) = (0.2 * (l + 1) as f64 * p.fm, 0.5 + l as f64);
+        (p.fst, p.vst) = (0.1 * (l + 1) as f64 * p.ft, 0.02 * (l + 1) as f64);
+        p.stribeck_shape = [2.0, 1.0, 0.5, 1.5][l % 4];
+        p
+    });
+    let slow: [Case; 8] = sines(5.0, 7.0, 0.3, 0.4);
+    let lone = compare_sets(&worm, &slow, 20_000);
+    let stuck: Vec<usize> = lone.iter().map(|r| r.stuck_steps).collect();
+    assert!(stuck.windows(2).any(|w| w[0] != w[1]), "{stuck:?}");
+    let direct: [Params; 8] = std::array::from_fn(|l| {
+        let mut p = presets::load("direct-drive").unwrap();
+        (p.jt, p.ct, p.ft) = (p.jt * (1.0 + 0.1 * l as f64), p.ct * 2.0, 0.2 * l as f64);
+        (p.unbalance_mass, p.unbalance_radius) = (1.0 + l as f64, 0.01);
+        p
+    });
+    let stuck: Vec<usize> = compare_sets(&direct, &slow, 20_000)
+        .iter()
+        .map(|r| r.stuck_steps)
+        .collect();
+    assert!(stuck.windows(2).any(|w| w[0] != w[1]), "{stuck:?}");
+}
+
+#[test]
+fn parameter_sets_of_different_shapes_are_refused_with_the_lane() {
+    let mut params: [Params; 8] = std::array::from_fn(varied_worm);
+    params[5].theta_bw = 0.0;
+    let err = LaneSimulation::<8>::of(&params, DT).unwrap_err();
+    assert!(err.to_string().contains("lane 5"), "{err}");
 }

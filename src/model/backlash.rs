@@ -4,7 +4,8 @@
 //!
 //! The laws are written as selects between values computed unconditionally (no
 //! branch depends on the state), so the kernel's lane-wise forms ([`mesh_torque_lanes`])
-//! vectorise; each lane gets exactly the scalar result.
+//! vectorise; each lane, with its own stiffness, damping and gap, gets exactly the
+//! scalar result.
 
 use super::lanes::Lanes;
 
@@ -47,19 +48,20 @@ fn contact_torque(dz: f64, t: f64) -> f64 {
     }
 }
 
-/// [`mesh_torque`] for each lane (`k`, `c`, `b` shared by all lanes).
+/// [`mesh_torque`] for each lane, each with its own `k`, `c` and `b`; `gapped`
+/// says whether the gaps are positive (in every lane) or zero (in every lane: a
+/// preloaded mesh, linear).
 #[inline(always)]
 pub(crate) fn mesh_torque_lanes<const L: usize>(
-    k: f64,
-    c: f64,
-    b: f64,
+    (k, c, b): (Lanes<L>, Lanes<L>, Lanes<L>),
+    gapped: bool,
     delta: Lanes<L>,
     rate: Lanes<L>,
 ) -> Lanes<L> {
-    if b == 0.0 {
+    if !gapped {
         return k * delta + c * rate;
     }
-    let dz = delta.map(|d| dead_zone(d, b));
+    let dz = delta.zip(b, dead_zone);
     dz.zip(k * dz + c * rate, contact_torque)
 }
 
@@ -96,7 +98,8 @@ mod tests {
         let delta = Lanes([-3e-4, -1.01e-4, -1e-4, 0.0, 5e-5, 1e-4, 1.01e-4, 3e-4]);
         for rate in [-50.0, -2.0, 0.0, 2.0, 50.0] {
             for b in [0.0, 1e-4] {
-                let t = mesh_torque_lanes(3e5, 100.0, b, delta, Lanes::splat(rate));
+                let mesh = (Lanes::splat(3e5), Lanes::splat(100.0), Lanes::splat(b));
+                let t = mesh_torque_lanes(mesh, b > 0.0, delta, Lanes::splat(rate));
                 for l in 0..8 {
                     assert_eq!(t.0[l], mesh_torque(3e5, 100.0, b, delta.0[l], rate));
                 }

@@ -39,7 +39,7 @@ pub mod idx {
 pub const NSTATE: usize = 8;
 
 /// Which equations the kernel integrates.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Form {
     /// Motor, spur mesh, driving shaft, drive mesh, axial bearing, table (`spur_gear`).
     Spur,
@@ -285,29 +285,6 @@ impl Drive {
         let (s, c) = (self.n * shaft_angle + self.phase).sin_cos();
         (self.w * s, self.w * self.n * c)
     }
-
-    /// sin and cos of N·θ + φ by the library (kept out of line: a call inside the
-    /// hot loop makes the compiler spill every live register around it).
-    #[cold]
-    #[inline(never)]
-    pub(crate) fn exact_phase(&self, shaft_angle: f64) -> (f64, f64) {
-        (self.n * shaft_angle + self.phase).sin_cos()
-    }
-
-    /// The fluctuation at `shaft_angle` from the phase (sin, cos) known at the
-    /// nearby angle `base`: a rotation by the small angle N·(θ − θ0), exact to
-    /// rounding for the sub-step distances of one integration step.
-    #[inline(always)]
-    pub(crate) fn fluctuation_near(
-        &self,
-        shaft_angle: f64,
-        base: f64,
-        (s0, c0): (f64, f64),
-    ) -> (f64, f64) {
-        let (sx, cx) = small_sin_cos(self.n * (shaft_angle - base));
-        let (s, c) = (s0 * cx + c0 * sx, c0 * cx - s0 * sx);
-        (self.w * s, self.w * self.n * c)
-    }
 }
 
 /// Steps between exact evaluations of the fluctuation phase.
@@ -316,7 +293,7 @@ pub(crate) const PHASE_RESYNC: u32 = 1024;
 /// sin and cos of `x`: Taylor polynomials for |x| < 0.01 (errors below x⁷/5040 and
 /// x⁶/720, i.e. < 2e-18 and 1.4e-15), the library functions otherwise.
 #[inline(always)]
-fn small_sin_cos(x: f64) -> (f64, f64) {
+pub(crate) fn small_sin_cos(x: f64) -> (f64, f64) {
     if x.abs() < SMALL_ANGLE {
         taylor_sin_cos(x)
     } else {

@@ -63,11 +63,13 @@
 //! [`Kernel`], which the caller owns and reuses.
 
 use super::backlash::mesh_torque_lanes;
-use super::drive::{idx::*, taylor_sin_cos, Drive, NSTATE, PHASE_RESYNC, SMALL_ANGLE};
+use super::drive::{idx::*, taylor_sin_cos, NSTATE, PHASE_RESYNC, SMALL_ANGLE};
 use super::friction::clamp::{
     decide_direction_lanes, decide_lanes, stop_at_reversal, stop_at_reversal_lanes, Friction,
 };
-use super::friction::{with_law, FrictionLaw};
+use super::friction::lanes::{with_lane_law, LaneLaw};
+use super::friction::FrictionLaw;
+use super::lane_drive::LaneDrive;
 use super::lanes::Lanes;
 
 /// The state of `L` lanes: `y[i][l]` is state `i` (see [`idx`](super::drive::idx)) of lane `l`.
@@ -163,7 +165,14 @@ impl<const L: usize> LaneState<L> {
     /// of its other torques and its velocity `w`: with a constant level (Coulomb)
     /// its torque for the whole step, with another law its direction.
     #[inline(always)]
-    fn decide<F: FrictionLaw>(&mut self, law: &F, b: usize, t: Lanes<L>, w: Lanes<L>, inv_j: f64) {
+    fn decide<F: FrictionLaw>(
+        &mut self,
+        law: &LaneLaw<F, L>,
+        b: usize,
+        t: Lanes<L>,
+        w: Lanes<L>,
+        inv_j: Lanes<L>,
+    ) {
         let free = if F::CONSTANT_LEVEL {
             let (torque, free) = decide_lanes(t, w, law.breakaway(b));
             self.friction[b] = torque.0;
@@ -182,11 +191,17 @@ impl<const L: usize> LaneState<L> {
     /// ((t − friction)·free)/J exactly.) With a law whose level varies the
     /// friction's level is that of `w`.
     #[inline(always)]
-    fn accel<F: FrictionLaw>(&self, law: &F, b: usize, t: Lanes<L>, w: Lanes<L>) -> Lanes<L> {
+    fn accel<F: FrictionLaw>(
+        &self,
+        law: &LaneLaw<F, L>,
+        b: usize,
+        t: Lanes<L>,
+        w: Lanes<L>,
+    ) -> Lanes<L> {
         let friction = if F::CONSTANT_LEVEL {
             Lanes(self.friction[b])
         } else {
-            Lanes(self.direction[b]).zip(w, |sign, w| sign * law.sliding(b, w.abs()))
+            Lanes(self.direction[b]) * law.sliding(b, w.map(f64::abs))
         };
         (t - friction) * Lanes(self.gain[b])
     }
@@ -196,7 +211,7 @@ impl<const L: usize> LaneState<L> {
     /// [`PHASE_RESYNC`] steps, after a jump and on the first step (out of line, only
     /// for the lanes that need it). Stores the Taylor coefficients for later stages.
     #[inline(always)]
-    fn fluctuation_first(&mut self, d: &Drive, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
+    fn fluctuation_first(&mut self, d: &LaneDrive<L>, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
         let x = d.n * (shaft - Lanes(self.shaft));
         let sx = x.map(|x| taylor_sin_cos(x).0);
         let cx = x.map(|x| taylor_sin_cos(x).1);
@@ -235,10 +250,10 @@ impl<const L: usize> LaneState<L> {
     /// The library sin/cos for the lanes whose counter was just reset.
     #[cold]
     #[inline(never)]
-    fn resync_phase(&self, d: &Drive, shaft: Lanes<L>, s: &mut Lanes<L>, c: &mut Lanes<L>) {
+    fn resync_phase(&self, d: &LaneDrive<L>, shaft: Lanes<L>, s: &mut Lanes<L>, c: &mut Lanes<L>) {
         for l in 0..L {
             if self.fresh[l] == PHASE_RESYNC as f64 {
-                (s.0[l], c.0[l]) = d.exact_phase(shaft.0[l]);
+                (s.0[l], c.0[l]) = d.exact_phase(l, shaft.0[l]);
             }
         }
     }
@@ -248,7 +263,7 @@ impl<const L: usize> LaneState<L> {
     /// exact derivative, so the mesh energy stays consistent), or the exact rotation
     /// for a lane that moved |N·Δθ| ≥ 0.01 within the step (out of line).
     #[inline(always)]
-    fn fluctuation_later(&self, d: &Drive, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
+    fn fluctuation_later(&self, d: &LaneDrive<L>, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
         let dx = shaft - Lanes(self.shaft);
         let t = self.taylor.map(Lanes);
         let mut e = t[0] + dx * (t[1] + dx * (t[2] + dx * t[3]));
@@ -261,11 +276,17 @@ impl<const L: usize> LaneState<L> {
 
     #[cold]
     #[inline(never)]
-    fn far_fluctuation(&self, d: &Drive, shaft: Lanes<L>, e: &mut Lanes<L>, ep: &mut Lanes<L>) {
+    fn far_fluctuation(
+        &self,
+        d: &LaneDrive<L>,
+        shaft: Lanes<L>,
+        e: &mut Lanes<L>,
+        ep: &mut Lanes<L>,
+    ) {
         for l in 0..L {
-            if far(d.n * (shaft.0[l] - self.shaft[l])) {
+            if far(d.n.0[l] * (shaft.0[l] - self.shaft[l])) {
                 (e.0[l], ep.0[l]) =
-                    d.fluctuation_near(shaft.0[l], self.shaft[l], (self.sin[l], self.cos[l]));
+                    d.fluctuation_near(l, shaft.0[l], self.shaft[l], (self.sin[l], self.cos[l]));
             }
         }
     }
@@ -274,7 +295,7 @@ impl<const L: usize> LaneState<L> {
     /// `fluctuation_near`, lane-wise; the library `sin_cos` out of line for lanes
     /// with |N·Δθ| ≥ 0.01).
     #[inline(always)]
-    fn fluctuation_near(&self, d: &Drive, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
+    fn fluctuation_near(&self, d: &LaneDrive<L>, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
         let x = d.n * (shaft - Lanes(self.shaft));
         let mut sx = x.map(|x| taylor_sin_cos(x).0);
         let mut cx = x.map(|x| taylor_sin_cos(x).1);
@@ -328,13 +349,13 @@ impl<const L: usize> Kernel<L> {
     ///
     /// `motor[s][l]` is lane `l`'s motor torque at the step's start (`s = 0`), middle
     /// (`s = 1`) and end (`s = 2`); `load[l]` the external table torque, held over the
-    /// step, **including** the drive's constant `Tload` ([`Drive::tload`]: the
+    /// step, **including** the drive's constant `Tload` ([`Drive::tload`](crate::model::Drive::tload): the
     /// simulations add it to their loads, so the kernel never spends an addition on
     /// it).
     #[inline]
     pub fn step(
         &mut self,
-        d: &Drive,
+        d: &LaneDrive<L>,
         y: &mut States<L>,
         motor: &[[f64; L]; 3],
         load: &[f64; L],
@@ -348,14 +369,14 @@ impl<const L: usize> Kernel<L> {
     }
 
     /// [`Kernel::step`] with a friction law of the caller's in place of the drive's
-    /// own ([`Drive::friction_law`]): a law under development runs through the same
+    /// own ([`Drive::friction_law`](crate::model::Drive::friction_law)): a law under development runs through the same
     /// clamp, integrator and events before it has its
     /// [`DriveFriction`](super::friction::DriveFriction) variant
     /// (`model/friction/tests.rs` runs one). `step` is this with the drive's law.
     pub fn step_with_law<F: FrictionLaw>(
         &mut self,
-        d: &Drive,
-        law: &F,
+        d: &LaneDrive<L>,
+        law: &LaneLaw<F, L>,
         y: &mut States<L>,
         motor: &[[f64; L]; 3],
         load: &[f64; L],
@@ -378,13 +399,13 @@ impl<const L: usize> Kernel<L> {
     #[inline]
     pub(crate) fn step_meshed(
         &mut self,
-        d: &Drive,
+        d: &LaneDrive<L>,
         y: &mut States<L>,
         motor: &[[f64; L]; 3],
         load: &[f64; L],
         h: f64,
     ) {
-        with_law!(&d.friction, law => if d.spur {
+        with_lane_law!(&d.friction, law => if d.spur {
             self.step_with_events::<true, _>(d, law, y, motor, load, h)
         } else {
             self.step_with_events::<false, _>(d, law, y, motor, load, h)
@@ -395,13 +416,13 @@ impl<const L: usize> Kernel<L> {
     #[inline]
     pub(crate) fn step_rigid(
         &mut self,
-        d: &Drive,
+        d: &LaneDrive<L>,
         y: &mut States<L>,
         motor: &[[f64; L]; 3],
         load: &[f64; L],
         h: f64,
     ) {
-        with_law!(&d.friction, law => rigid_rk4(d, law, &mut self.lanes, y, motor, load, h));
+        with_lane_law!(&d.friction, law => rigid_rk4(d, law, &mut self.lanes, y, motor, load, h));
     }
 
     /// Whether motor, shaft and table of lane `l` were stuck during the last step.
@@ -422,8 +443,8 @@ impl<const L: usize> Kernel<L> {
     #[inline(always)]
     fn step_with_events<const SPUR: bool, F: FrictionLaw>(
         &mut self,
-        d: &Drive,
-        law: &F,
+        d: &LaneDrive<L>,
+        law: &LaneLaw<F, L>,
         y: &mut States<L>,
         motor: &[[f64; L]; 3],
         load: &[f64; L],
@@ -440,7 +461,7 @@ impl<const L: usize> Kernel<L> {
             load,
             Lanes::splat(h),
         );
-        let gaps = [SPUR && d.bg > 0.0, d.bw > 0.0];
+        let gaps = [SPUR && d.gapped[0], d.gapped[1]];
         if !(gaps[0] || gaps[1]) {
             return;
         }
@@ -482,8 +503,8 @@ impl<const L: usize> Kernel<L> {
     #[allow(clippy::too_many_arguments)]
     fn resolve_events<const SPUR: bool, F: FrictionLaw>(
         &mut self,
-        d: &Drive,
-        law: &F,
+        d: &LaneDrive<L>,
+        law: &LaneLaw<F, L>,
         y0: &States<L>,
         y: &mut States<L>,
         motor: &[[f64; L]; 3],
@@ -492,11 +513,10 @@ impl<const L: usize> Kernel<L> {
         twist: &[Lanes<L>; 2],
         rate: &[Lanes<L>; 2],
     ) {
-        let gaps = [if SPUR { d.bg } else { 0.0 }, d.bw];
         for l in 0..L {
+            let gaps = [if SPUR { d.bg.0[l] } else { 0.0 }, d.bw.0[l]];
             let mut earliest: Option<f64> = None;
-            for mesh in 0..2 {
-                let b = gaps[mesh];
+            for (mesh, &b) in gaps.iter().enumerate() {
                 if b > 0.0 {
                     let start = (self.lanes.twist[mesh][l], self.lanes.rate[mesh][l]);
                     let end = (twist[mesh].0[l], rate[mesh].0[l]);
@@ -517,8 +537,8 @@ impl<const L: usize> Kernel<L> {
     #[allow(clippy::too_many_arguments)]
     fn split_lane<const SPUR: bool, F: FrictionLaw>(
         &mut self,
-        d: &Drive,
-        law: &F,
+        d: &LaneDrive<L>,
+        law: &LaneLaw<F, L>,
         y0: &States<L>,
         y: &mut States<L>,
         motor: &[[f64; L]; 3],
@@ -538,6 +558,7 @@ impl<const L: usize> Kernel<L> {
         let m2 = [s, 0.5 * (1.0 + s), 1.0].map(|at| [quadratic(&m, at)]);
         let load = [load[l]];
         let mut mid = part;
+        let (d, law) = (&d.lane(l), &law.lane(l));
         rk4::<1, SPUR, F>(
             d,
             law,
@@ -578,10 +599,13 @@ fn region(twist: f64, b: f64) -> f64 {
 
 /// Whether any lane's twist changed region between `start` and `end`.
 #[inline(always)]
-fn region_changed<const L: usize>(start: Lanes<L>, end: Lanes<L>, b: f64) -> bool {
-    start
-        .zip(end, |t0, t1| region(t0, b) - region(t1, b))
-        .any(|d| d != 0.0)
+#[allow(clippy::needless_range_loop)]
+fn region_changed<const L: usize>(start: Lanes<L>, end: Lanes<L>, b: Lanes<L>) -> bool {
+    let mut change = start.0;
+    for l in 0..L {
+        change[l] = region(start.0[l], b.0[l]) - region(end.0[l], b.0[l]);
+    }
+    Lanes(change).any(|d| d != 0.0)
 }
 
 /// The fraction of a step of length `h` at which a mesh's twist, going from
@@ -630,13 +654,6 @@ fn quadratic(m: &[f64; 3], s: f64) -> f64 {
     a + s * (-3.0 * a + 4.0 * b - c) + s * s * (2.0 * a - 4.0 * b + 2.0 * c)
 }
 
-/// Tu = −m·g·e·sin(θt + ψ). Out of line on purpose: inlined, the compiler may
-/// evaluate the `sin` for every stage and discard it when there is no unbalance.
-#[inline(never)]
-fn unbalance_torque(d: &Drive, table_angle: f64) -> f64 {
-    -d.mge * (table_angle + d.psi).sin()
-}
-
 /// One classical RK4 step of the single rigid body of `direct_drive` (motor rotor and
 /// table, slots θt, ωt; motor and shaft slots mirror them):
 ///
@@ -653,8 +670,8 @@ fn unbalance_torque(d: &Drive, table_angle: f64) -> f64 {
 /// lanes equal lone runs.
 #[inline(never)]
 fn rigid_rk4<const L: usize, F: FrictionLaw>(
-    d: &Drive,
-    law: &F,
+    d: &LaneDrive<L>,
+    laws: &LaneLaw<F, L>,
     st: &mut LaneState<L>,
     y: &mut States<L>,
     motor: &[[f64; L]; 3],
@@ -662,12 +679,13 @@ fn rigid_rk4<const L: usize, F: FrictionLaw>(
     h: f64,
 ) {
     for l in 0..L {
+        let (law, ct, inv_jt) = (laws.law(l), d.ct.0[l], d.inv_jt.0[l]);
         let (t1, w1) = (y[THETA_T][l], y[OMEGA_T][l]);
         let m = [motor[0][l], motor[1][l], motor[2][l]];
-        let torque = |t: f64, w: f64, m: f64| m - d.ct * w + rigid_unbalance(d, t) + load[l];
+        let torque = |t: f64, w: f64, m: f64| m - ct * w + rigid_unbalance(d, l, t) + load[l];
         let first = torque(t1, w1, m[0]);
         let friction = RigidFriction::decide(law, first, w1);
-        let accel = |t: f64, w: f64| friction.net(t, w) * d.inv_jt;
+        let accel = |t: f64, w: f64| friction.net(t, w) * inv_jt;
         let a1 = accel(first, w1);
         let (t2, w2) = (t1 + 0.5 * h * w1, w1 + 0.5 * h * a1);
         let a2 = accel(torque(t2, w2, m[1]), w2);
@@ -709,7 +727,7 @@ impl<'a, F: FrictionLaw> RigidFriction<'a, F> {
             (f.torque, f.free)
         } else {
             let (direction, free) =
-                decide_direction_lanes(Lanes([t]), Lanes([w]), law.breakaway(2));
+                decide_direction_lanes(Lanes([t]), Lanes([w]), Lanes([law.breakaway(2)]));
             (direction.0[0], free.0[0])
         };
         RigidFriction {
@@ -741,9 +759,9 @@ impl<'a, F: FrictionLaw> RigidFriction<'a, F> {
 
 /// Tu = −m·g·e·sin(θt + ψ) on the rigid body (0 without unbalance).
 #[inline(always)]
-fn rigid_unbalance(d: &Drive, table_angle: f64) -> f64 {
+fn rigid_unbalance<const L: usize>(d: &LaneDrive<L>, l: usize, table_angle: f64) -> f64 {
     if d.unbalance {
-        unbalance_torque(d, table_angle)
+        d.unbalance_torque(l, table_angle)
     } else {
         0.0
     }
@@ -765,8 +783,8 @@ fn axpy<const L: usize>(y: &States<L>, a: Lanes<L>, k: &States<L>) -> States<L> 
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn rk4<const L: usize, const SPUR: bool, F: FrictionLaw>(
-    d: &Drive,
-    law: &F,
+    d: &LaneDrive<L>,
+    law: &LaneLaw<F, L>,
     st: &mut LaneState<L>,
     y0: &States<L>,
     y: &mut States<L>,
@@ -805,8 +823,8 @@ fn rk4<const L: usize, const SPUR: bool, F: FrictionLaw>(
 /// `y`, and the step-start values are stored in `st` for the later stages.
 #[inline(always)]
 fn derivative<const L: usize, const SPUR: bool, const FIRST: bool, F: FrictionLaw>(
-    d: &Drive,
-    law: &F,
+    d: &LaneDrive<L>,
+    law: &LaneLaw<F, L>,
     y: &States<L>,
     motor: Lanes<L>,
     load: Lanes<L>,
@@ -830,10 +848,10 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool, F: FrictionLa
     let lever = d.rw + ep;
     let dw = d.rw * shaft + e + xw * d.inv_r - tt;
     let dw_rate = lever * ws + vw * d.inv_r - wt;
-    let tw = mesh_torque_lanes(d.kw, d.ciw, d.bw, dw, dw_rate);
+    let tw = mesh_torque_lanes((d.kw, d.ciw, d.bw), d.gapped[1], dw, dw_rate);
 
     let unbalance = if d.unbalance {
-        tt.map(|t| unbalance_torque(d, t))
+        Lanes(std::array::from_fn(|l| d.unbalance_torque(l, tt.0[l])))
     } else {
         zero
     };
@@ -852,7 +870,7 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool, F: FrictionLa
             st.twist[0] = dg.0;
             st.rate[0] = dg_rate.0;
         }
-        let tg = mesh_torque_lanes(d.kg, d.cig, d.bg, dg, dg_rate);
+        let tg = mesh_torque_lanes((d.kg, d.cig, d.bg), d.gapped[0], dg, dg_rate);
         let m = motor - d.cm * wm - d.rg * tg;
         let s = tg - d.cw * ws - lever * tw;
         if FIRST {

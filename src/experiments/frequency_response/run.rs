@@ -178,7 +178,7 @@ impl Run {
                 motor: Vec::with_capacity(capacity),
                 table: Vec::with_capacity(capacity),
                 open: [0, 0],
-                drive: *sim.drive(),
+                drive: *sim.drive(l),
             },
             remaining: 0,
             previous: None,

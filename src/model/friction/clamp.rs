@@ -89,16 +89,17 @@ fn decided_free(t: f64, w: f64, fc: f64) -> f64 {
     }
 }
 
-/// [`Friction::decide`] for each lane: (friction torques, free flags).
+/// [`Friction::decide`] for each lane, with each lane's level `fc`: (friction
+/// torques, free flags).
 #[inline(always)]
 pub(crate) fn decide_lanes<const L: usize>(
     t: Lanes<L>,
     w: Lanes<L>,
-    fc: f64,
+    fc: Lanes<L>,
 ) -> (Lanes<L>, Lanes<L>) {
     (
-        t.zip(w, |t, w| decided_torque(t, w, fc)),
-        t.zip(w, |t, w| decided_free(t, w, fc)),
+        lane_wise(t, w, fc, decided_torque),
+        lane_wise(t, w, fc, decided_free),
     )
 }
 
@@ -108,26 +109,44 @@ pub(crate) fn decide_lanes<const L: usize>(
 pub(crate) fn decide_direction_lanes<const L: usize>(
     t: Lanes<L>,
     w: Lanes<L>,
-    fs: f64,
+    fs: Lanes<L>,
 ) -> (Lanes<L>, Lanes<L>) {
     (
-        t.zip(w, |t, w| decided_direction(t, w, fs)),
-        t.zip(w, |t, w| decided_free(t, w, fs)),
+        lane_wise(t, w, fs, decided_direction),
+        lane_wise(t, w, fs, decided_free),
     )
 }
 
-/// [`stop_at_reversal`] for each lane.
+/// [`stop_at_reversal`] for each lane, with each lane's level `fc`.
 #[inline(always)]
 pub(crate) fn stop_at_reversal_lanes<const L: usize>(
     w_before: Lanes<L>,
     w_after: Lanes<L>,
-    fc: f64,
+    fc: Lanes<L>,
 ) -> Lanes<L> {
-    if fc > 0.0 {
-        w_before.zip(w_after, |b, a| if b * a < 0.0 { 0.0 } else { a })
-    } else {
-        w_after
+    lane_wise(w_before, w_after, fc, |b, a, fc| {
+        if (fc > 0.0) & (b * a < 0.0) {
+            0.0
+        } else {
+            a
+        }
+    })
+}
+
+/// `f` applied lane by lane to three lanes' values (an indexed loop: it vectorises).
+#[inline(always)]
+#[allow(clippy::needless_range_loop)]
+fn lane_wise<const L: usize>(
+    a: Lanes<L>,
+    b: Lanes<L>,
+    c: Lanes<L>,
+    f: impl Fn(f64, f64, f64) -> f64,
+) -> Lanes<L> {
+    let mut out = a.0;
+    for l in 0..L {
+        out[l] = f(out[l], b.0[l], c.0[l]);
     }
+    Lanes(out)
 }
 
 /// After a step: a sliding body (with friction) whose velocity changed sign is put
@@ -170,11 +189,11 @@ mod tests {
 
     #[test]
     fn a_stribeck_body_breaks_away_at_the_static_level() {
-        let held = decide_direction_lanes(Lanes([2.9]), Lanes([0.0]), 3.0);
+        let held = decide_direction_lanes(Lanes([2.9]), Lanes([0.0]), Lanes([3.0]));
         assert_eq!((held.0 .0, held.1 .0), ([0.0], [0.0]));
-        let breaks = decide_direction_lanes(Lanes([-3.1]), Lanes([0.0]), 3.0);
+        let breaks = decide_direction_lanes(Lanes([-3.1]), Lanes([0.0]), Lanes([3.0]));
         assert_eq!((breaks.0 .0, breaks.1 .0), ([-1.0], [1.0]));
-        let slides = decide_direction_lanes(Lanes([5.0]), Lanes([-1e-9]), 3.0);
+        let slides = decide_direction_lanes(Lanes([5.0]), Lanes([-1e-9]), Lanes([3.0]));
         assert_eq!((slides.0 .0, slides.1 .0), ([-1.0], [1.0]));
     }
 

@@ -16,7 +16,9 @@
 //!
 //! **Adding a law**: one file here with its struct (compiled from [`Params`]) and its
 //! [`FrictionLaw`] impl, a [`DriveFriction`] variant with its arm in
-//! [`with_law`] and in [`DriveFriction::of`] below; its parameters in the registry
+//! [`with_law`], [`DriveFriction::of`] and [`DriveFriction::kind`] below, and the same
+//! variant in lanes ([`lanes::LaneFriction`], its `gather`, `lane` and
+//! `with_lane_law`); its parameters in the registry
 //! (`model/registry.rs`). The kernel, the simulation and every test on the model then
 //! run it unchanged (docs/architecture.md).
 //!
@@ -24,6 +26,7 @@
 
 pub(crate) mod clamp;
 mod coulomb;
+pub mod lanes;
 mod steady;
 mod stribeck;
 #[cfg(test)]
@@ -63,7 +66,6 @@ macro_rules! with_law {
         }
     };
 }
-pub(crate) use with_law;
 
 /// The friction law of a drive's bodies, compiled from its parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,6 +82,15 @@ impl DriveFriction {
         match Stribeck::of(p, fc) {
             Some(law) => DriveFriction::Stribeck(law),
             None => DriveFriction::Coulomb(Coulomb::new(fc)),
+        }
+    }
+
+    /// Which law this is (its variant's index): lanes of one batch share it
+    /// ([`lanes::LaneFriction`]).
+    pub(crate) fn kind(&self) -> u8 {
+        match self {
+            DriveFriction::Coulomb(_) => 0,
+            DriveFriction::Stribeck(_) => 1,
         }
     }
 

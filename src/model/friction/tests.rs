@@ -3,9 +3,10 @@
 //! [`Kernel::step_with_law`] on a rigid and a meshed drive; and the drive's own laws
 //! run through the same entry give bit for bit what [`Kernel::step`] gives.
 
+use super::lanes::LaneLaw;
 use super::{Coulomb, DriveFriction, FrictionLaw};
 use crate::model::drive::idx::*;
-use crate::model::{presets, Drive, Kernel, Params, NSTATE};
+use crate::model::{presets, Drive, Kernel, LaneDrive, Params, NSTATE};
 
 /// Viscous friction that starts only beyond a speed `band`: c·(|ω| − band) above it,
 /// nothing below; nothing to break away from.
@@ -37,11 +38,12 @@ fn frictionless_table() -> Params {
 /// The table's speed after `seconds` of a constant motor torque under `law`.
 fn speed_after<F: FrictionLaw>(p: &Params, law: &F, torque: f64, seconds: f64) -> f64 {
     let d = Drive::new(p).unwrap();
+    let (lane, law) = (LaneDrive::splat(&d), LaneLaw::splat(*law));
     let mut kernel = Kernel::<1>::default();
     let mut y = [[0.0; 1]; NSTATE];
     let h = 1e-4;
     for _ in 0..(seconds / h).round() as usize {
-        kernel.step_with_law(&d, law, &mut y, &[[torque]; 3], &[d.tload()], h);
+        kernel.step_with_law(&lane, &law, &mut y, &[[torque]; 3], &[d.tload()], h);
     }
     y[OMEGA_T][0]
 }
@@ -74,6 +76,7 @@ fn inside_its_band_the_law_leaves_the_body_free() {
 /// under a sine of the motor torque, through `step` or `step_with_law`.
 fn worm_run(p: &Params, own: bool) -> Vec<[f64; NSTATE]> {
     let d = Drive::new(p).unwrap();
+    let lane = LaneDrive::splat(&d);
     let mut kernel = Kernel::<1>::default();
     let mut y = [[0.0; 1]; NSTATE];
     let h = 1e-5;
@@ -83,14 +86,15 @@ fn worm_run(p: &Params, own: bool) -> Vec<[f64; NSTATE]> {
             let m = [0.0, 0.5, 1.0]
                 .map(|s| [5.0 * (2.0 * 3.0 * std::f64::consts::PI * 37.0 * (t + s * h)).sin()]);
             if own {
-                kernel.step(&d, &mut y, &m, &[d.tload()], h);
+                kernel.step(&lane, &mut y, &m, &[d.tload()], h);
             } else {
-                match d.friction_law() {
+                let load = &[d.tload()];
+                match *d.friction_law() {
                     DriveFriction::Coulomb(law) => {
-                        kernel.step_with_law(&d, law, &mut y, &m, &[d.tload()], h)
+                        kernel.step_with_law(&lane, &LaneLaw::splat(law), &mut y, &m, load, h)
                     }
                     DriveFriction::Stribeck(law) => {
-                        kernel.step_with_law(&d, law, &mut y, &m, &[d.tload()], h)
+                        kernel.step_with_law(&lane, &LaneLaw::splat(law), &mut y, &m, load, h)
                     }
                 }
             }
