@@ -9,6 +9,10 @@
 //! a temporary folder.
 //! `sweep/point/nonlinear_short`: one point of reversal, repeatability, accuracy,
 //! fluctuation_pp and torque_rms with the short tests.
+//! `sweep/reversal/{lone,batch}_4_points`: the `reversal` output (the short
+//! positioning test, closed loop) at 4 design points (Kw ±20 %), evaluated one by one
+//! and as one batch in the kernel's lanes: the batch's time per point against a lone
+//! point's is issue 38's measure.
 //! `sweep/design/sobol_4096x3`: the Saltelli design of 4096 base rows, 3 factors
 //! (20 480 points) built into its matrices.
 //! `sweep/ishigami_indices`: Sobol S1/ST with 100 bootstrap resamples from
@@ -83,6 +87,7 @@ fn benches(c: &mut Criterion) {
     group.bench_function("point/nonlinear_short", |b| {
         b.iter(|| nonlinear.evaluate(&p).unwrap())
     });
+    reversal(&mut group);
     let factors: Vec<Factor> = (0..3)
         .map(|i| {
             let pi = std::f64::consts::PI;
@@ -107,6 +112,33 @@ fn benches(c: &mut Criterion) {
         b.iter(|| sobol::indices(&y, 3, 4096, 100, 0.95, 0).unwrap())
     });
     group.finish();
+}
+
+/// `reversal` at 4 design points, lone and batched.
+fn reversal(group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>) {
+    let base = presets::load("worm-gear").unwrap();
+    let points: Vec<_> = [0.8, 0.93, 1.07, 1.2]
+        .iter()
+        .map(|f| {
+            let mut p = base.clone();
+            p.kw *= f;
+            p
+        })
+        .collect();
+    let reversal = sweep::Evaluator {
+        outputs: vec![Output::Reversal],
+        tests: TestLength::Short,
+        topology: base.topology,
+    };
+    group.bench_function("reversal/lone_4_points", |b| {
+        b.iter(|| {
+            let rows: Vec<_> = points.iter().map(|p| reversal.evaluate(p)).collect();
+            rows
+        })
+    });
+    group.bench_function("reversal/batch_4_points", |b| {
+        b.iter(|| reversal.evaluate_batch(&points))
+    });
 }
 
 criterion_group!(sweeps, benches);

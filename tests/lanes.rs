@@ -6,10 +6,12 @@
 //! `simulate_point`.
 
 use rtid::experiments::frequency_response::{simulate_point, sweep, FrequencyTest};
+use rtid::experiments::positioning;
 use rtid::input::{Sine, TorqueInput};
 use rtid::model::{idx::*, presets, Params, NSTATE};
 use rtid::recorder::Recorder;
 use rtid::sim::{LaneSimulation, Simulation};
+use rtid::sweep::TestLength;
 
 const DT: f64 = 1e-5;
 
@@ -350,4 +352,33 @@ fn parameter_sets_of_different_shapes_are_refused_with_the_lane() {
     params[5].theta_bw = 0.0;
     let err = LaneSimulation::<8>::of(&params, DT).unwrap_err();
     assert!(err.to_string().contains("lane 5"), "{err}");
+}
+
+#[test]
+fn a_batch_of_positioning_tests_equals_its_lone_runs() {
+    // Eight sets: stiffness, gains, friction, encoder and loop mode vary; one set has
+    // no drive-mesh gap (another shape: it runs in a group of its own), one set's
+    // servo is unstable (it diverges alone, the others go on).
+    let test = TestLength::Short.positioning();
+    let sets: Vec<Params> = (0..8)
+        .map(|l| {
+            let mut p = varied_worm(l % 4);
+            p.controller.kvp *= 1.0 + 0.1 * l as f64;
+            if l == 2 {
+                p.theta_bw = 0.0;
+            }
+            if l == 5 {
+                p.controller.kvp *= 1e4;
+                p.controller.torque_limit = 1e12;
+            }
+            p
+        })
+        .collect();
+    let batch = positioning::run_batch(&sets, &test);
+    for (l, (p, got)) in sets.iter().zip(&batch).enumerate() {
+        let alone = positioning::run(p, &test, |_, _| {});
+        assert_eq!(got, &alone, "set {l}");
+    }
+    assert!(batch[5].is_err(), "the unstable servo diverges");
+    assert!(batch.iter().filter(|r| r.is_ok()).count() == 7);
 }

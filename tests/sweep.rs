@@ -459,3 +459,54 @@ fn the_command_line_shards_merges_and_plots() {
     let out = rtid(&[&common[..], &["--out", "all.csv"]].concat(), dir.path());
     assert!(String::from_utf8(out.stderr).unwrap().contains("--resume"));
 }
+
+#[test]
+fn a_sweep_of_the_positioning_test_in_lanes_gives_each_point_its_lone_outputs() {
+    // Points of two shapes (with and without the drive mesh's gap) and three
+    // stiffnesses: batched in lanes by shape and step, each row must be the point's
+    // own evaluation.
+    let p = presets::load("worm-gear").unwrap();
+    let factors = vec![
+        Factor::new("Kw", 0.8 * p.kw, 1.2 * p.kw, Scale::Lin, 3).unwrap(),
+        Factor::new("theta_bw", 0.0, p.theta_bw, Scale::Lin, 2).unwrap(),
+    ];
+    let outputs = vec![Output::Reversal, Output::Repeatability];
+    let s = Sweep::new(
+        p.clone(),
+        factors,
+        Method::Grid,
+        outputs.clone(),
+        TestLength::Short,
+        0,
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("grid.csv");
+    let r = sweep::run(&s, &out, &RunOptions::default()).unwrap();
+    assert_eq!((r.total, r.failed), (6, 0));
+    let evaluator = sweep::Evaluator {
+        outputs,
+        tests: TestLength::Short,
+        topology: p.topology,
+    };
+    let text = std::fs::read_to_string(&out).unwrap();
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .collect();
+    assert_eq!(rows.len(), 6);
+    for row in rows {
+        let fields: Vec<&str> = row.split(',').collect();
+        let mut q = p.clone();
+        q.set("Kw", fields[1].parse().unwrap()).unwrap();
+        q.set("theta_bw", fields[2].parse().unwrap()).unwrap();
+        let alone: Vec<String> = evaluator
+            .evaluate(&q)
+            .unwrap()
+            .iter()
+            .map(|v| v.unwrap().to_string())
+            .collect();
+        assert_eq!(fields[3..5], alone[..], "row {row}");
+    }
+}

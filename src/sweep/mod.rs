@@ -201,32 +201,66 @@ impl Sweep {
         Ok(p)
     }
 
-    /// The row of design point `index` (fields as written to the file).
-    pub fn row(&self, design: &Design, evaluator: &Evaluator, index: usize) -> Vec<String> {
-        let values = design.values.row(index).to_vec();
+    /// The rows of design points `indices` (fields as written to the file), their
+    /// nonlinear tests run together in the kernel's lanes where the points allow
+    /// ([`Evaluator::evaluate_batch`]); each row is what the point gives alone.
+    pub fn rows(
+        &self,
+        design: &Design,
+        evaluator: &Evaluator,
+        indices: &[usize],
+    ) -> Vec<Vec<String>> {
+        let values: Vec<Vec<f64>> = indices
+            .iter()
+            .map(|&i| design.values.row(i).to_vec())
+            .collect();
+        let sets: Vec<_> = values.iter().map(|v| self.params_at(v)).collect();
+        let valid: Vec<Params> = sets
+            .iter()
+            .filter_map(|p| p.as_ref().ok().cloned())
+            .collect();
+        let mut outputs = evaluator.evaluate_batch(&valid).into_iter();
         let n_out = evaluator.columns().len();
-        let result = self
-            .params_at(&values)
-            .map_err(outputs::OutputError::from)
-            .and_then(|p| evaluator.evaluate(&p));
-        let mut row = Vec::with_capacity(2 + values.len() + n_out);
-        row.push(index.to_string());
-        row.extend(values.iter().map(|v| v.to_string()));
-        match result {
-            Ok(out) => {
-                row.extend(
-                    out.iter()
-                        .map(|v| v.map_or(String::new(), |v| v.to_string())),
-                );
-                row.push(String::new());
-            }
-            Err(e) => {
-                row.extend(std::iter::repeat(String::new()).take(n_out));
-                row.push(e.to_string());
-            }
-        }
-        row
+        indices
+            .iter()
+            .zip(values)
+            .zip(sets)
+            .map(|((&index, values), set)| {
+                let result = match set {
+                    Ok(_) => outputs.next().expect("one result per valid set"),
+                    Err(e) => Err(outputs::OutputError::from(e)),
+                };
+                row(index, &values, n_out, result)
+            })
+            .collect()
     }
+}
+
+/// The fields of design point `index` at `values` with its outputs (`n_out`
+/// columns) or the reason they are missing.
+fn row(
+    index: usize,
+    values: &[f64],
+    n_out: usize,
+    result: Result<Vec<Option<f64>>, outputs::OutputError>,
+) -> Vec<String> {
+    let mut row = Vec::with_capacity(2 + values.len() + n_out);
+    row.push(index.to_string());
+    row.extend(values.iter().map(|v| v.to_string()));
+    match result {
+        Ok(out) => {
+            row.extend(
+                out.iter()
+                    .map(|v| v.map_or(String::new(), |v| v.to_string())),
+            );
+            row.push(String::new());
+        }
+        Err(e) => {
+            row.extend(std::iter::repeat(String::new()).take(n_out));
+            row.push(e.to_string());
+        }
+    }
+    row
 }
 
 /// How [`run`] proceeds.
@@ -297,15 +331,22 @@ pub fn run(sweep: &Sweep, out: &Path, opts: &RunOptions) -> Result<RunReport, Sw
     }
     let journal = Mutex::new(journal);
     let rows = Mutex::new(done);
-    todo.par_iter()
-        .try_for_each(|&i| -> Result<(), StreamError> {
-            let row = sweep.row(&design, &evaluator, i);
-            journal
-                .lock()
-                .expect("no panic holds the lock")
-                .append(&row)?;
-            rows.lock().expect("no panic holds the lock").insert(i, row);
-            (opts.on_row)();
+    // Points in batches of up to LANES per task (the kernel's lanes), fewer when
+    // that leaves a worker idle.
+    let per_task = todo
+        .len()
+        .div_ceil(rayon::current_num_threads())
+        .clamp(1, crate::sim::LANES);
+    todo.par_chunks(per_task)
+        .try_for_each(|chunk| -> Result<(), StreamError> {
+            for (&i, row) in chunk.iter().zip(sweep.rows(&design, &evaluator, chunk)) {
+                journal
+                    .lock()
+                    .expect("no panic holds the lock")
+                    .append(&row)?;
+                rows.lock().expect("no panic holds the lock").insert(i, row);
+                (opts.on_row)();
+            }
             Ok(())
         })?;
     drop(journal);

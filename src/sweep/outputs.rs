@@ -229,6 +229,41 @@ impl Evaluator {
 
     /// The outputs at `p`, one value per column (`None`: no such peak).
     pub fn evaluate(&self, p: &Params) -> Result<Vec<Option<f64>>, OutputError> {
+        self.evaluate_with(p, None)
+    }
+
+    /// The outputs at each of `points`, in order, each what [`Evaluator::evaluate`]
+    /// gives for it: the positioning tests of all the points run together in the
+    /// kernel's lanes (`positioning::run_batch`), the other outputs point by point.
+    pub fn evaluate_batch(&self, points: &[Params]) -> Vec<Result<Vec<Option<f64>>, OutputError>> {
+        let positioning = self.outputs.iter().any(|o| {
+            matches!(
+                o,
+                Output::Reversal | Output::Repeatability | Output::Accuracy
+            )
+        });
+        let mut measured: Vec<Option<_>> = if positioning && points.len() > 1 {
+            positioning::run_batch(points, &self.tests.positioning())
+                .into_iter()
+                .map(Some)
+                .collect()
+        } else {
+            points.iter().map(|_| None).collect()
+        };
+        points
+            .iter()
+            .zip(&mut measured)
+            .map(|(p, m)| self.evaluate_with(p, m.take()))
+            .collect()
+    }
+
+    /// [`Evaluator::evaluate`], with the positioning test's readings at `p` when
+    /// they were measured already (`measured`).
+    fn evaluate_with(
+        &self,
+        p: &Params,
+        mut measured: Option<Result<Vec<iso230::Measurement>, SimError>>,
+    ) -> Result<Vec<Option<f64>>, OutputError> {
         p.validate()?;
         let mut out = Vec::new();
         let mut peaks: Option<Vec<Peak>> = None;
@@ -253,7 +288,10 @@ impl Evaluator {
                 }
                 Output::Reversal | Output::Repeatability | Output::Accuracy => {
                     if iso.is_none() {
-                        let m = positioning::run(p, &self.tests.positioning(), |_, _| {})?;
+                        let m = match measured.take() {
+                            Some(m) => m?,
+                            None => positioning::run(p, &self.tests.positioning(), |_, _| {})?,
+                        };
                         iso = Some(iso230::evaluate(&m)?.axis.in_arcsec());
                     }
                     let a = iso.expect("computed above");

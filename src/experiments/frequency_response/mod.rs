@@ -46,7 +46,7 @@ use crate::model::Params;
 use crate::sim::SimError;
 
 /// Frequencies advanced together by one worker (two AVX2 registers per state).
-pub const LANES: usize = 4;
+pub const LANES: usize = crate::sim::LANES;
 
 /// Conditions of the test (defaults: docs/experiments.md (frequency response)).
 #[derive(Clone, Debug, PartialEq)]

@@ -14,14 +14,13 @@ pub mod iso230;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
-use crate::controller::{quantise, Compensation};
+use crate::controller::{quantise, Compensation, Controller};
 use crate::input::Move;
 use crate::io::experiment_file::{Approaches, Data, Kind, Manifest};
 use crate::model::idx::THETA_T;
 use crate::model::params::{Axis, LoopMode, Params};
 use crate::model::rest::{rest_state, Preload};
-use crate::recorder::NullRecorder;
-use crate::sim::{SimError, Simulation};
+use crate::sim::{LaneSimulation, SimError};
 use iso230::{Direction, Measurement, ARCSEC_PER_RAD};
 
 /// Conditions of the test (defaults: docs/experiments.md (positioning)).
@@ -121,27 +120,59 @@ impl PositioningTest {
 pub fn run(
     params: &Params,
     test: &PositioningTest,
-    mut progress: impl FnMut(usize, usize),
+    progress: impl FnMut(usize, usize),
 ) -> Result<Vec<Measurement>, SimError> {
+    let [one] = run_lanes(&[test_params(params, test)], test, progress)?;
+    one
+}
+
+/// [`run`] for each of `params`, in order, in the kernel's lanes where the sets can
+/// share them (`sim::batch`): each result is what `run` gives for its set alone.
+pub fn run_batch(
+    params: &[Params],
+    test: &PositioningTest,
+) -> Vec<Result<Vec<Measurement>, SimError>> {
+    let sets: Vec<Params> = params.iter().map(|p| test_params(p, test)).collect();
+    crate::sim::batch::in_lanes(
+        &sets,
+        |p| run(p, test, |_, _| {}),
+        |lanes| run_lanes(lanes, test, |_, _| {}),
+    )
+}
+
+/// `params` with the test's feedback arrangement.
+fn test_params(params: &Params, test: &PositioningTest) -> Params {
     let mut p = params.clone();
     p.controller.loop_mode = test.loop_mode;
-    let resolution = p.controller.table_encoder_resolution;
-    let mut sim = Simulation::with_default_step(&p)?;
+    p
+}
+
+/// The cycle on `L` parameter sets at once (already [`test_params`]), lane by lane
+/// as a lone run computes it: one result per set (a set that diverges fails alone).
+/// `progress` counts the readings of the cycle.
+fn run_lanes<const L: usize>(
+    params: &[Params; L],
+    test: &PositioningTest,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<[Result<Vec<Measurement>, SimError>; L], SimError> {
+    let mut sim = LaneSimulation::<L>::of(params, crate::sim::common_step(params)?)?;
     let stops = test.cycle();
-    // Start at rest at the first stop, controller aligned with it.
-    let start = stops[0].0;
-    sim.set_state(rest_state(&p, start, Preload::None));
-    let mut controller = sim.controller(&p)?;
-    controller.set_compensation(test.compensation.clone());
-    // Invariant: Normal refuses only a non-finite σ; `noise` is finite (its field's
-    // contract; the command line checks it).
-    let noise = Normal::new(0.0, test.noise.max(0.0)).expect("a finite σ");
-    let mut rng = rand::rngs::StdRng::seed_from_u64(test.seed);
-    let total = test.readings();
-    let mut out = Vec::with_capacity(total);
+    // Start at rest at the first stop, controllers aligned with it.
+    for (l, p) in params.iter().enumerate() {
+        sim.start(l, rest_state(p, stops[0].0, Preload::None), 0.0);
+    }
+    let mut controllers = Vec::with_capacity(L);
+    for (l, p) in params.iter().enumerate() {
+        let mut c = sim.controller(l, p)?;
+        c.set_compensation(test.compensation.clone());
+        controllers.push(c);
+    }
+    let mut controllers: [Controller; L] = controllers.try_into().expect("one per lane");
+    let mut readings = Readings::<L>::new(params, test);
+    let mut failed: [Option<SimError>; L] = std::array::from_fn(|_| None);
     for w in stops.windows(2) {
         let (from, to) = (w[0].0, w[1].0);
-        let t0 = sim.time();
+        let t0 = sim.time(0);
         let m = Move {
             from,
             to,
@@ -149,19 +180,61 @@ pub fn run(
         };
         let duration = (to - from).abs() / test.speed + test.dwell;
         let reference = |t: f64| crate::input::Trajectory::angle(&m, t - t0);
-        sim.run_closed_loop(&mut controller, &reference, duration, &mut NullRecorder)?;
-        if let Some((target, direction, run)) = w[1].1 {
-            let reading = quantise(sim.state()[THETA_T], resolution) + noise.sample(&mut rng);
-            out.push(Measurement {
+        sim.run_closed_loop(&mut controllers, &reference, duration, &mut failed)?;
+        if let Some(at) = w[1].1 {
+            readings.take(at, |l| sim.state(l)[THETA_T]);
+            progress(readings.out[0].len(), test.readings());
+        }
+        if failed.iter().all(Option::is_some) {
+            break;
+        }
+    }
+    let mut out = readings.out.into_iter();
+    Ok(failed.map(|f| {
+        let measurements = out.next().expect("one per lane");
+        f.map_or(Ok(measurements), Err)
+    }))
+}
+
+/// The readings of `L` lanes: each lane's table encoder and noise generator.
+struct Readings<const L: usize> {
+    resolution: [f64; L],
+    noise: Normal<f64>,
+    rng: [rand::rngs::StdRng; L],
+    out: [Vec<Measurement>; L],
+}
+
+impl<const L: usize> Readings<L> {
+    fn new(params: &[Params; L], test: &PositioningTest) -> Self {
+        Readings {
+            resolution: params
+                .each_ref()
+                .map(|p| p.controller.table_encoder_resolution),
+            // Invariant: Normal refuses only a non-finite σ; `noise` is finite (its
+            // field's contract; the command line checks it).
+            noise: Normal::new(0.0, test.noise.max(0.0)).expect("a finite σ"),
+            rng: std::array::from_fn(|_| rand::rngs::StdRng::seed_from_u64(test.seed)),
+            out: std::array::from_fn(|_| Vec::with_capacity(test.readings())),
+        }
+    }
+
+    /// Every lane's reading at `target`, from its table angle `table(l)`.
+    fn take(
+        &mut self,
+        (target, direction, run): (f64, Direction, u32),
+        table: impl Fn(usize) -> f64,
+    ) {
+        for l in 0..L {
+            let reading =
+                quantise(table(l), self.resolution[l]) + self.noise.sample(&mut self.rng[l]);
+            self.out[l].push(Measurement {
                 target,
                 direction,
                 run,
                 deviation: reading - target,
             });
-            progress(out.len(), total);
         }
     }
-    Ok(out)
 }
 
 /// The experiment-file form of a positioning test's readings on `axis` (angles in
@@ -253,4 +326,38 @@ pub fn manifest(params: &Params, test: &PositioningTest) -> Manifest {
         }
     ));
     m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets;
+
+    #[test]
+    fn four_sets_in_lanes_read_what_each_reads_alone() {
+        let test = PositioningTest {
+            targets: vec![0.0, 0.1],
+            runs: 2,
+            dwell: 0.3,
+            noise: 2e-6,
+            ..PositioningTest::default()
+        };
+        let sets: [Params; 4] = std::array::from_fn(|l| {
+            let mut p = presets::load("worm-gear").unwrap();
+            p.kw *= 1.0 - 0.1 * l as f64;
+            p.ft *= 1.0 + 0.5 * l as f64;
+            p.controller.kvp *= 1.0 - 0.1 * l as f64;
+            test_params(&p, &test)
+        });
+        let lanes = run_lanes(&sets, &test, |_, _| {}).unwrap();
+        for (l, p) in sets.iter().enumerate() {
+            let alone = run(p, &test, |_, _| {}).unwrap();
+            assert_eq!(lanes[l].as_ref().unwrap(), &alone, "lane {l}");
+        }
+        assert_ne!(lanes[0], lanes[3], "the sets read differently");
+        let mut stiffer = sets.clone();
+        stiffer[2].kw *= 2.0;
+        let err = run_lanes(&stiffer, &test, |_, _| {}).unwrap_err();
+        assert!(err.to_string().contains("lane 2"), "{err}");
+    }
 }

@@ -11,7 +11,11 @@ use crate::input::{TorqueInput, Trajectory};
 use crate::model::drive::idx::*;
 use crate::model::lanes::Lanes;
 use crate::model::{Drive, Kernel, LaneDrive, LaneMismatch, ParamError, Params, States, NSTATE};
+
+pub mod batch;
+mod lanes;
 use crate::recorder::Recorder;
+pub use lanes::{LaneSimulation, LANES};
 
 /// The RK4 step is chosen so that |λ|·dt ≤ this for the fastest eigenvalue λ of the
 /// linearised model (docs/model.md gives the resulting errors).
@@ -80,6 +84,19 @@ pub fn default_step(params: &Params) -> Result<f64, SimError> {
         .chain(accurate.take_while(|&dt| dt >= 0.1 * largest))
         .find(|&dt| whole_steps(tc, dt).is_some());
     Ok(dividing.unwrap_or_else(|| tc / (tc / largest).ceil()))
+}
+
+/// The [`default_step`] every set of `params` shares; an error names the first set
+/// whose own step differs from the first's (lanes of one batch share their step).
+pub fn common_step(params: &[Params]) -> Result<f64, SimError> {
+    let dt0 = default_step(&params[0])?;
+    for (lane, p) in params.iter().enumerate().skip(1) {
+        let dt = default_step(p)?;
+        if dt != dt0 {
+            return Err(SimError::LaneStep { lane, dt, dt0 });
+        }
+    }
+    Ok(dt0)
 }
 
 /// `Some(n)` if `period` is `n` steps of `dt` (to 1e-9 relative).
@@ -312,115 +329,6 @@ fn diverged<const L: usize>(y: &States<L>) -> Option<usize> {
         bad.0.iter().position(|&b| b != 0.0)
     } else {
         None
-    }
-}
-
-/// `L` independent simulations, advanced together one step at a time (`Kernel<L>`
-/// lanes, so that the compiler vectorises them): of one model
-/// ([`LaneSimulation::new`]), or of `L` parameter sets whose equations have one
-/// shape ([`LaneSimulation::of`]). Each lane has its own state, clock, table load
-/// and motor torque, and can be restarted on its own; lane `l` computes bit for bit
-/// what a [`Simulation`] computes for the same run alone. Every step checks every
-/// lane for divergence; an idle lane (at rest, no torque) stays at rest.
-#[derive(Clone, Debug)]
-pub struct LaneSimulation<const L: usize> {
-    drives: [Drive; L],
-    lanes: LaneDrive<L>,
-    dt: f64,
-    steps: [u64; L],
-    y: States<L>,
-    kernel: Kernel<L>,
-    load: [f64; L],
-}
-
-impl<const L: usize> LaneSimulation<L> {
-    /// `L` tables at rest at zero angles, integrated with step `dt` (checked as by
-    /// [`Simulation::new`]).
-    pub fn new(params: &Params, dt: f64) -> Result<Self, SimError> {
-        Self::with_drives([checked_drive(params, dt)?; L], dt)
-    }
-
-    /// `params[l]` in lane `l`, every lane at rest at zero angles and integrated with
-    /// step `dt` (checked for each as by [`Simulation::new`]). The parameter sets
-    /// must give equations of one shape ([`crate::model::LaneKey`]); an error names
-    /// the first that does not.
-    pub fn of(params: &[Params; L], dt: f64) -> Result<Self, SimError> {
-        let mut drives = Vec::with_capacity(L);
-        for p in params {
-            drives.push(checked_drive(p, dt)?);
-        }
-        let drives: [Drive; L] = drives.try_into().expect("one drive per parameter set");
-        Self::with_drives(drives, dt)
-    }
-
-    fn with_drives(drives: [Drive; L], dt: f64) -> Result<Self, SimError> {
-        Ok(LaneSimulation {
-            lanes: LaneDrive::gather(&drives)?,
-            drives,
-            dt,
-            steps: [0; L],
-            y: [[0.0; L]; NSTATE],
-            kernel: Kernel::default(),
-            load: drives.map(|d| d.tload()),
-        })
-    }
-
-    /// The integration step, s.
-    pub fn dt(&self) -> f64 {
-        self.dt
-    }
-
-    /// The compiled model of lane `l`.
-    pub fn drive(&self, l: usize) -> &Drive {
-        &self.drives[l]
-    }
-
-    /// Starts a new run in lane `l` at t = 0 from state `y` (slots the topology does
-    /// not integrate follow, [`Drive::mirror`]) under the external table torque `load`
-    /// (N·m; `Tload` adds to it), as a new [`Simulation`] with
-    /// [`Simulation::set_state`] and [`Simulation::set_load`] would.
-    pub fn start(&mut self, l: usize, mut y: [f64; NSTATE], load: f64) {
-        self.drives[l].mirror(&mut y);
-        for (i, v) in y.into_iter().enumerate() {
-            self.y[i][l] = v;
-        }
-        self.kernel.reset_lane(l);
-        self.steps[l] = 0;
-        self.load[l] = load + self.drives[l].tload();
-    }
-
-    /// Simulated time of lane `l`, s.
-    pub fn time(&self, l: usize) -> f64 {
-        self.steps[l] as f64 * self.dt
-    }
-
-    /// The state of lane `l`.
-    pub fn state(&self, l: usize) -> [f64; NSTATE] {
-        self.y.map(|s| s[l])
-    }
-
-    /// Contact events split so far, all lanes.
-    pub fn contact_events(&self) -> u64 {
-        self.kernel.events()
-    }
-
-    /// One step of every lane; `motor[s][l]` is lane `l`'s motor torque at the
-    /// step's start, middle and end (see [`TorqueInput`]). A diverged lane stops the
-    /// run with its time and state.
-    #[inline]
-    pub fn step(&mut self, motor: &[[f64; L]; 3]) -> Result<(), SimError> {
-        self.kernel
-            .step(&self.lanes, &mut self.y, motor, &self.load, self.dt);
-        for s in &mut self.steps {
-            *s += 1;
-        }
-        match diverged(&self.y) {
-            None => Ok(()),
-            Some(l) => Err(SimError::Diverged {
-                time: self.time(l),
-                state: describe(&self.state(l)),
-            }),
-        }
     }
 }
 
