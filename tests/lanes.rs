@@ -7,6 +7,7 @@
 
 use rtid::experiments::frequency_response::{simulate_point, sweep, FrequencyTest};
 use rtid::experiments::positioning;
+use rtid::experiments::torque_curve::{simulate_torque, simulate_torque_batch, TorqueTest};
 use rtid::input::{Sine, TorqueInput};
 use rtid::model::{idx::*, presets, Params, NSTATE};
 use rtid::recorder::Recorder;
@@ -381,4 +382,36 @@ fn a_batch_of_positioning_tests_equals_its_lone_runs() {
     }
     assert!(batch[5].is_err(), "the unstable servo diverges");
     assert!(batch.iter().filter(|r| r.is_ok()).count() == 7);
+}
+
+#[test]
+fn the_torque_test_in_lanes_gives_each_set_its_lone_torque() {
+    // Five sets: three of one shape (friction and stiffness differ), one without
+    // the drive mesh's gap, one with a stiffer mesh (another step): batched by
+    // shape and step, each must get its lone torque bit for bit.
+    let test = TorqueTest {
+        period: 0.5,
+        run_in_periods: 1.0,
+        ..TorqueTest::default()
+    };
+    let times: Vec<f64> = (0..200).map(|i| 0.0025 * i as f64 + 1e-4).collect();
+    let sets: Vec<Params> = (0..5)
+        .map(|l| {
+            let mut p = varied_worm(l % 3);
+            p.fm *= 1.0 + 0.2 * l as f64;
+            if l == 3 {
+                p.theta_bw = 0.0;
+            }
+            if l == 4 {
+                p.kw *= 3.0;
+            }
+            p
+        })
+        .collect();
+    let batch = simulate_torque_batch(&sets, &test, &times);
+    for (l, (p, got)) in sets.iter().zip(&batch).enumerate() {
+        let alone = simulate_torque(p, &test, &times).unwrap();
+        assert_eq!(got.as_ref().unwrap(), &alone, "set {l}");
+    }
+    assert_ne!(batch[0], batch[1], "the sets differ");
 }

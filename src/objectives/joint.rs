@@ -85,6 +85,29 @@ impl Objective for Joint {
         Ok(all)
     }
 
+    fn residuals_batch(&self, points: &[Params]) -> Vec<Result<Vec<f64>, ObjectiveError>> {
+        let mut all: Vec<Result<Vec<f64>, ObjectiveError>> = points
+            .iter()
+            .map(|_| Ok(Vec::with_capacity(self.len())))
+            .collect();
+        for part in &self.parts {
+            let k = Self::factor(part);
+            for (acc, r) in all.iter_mut().zip(part.objective.residuals_batch(points)) {
+                if let Ok(v) = acc {
+                    match r {
+                        Ok(r) => v.extend(r.into_iter().map(|r| k * r)),
+                        Err(e) => *acc = Err(e),
+                    }
+                }
+            }
+        }
+        all
+    }
+
+    fn in_lanes(&self) -> bool {
+        self.parts.iter().any(|p| p.objective.in_lanes())
+    }
+
     fn len(&self) -> usize {
         self.parts.iter().map(|p| p.objective.len()).sum()
     }

@@ -116,6 +116,18 @@ pub trait Objective: Sync + Send {
     fn name(&self) -> &'static str;
     /// Scaled residuals (model − measured) / scale, for the parameter set `p`.
     fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError>;
+    /// The residuals at each of `points`, in order, each what
+    /// [`residuals`](Objective::residuals) gives for it; an objective whose model
+    /// runs in the kernel's lanes ([`in_lanes`](Objective::in_lanes)) computes them
+    /// together.
+    fn residuals_batch(&self, points: &[Params]) -> Vec<Result<Vec<f64>, ObjectiveError>> {
+        points.iter().map(|p| self.residuals(p)).collect()
+    }
+    /// Whether [`residuals_batch`](Objective::residuals_batch) runs its points in
+    /// the kernel's lanes (then the search hands it several points at a time).
+    fn in_lanes(&self) -> bool {
+        false
+    }
     /// The residual count (fixed for a given objective).
     fn len(&self) -> usize;
     /// Whether there is nothing to compare.
@@ -130,6 +142,31 @@ pub trait Objective: Sync + Send {
         let _ = (p, r);
         None
     }
+}
+
+/// How many of `n` points one parallel task evaluates: one, or for an objective
+/// that runs in the kernel's lanes up to [`LANES`](crate::sim::LANES) (fewer when
+/// that would leave a worker idle).
+pub fn points_per_task(objective: &dyn Objective, n: usize) -> usize {
+    if objective.in_lanes() {
+        n.div_ceil(rayon::current_num_threads())
+            .clamp(1, crate::sim::LANES)
+    } else {
+        1
+    }
+}
+
+/// The residuals at each of `points`, in order, in parallel ([`points_per_task`]
+/// points per task, together where the objective runs in lanes).
+pub fn residuals_all(
+    objective: &dyn Objective,
+    points: &[Params],
+) -> Vec<Result<Vec<f64>, ObjectiveError>> {
+    use rayon::prelude::*;
+    points
+        .par_chunks(points_per_task(objective, points.len()))
+        .flat_map_iter(|chunk| objective.residuals_batch(chunk))
+        .collect()
 }
 
 /// Sum of squares of scaled residuals.

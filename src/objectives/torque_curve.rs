@@ -14,7 +14,8 @@
 use super::definition::{Definition, SetupError, Source};
 use super::{Detail, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::torque_curve::{
-    from_data, motion_difference, simulate_torque, MotionDifference, TorqueTest,
+    from_data, motion_difference, simulate_torque, simulate_torque_batch, MotionDifference,
+    TorqueTest,
 };
 use crate::io::experiment_file::{Axis, Kind};
 use crate::model::Params;
@@ -119,6 +120,15 @@ impl TorqueResidual {
     pub(crate) fn model_nm(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
         Ok(simulate_torque(p, &self.test, &self.time_s)?)
     }
+
+    /// (model − measured) / scale.
+    fn scaled(&self, model_nm: &[f64]) -> Vec<f64> {
+        model_nm
+            .iter()
+            .zip(&self.motor_torque_nm)
+            .map(|(m, t)| (m - t) / self.scale_nm)
+            .collect()
+    }
 }
 
 impl Objective for TorqueResidual {
@@ -127,12 +137,18 @@ impl Objective for TorqueResidual {
     }
 
     fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
-        Ok(self
-            .model_nm(p)?
-            .iter()
-            .zip(&self.motor_torque_nm)
-            .map(|(m, t)| (m - t) / self.scale_nm)
-            .collect())
+        Ok(self.scaled(&self.model_nm(p)?))
+    }
+
+    fn residuals_batch(&self, points: &[Params]) -> Vec<Result<Vec<f64>, ObjectiveError>> {
+        simulate_torque_batch(points, &self.test, &self.time_s)
+            .into_iter()
+            .map(|m| Ok(self.scaled(&m?)))
+            .collect()
+    }
+
+    fn in_lanes(&self) -> bool {
+        true
     }
 
     fn len(&self) -> usize {

@@ -12,26 +12,40 @@ use crate::model::{Drive, LaneKey, Params};
 /// What lanes of one batch share.
 type BatchKey = (LaneKey, u64, u64);
 
-/// `lone(p)` for every set of `params`, in order, computed `LANES` at a time by
-/// `lanes` where the sets can share lanes. `lanes` gets `LANES` sets (a short group
-/// padded with copies of its last set, whose results are dropped) and gives one
-/// result per lane; if it fails as a whole (a set it cannot run), its sets run
-/// alone.
-pub fn in_lanes<T>(
-    params: &[Params],
-    lone: impl Fn(&Params) -> Result<T, SimError>,
-    lanes: impl Fn(&[Params; LANES]) -> Result<[Result<T, SimError>; LANES], SimError>,
-) -> Vec<Result<T, SimError>> {
-    let mut results: Vec<Option<Result<T, SimError>>> = params.iter().map(|_| None).collect();
+/// A virtual test that runs a parameter set alone or several in lanes, with the
+/// same result for each set either way.
+pub trait LaneRun {
+    type Out;
+    /// The test on `p` alone.
+    fn lone(&self, p: &Params) -> Result<Self::Out, SimError>;
+    /// The test on `L` sets of one [`BatchKey`] at once: one result per set, or an
+    /// error that stops them all (a set it cannot run: they then run alone).
+    fn lanes<const L: usize>(
+        &self,
+        params: &[Params; L],
+    ) -> Result<[Result<Self::Out, SimError>; L], SimError>;
+}
+
+/// `test.lone(p)` for every set of `params`, in order, computed in lanes where the
+/// sets can share them: up to [`LANES`] at a time (two lanes for a pair, alone for
+/// a single set; a group of three is padded with a copy of its last set, whose
+/// result is dropped).
+pub fn in_lanes<R: LaneRun>(params: &[Params], test: &R) -> Vec<Result<R::Out, SimError>> {
+    let mut results: Vec<Option<Result<R::Out, SimError>>> = params.iter().map(|_| None).collect();
     for group in groups(params) {
         for chunk in group.chunks(LANES) {
-            let batch = (chunk.len() > 1)
-                .then(|| {
-                    lanes(&std::array::from_fn(|l| {
-                        params[chunk[l.min(chunk.len() - 1)]].clone()
-                    }))
-                })
-                .and_then(Result::ok);
+            let set = |l: usize| params[chunk[l.min(chunk.len() - 1)]].clone();
+            let batch: Option<Vec<_>> = match chunk.len() {
+                1 => None,
+                2 => test
+                    .lanes::<2>(&std::array::from_fn(set))
+                    .ok()
+                    .map(Vec::from),
+                _ => test
+                    .lanes::<LANES>(&std::array::from_fn(set))
+                    .ok()
+                    .map(Vec::from),
+            };
             match batch {
                 Some(out) => {
                     for (&i, r) in chunk.iter().zip(out) {
@@ -40,7 +54,7 @@ pub fn in_lanes<T>(
                 }
                 None => {
                     for &i in chunk {
-                        results[i] = Some(lone(&params[i]));
+                        results[i] = Some(test.lone(&params[i]));
                     }
                 }
             }
@@ -49,6 +63,34 @@ pub fn in_lanes<T>(
     results
         .into_iter()
         .map(|r| r.expect("every set is in one group"))
+        .collect()
+}
+
+/// `batch` applied to the items of `items` that are `Ok`, its results put back in
+/// their places among the errors: for a batch of parameter sets some of which could
+/// not be made. `batch` gives one result per item it gets, in order.
+pub fn on_valid<P, T, E>(
+    items: Vec<Result<P, E>>,
+    batch: impl FnOnce(&[P]) -> Vec<Result<T, E>>,
+) -> Vec<Result<T, E>> {
+    let mut errors = Vec::with_capacity(items.len());
+    let mut valid = Vec::with_capacity(items.len());
+    for item in items {
+        match item {
+            Ok(p) => {
+                valid.push(p);
+                errors.push(None);
+            }
+            Err(e) => errors.push(Some(e)),
+        }
+    }
+    let mut computed = batch(&valid).into_iter();
+    errors
+        .into_iter()
+        .map(|e| match e {
+            Some(e) => Err(e),
+            None => computed.next().expect("one result per valid item"),
+        })
         .collect()
 }
 
@@ -115,19 +157,39 @@ mod tests {
             p.jt *= 1.0 + 0.01 * i as f64;
             params.push(p);
         }
-        let lone = |p: &Params| Ok(p.jt);
-        let lanes = |ps: &[Params; LANES]| Ok(ps.clone().map(|p| Ok(p.jt)));
-        let expected: Vec<f64> = params.iter().map(|p| p.jt).collect();
-        let got: Vec<f64> = in_lanes(&params, lone, lanes)
+        /// Jt of each set, negated when run in lanes (or failing there).
+        struct Inertia(bool);
+        impl LaneRun for Inertia {
+            type Out = f64;
+            fn lone(&self, p: &Params) -> Result<f64, SimError> {
+                Ok(p.jt)
+            }
+            fn lanes<const L: usize>(
+                &self,
+                ps: &[Params; L],
+            ) -> Result<[Result<f64, SimError>; L], SimError> {
+                if self.0 {
+                    return Err(SimError::BadStep { dt: 0.0 });
+                }
+                Ok(ps.each_ref().map(|p| Ok(-p.jt)))
+            }
+        }
+        let jt: Vec<f64> = params.iter().map(|p| p.jt).collect();
+        let got: Vec<f64> = in_lanes(&params[..6], &Inertia(false))
             .into_iter()
             .map(Result::unwrap)
             .collect();
-        assert_eq!(got, expected);
-        let failing = |_: &[Params; LANES]| Err(SimError::BadStep { dt: 0.0 });
-        let got: Vec<f64> = in_lanes(&params, lone, failing)
+        // 4 in lanes, then a pair in two lanes.
+        assert_eq!(got, jt.iter().map(|j| -j).collect::<Vec<_>>());
+        let got: Vec<f64> = in_lanes(&params[..5], &Inertia(false))
             .into_iter()
             .map(Result::unwrap)
             .collect();
-        assert_eq!(got, expected);
+        assert_eq!(got[4], jt[4], "a set left alone runs alone");
+        let got: Vec<f64> = in_lanes(&params, &Inertia(true))
+            .into_iter()
+            .map(Result::unwrap)
+            .collect();
+        assert_eq!(got, jt, "a failed batch runs alone");
     }
 }

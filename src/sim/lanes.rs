@@ -8,6 +8,7 @@ use crate::controller::{Controller, Gains};
 use crate::input::Trajectory;
 use crate::model::drive::idx::*;
 use crate::model::{Drive, Kernel, LaneDrive, Params, States, NSTATE};
+use crate::recorder::Recorder;
 
 /// Trajectories advanced together by one worker: two AVX2 registers per state
 /// (docs/performance.md: 8 measured no faster on the hosts at hand).
@@ -127,17 +128,26 @@ impl<const L: usize> LaneSimulation<L> {
         ))
     }
 
+    /// A controller for each lane (`params[l]` for lane `l`), as
+    /// [`LaneSimulation::controller`].
+    pub fn controllers(&self, params: &[Params; L]) -> Result<[Controller; L], SimError> {
+        let mut out = Vec::with_capacity(L);
+        for (l, p) in params.iter().enumerate() {
+            out.push(self.controller(l, p)?);
+        }
+        Ok(out.try_into().expect("one per lane"))
+    }
+
     /// Runs `duration` seconds of every lane under its controller, all following
     /// `trajectory` (table angle command, rad or m), each controller updating every
     /// control period and holding its output: lane `l` as
     /// [`Simulation::run_closed_loop`](super::Simulation::run_closed_loop) would run
-    /// it alone. Lanes with an error in `failed` are skipped (at rest, no torque); a
-    /// lane that diverges gets its error there and is put to rest, and the others go
-    /// on. The lanes' clocks must agree modulo the control period (they do when the
-    /// lanes started together).
-    pub fn run_closed_loop<T: Trajectory + ?Sized>(
+    /// it alone, every step reported to `recorders[l]`. Lanes with an error in
+    /// `failed` are skipped (at rest, no torque, not recorded); a lane that diverges
+    /// gets its error there and is put to rest, and the others go on.
+    pub fn run_closed_loop<T: Trajectory + ?Sized, R: Recorder>(
         &mut self,
-        controllers: &mut [Controller; L],
+        (controllers, recorders): (&mut [Controller; L], &mut [R; L]),
         trajectory: &T,
         duration: f64,
         failed: &mut [Option<SimError>; L],
@@ -150,17 +160,23 @@ impl<const L: usize> LaneSimulation<L> {
             return Err(SimError::ControlPeriod { tc, dt: self.dt });
         }
         // The form is chosen once, outside the step loop (kernel.rs).
+        for l in 0..L {
+            if self.steps[l] == 0 && failed[l].is_none() {
+                recorders[l].record(0.0, &self.state(l), controllers[l].torque());
+            }
+        }
+        let run = (controllers, recorders);
         if self.lanes.form == crate::model::drive::Form::Rigid {
-            self.closed_loop::<true, T>(controllers, trajectory, duration, per, failed);
+            self.closed_loop::<true, T, R>(run, trajectory, duration, per, failed);
         } else {
-            self.closed_loop::<false, T>(controllers, trajectory, duration, per, failed);
+            self.closed_loop::<false, T, R>(run, trajectory, duration, per, failed);
         }
         Ok(())
     }
 
-    fn closed_loop<const RIGID: bool, T: Trajectory + ?Sized>(
+    fn closed_loop<const RIGID: bool, T: Trajectory + ?Sized, R: Recorder>(
         &mut self,
-        controllers: &mut [Controller; L],
+        (controllers, recorders): (&mut [Controller; L], &mut [R; L]),
         trajectory: &T,
         duration: f64,
         per: u64,
@@ -188,6 +204,11 @@ impl<const L: usize> LaneSimulation<L> {
             self.tick();
             if diverged(&self.y).is_some() {
                 self.stop_diverged(failed);
+            }
+            for (l, r) in recorders.iter_mut().enumerate() {
+                if failed[l].is_none() {
+                    r.record(self.time(l), &self.state(l), u[l]);
+                }
             }
         }
     }

@@ -214,24 +214,17 @@ impl Sweep {
             .iter()
             .map(|&i| design.values.row(i).to_vec())
             .collect();
-        let sets: Vec<_> = values.iter().map(|v| self.params_at(v)).collect();
-        let valid: Vec<Params> = sets
+        let sets = values
             .iter()
-            .filter_map(|p| p.as_ref().ok().cloned())
+            .map(|v| self.params_at(v).map_err(outputs::OutputError::from))
             .collect();
-        let mut outputs = evaluator.evaluate_batch(&valid).into_iter();
+        let results = crate::sim::batch::on_valid(sets, |sets| evaluator.evaluate_batch(sets));
         let n_out = evaluator.columns().len();
         indices
             .iter()
             .zip(values)
-            .zip(sets)
-            .map(|((&index, values), set)| {
-                let result = match set {
-                    Ok(_) => outputs.next().expect("one result per valid set"),
-                    Err(e) => Err(outputs::OutputError::from(e)),
-                };
-                row(index, &values, n_out, result)
-            })
+            .zip(results)
+            .map(|((&index, values), result)| row(index, &values, n_out, result))
             .collect()
     }
 }

@@ -14,12 +14,14 @@ pub mod iso230;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
-use crate::controller::{quantise, Compensation, Controller};
+use crate::controller::{quantise, Compensation};
 use crate::input::Move;
 use crate::io::experiment_file::{Approaches, Data, Kind, Manifest};
 use crate::model::idx::THETA_T;
 use crate::model::params::{Axis, LoopMode, Params};
 use crate::model::rest::{rest_state, Preload};
+use crate::recorder::NullRecorder;
+use crate::sim::batch::LaneRun;
 use crate::sim::{LaneSimulation, SimError};
 use iso230::{Direction, Measurement, ARCSEC_PER_RAD};
 
@@ -133,11 +135,25 @@ pub fn run_batch(
     test: &PositioningTest,
 ) -> Vec<Result<Vec<Measurement>, SimError>> {
     let sets: Vec<Params> = params.iter().map(|p| test_params(p, test)).collect();
-    crate::sim::batch::in_lanes(
-        &sets,
-        |p| run(p, test, |_, _| {}),
-        |lanes| run_lanes(lanes, test, |_, _| {}),
-    )
+    crate::sim::batch::in_lanes(&sets, &Cycle(test))
+}
+
+/// The test's cycle, for `sim::batch`.
+struct Cycle<'a>(&'a PositioningTest);
+
+impl LaneRun for Cycle<'_> {
+    type Out = Vec<Measurement>;
+
+    fn lone(&self, p: &Params) -> Result<Vec<Measurement>, SimError> {
+        run(p, self.0, |_, _| {})
+    }
+
+    fn lanes<const L: usize>(
+        &self,
+        params: &[Params; L],
+    ) -> Result<[Result<Vec<Measurement>, SimError>; L], SimError> {
+        run_lanes(params, self.0, |_, _| {})
+    }
 }
 
 /// `params` with the test's feedback arrangement.
@@ -161,13 +177,10 @@ fn run_lanes<const L: usize>(
     for (l, p) in params.iter().enumerate() {
         sim.start(l, rest_state(p, stops[0].0, Preload::None), 0.0);
     }
-    let mut controllers = Vec::with_capacity(L);
-    for (l, p) in params.iter().enumerate() {
-        let mut c = sim.controller(l, p)?;
+    let mut controllers = sim.controllers(params)?;
+    for c in &mut controllers {
         c.set_compensation(test.compensation.clone());
-        controllers.push(c);
     }
-    let mut controllers: [Controller; L] = controllers.try_into().expect("one per lane");
     let mut readings = Readings::<L>::new(params, test);
     let mut failed: [Option<SimError>; L] = std::array::from_fn(|_| None);
     for w in stops.windows(2) {
@@ -180,7 +193,8 @@ fn run_lanes<const L: usize>(
         };
         let duration = (to - from).abs() / test.speed + test.dwell;
         let reference = |t: f64| crate::input::Trajectory::angle(&m, t - t0);
-        sim.run_closed_loop(&mut controllers, &reference, duration, &mut failed)?;
+        let run = (&mut controllers, &mut std::array::from_fn(|_| NullRecorder));
+        sim.run_closed_loop(run, &reference, duration, &mut failed)?;
         if let Some(at) = w[1].1 {
             readings.take(at, |l| sim.state(l)[THETA_T]);
             progress(readings.out[0].len(), test.readings());

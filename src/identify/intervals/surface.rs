@@ -34,7 +34,8 @@ use super::request::{Request, LEVEL, THRESHOLD, Z};
 use crate::identify::intervals::resample::block_length;
 use crate::identify::result::profile::{Profile, Surface, Variance};
 use crate::identify::space::Bound;
-use crate::objectives::{sum_of_squares, Objective};
+use crate::objectives::{points_per_task, sum_of_squares, Objective};
+use crate::sim::batch::on_valid;
 
 /// Radii of the design, as fractions of the outer one.
 const RADII: [f64; 3] = [1.0 / 3.0, 2.0 / 3.0, 1.0];
@@ -429,15 +430,18 @@ fn evaluate(
             })
         })
         .collect();
+    let per_task = points_per_task(request.objective, design.len());
     let evaluated: Vec<Result<(f64, Vec<f64>), String>> = design
-        .par_iter()
-        .map(|(u, _, _)| {
-            if (request.stop)() {
-                return Err("stopped (Ctrl-C)".into());
-            }
-            let r = residuals_at(request.objective, request.params, coords, u);
-            (request.on_point)();
-            r.map(|r| (sum_of_squares(&r), r))
+        .par_chunks(per_task)
+        .flat_map_iter(|chunk| {
+            let at: Vec<&DVector<f64>> = chunk.iter().map(|(u, _, _)| u).collect();
+            let r = if (request.stop)() {
+                at.iter().map(|_| Err("stopped (Ctrl-C)".into())).collect()
+            } else {
+                residuals_at(request.objective, request.params, coords, &at)
+            };
+            at.iter().for_each(|_| (request.on_point)());
+            r.into_iter().map(|r| r.map(|r| (sum_of_squares(&r), r)))
         })
         .collect();
     let mut out = Vec::new();
@@ -460,18 +464,30 @@ fn evaluate(
     out
 }
 
-/// The joint residuals at design coordinates `u`.
+/// The joint residuals at each of the design coordinates `at`, together
+/// ([`Objective::residuals_batch`]).
 fn residuals_at(
     objective: &dyn Objective,
     base: &crate::model::Params,
     coords: &Coordinates,
-    u: &DVector<f64>,
-) -> Result<Vec<f64>, String> {
-    let mut p = base.clone();
-    for (name, x) in coords.names.iter().zip(u.iter()) {
-        p.set(name, *x).map_err(|e| e.to_string())?;
-    }
-    objective.residuals(&p).map_err(|e| e.to_string())
+    at: &[&DVector<f64>],
+) -> Vec<Result<Vec<f64>, String>> {
+    let sets = at
+        .iter()
+        .map(|u| {
+            let mut p = base.clone();
+            for (name, x) in coords.names.iter().zip(u.iter()) {
+                p.set(name, *x).map_err(|e| e.to_string())?;
+            }
+            Ok(p)
+        })
+        .collect();
+    on_valid(sets, |sets| {
+        let r = objective.residuals_batch(sets);
+        r.into_iter()
+            .map(|r| r.map_err(|e| e.to_string()))
+            .collect()
+    })
 }
 
 /// Whether the fitted quadratic is a bowl whose rise at the outer radius, along its

@@ -10,11 +10,10 @@
 
 use crate::identify::result::uncertainty::Uncertainty;
 use nalgebra::{DMatrix, SVD};
-use rayon::prelude::*;
 
 use crate::identify::result::warning::Warning;
 use crate::identify::space::ParamSpace;
-use crate::objectives::{Objective, ObjectiveError};
+use crate::objectives::{residuals_all, Objective, ObjectiveError};
 
 /// Above this |correlation| two parameters are reported as not separable.
 pub const CORRELATION_LIMIT: f64 = 0.95;
@@ -135,7 +134,7 @@ pub(crate) fn jacobian(
     values: &[f64],
     step: f64,
 ) -> Result<DMatrix<f64>, ObjectiveError> {
-    let shifted = |j: usize, sign: f64| -> Result<Vec<f64>, ObjectiveError> {
+    let shifted = |j: usize, sign: f64| {
         let mut v = values.to_vec();
         let b = space.bounds[j];
         v[j] = if b.log() {
@@ -143,19 +142,25 @@ pub(crate) fn jacobian(
         } else {
             values[j] + sign * step * (b.hi - b.lo)
         };
-        objective.residuals(&space.params(&v)?)
+        space.params(&v)
     };
-    let columns: Vec<Vec<f64>> = (0..space.dim())
-        .into_par_iter()
-        .map(|j| {
-            let (up, down) = (shifted(j, 1.0)?, shifted(j, -1.0)?);
-            Ok(up
-                .iter()
-                .zip(&down)
+    // Up and down of every parameter, [up 0, down 0, up 1, …], together.
+    let sets = (0..space.dim())
+        .flat_map(|j| [shifted(j, 1.0), shifted(j, -1.0)])
+        .collect::<Result<Vec<_>, _>>()?;
+    let r = residuals_all(objective, &sets)
+        .into_iter()
+        .collect::<Result<Vec<_>, _>>()?;
+    let columns: Vec<Vec<f64>> = r
+        .chunks(2)
+        .map(|ud| {
+            let (up, down) = (&ud[0], &ud[1]);
+            up.iter()
+                .zip(down)
                 .map(|(a, b)| (a - b) / (2.0 * step))
-                .collect())
+                .collect()
         })
-        .collect::<Result<_, ObjectiveError>>()?;
+        .collect();
     let m = columns.first().map_or(0, Vec::len);
     Ok(DMatrix::from_fn(m, space.dim(), |i, j| columns[j][i]))
 }

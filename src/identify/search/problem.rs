@@ -20,7 +20,8 @@ use rayon::prelude::*;
 use crate::identify::search::progress::Progress;
 use crate::identify::search::settings::Settings;
 use crate::identify::space::ParamSpace;
-use crate::objectives::{sum_of_squares, Objective, ObjectiveError};
+use crate::objectives::{points_per_task, sum_of_squares, Objective, ObjectiveError};
+use crate::sim::batch::on_valid;
 
 /// The scaled residual given to every entry at a point the model cannot evaluate.
 pub const PENALTY: f64 = 1e6;
@@ -193,39 +194,68 @@ impl<'a> Problem<'a> {
     }
 
     fn evaluate(&self, x: &DVector<f64>) -> Result<Vec<f64>, ObjectiveError> {
+        let mut one = self.evaluate_batch(std::slice::from_ref(x))?;
+        Ok(one.pop().expect("one point, one result"))
+    }
+
+    /// The residuals at each of `xs`, the points' models run together where the
+    /// objective can ([`Objective::residuals_batch`]).
+    fn evaluate_batch(&self, xs: &[DVector<f64>]) -> Result<Vec<Vec<f64>>, ObjectiveError> {
         self.monitor.check_budget(self.max_evaluations);
         if self.monitor.stopped() {
             return Err(ObjectiveError::Interrupted);
         }
-        let values = self.space.physical(x);
-        let r = self
-            .space
-            .params(&values)
-            .map_err(ObjectiveError::from)
-            .and_then(|p| self.objective.residuals(&p));
+        let values: Vec<Vec<f64>> = xs.iter().map(|x| self.space.physical(x)).collect();
+        let sets = values
+            .iter()
+            .map(|v| self.space.params(v).map_err(ObjectiveError::from))
+            .collect();
+        let results = on_valid(sets, |sets| self.objective.residuals_batch(sets));
+        results
+            .into_iter()
+            .zip(&values)
+            .map(|(r, values)| self.settle(r, values))
+            .collect()
+    }
+
+    /// Counts an evaluation at `values` and turns its result `r` into residuals: a
+    /// non-finite or failed one into the penalty (the first failure kept for the
+    /// report), an interruption into an error.
+    fn settle(
+        &self,
+        r: Result<Vec<f64>, ObjectiveError>,
+        values: &[f64],
+    ) -> Result<Vec<f64>, ObjectiveError> {
         self.monitor.evaluations.fetch_add(1, Ordering::Relaxed);
         match r {
             Ok(r) if r.iter().all(|v| v.is_finite()) => {
-                self.monitor.offer(sum_of_squares(&r), &values);
+                self.monitor.offer(sum_of_squares(&r), values);
                 Ok(r)
             }
             Ok(_) => Ok(vec![PENALTY; self.objective.len()]),
             Err(ObjectiveError::Interrupted) => Err(ObjectiveError::Interrupted),
             Err(e) => {
                 if let Ok(mut f) = self.monitor.failure.lock() {
-                    f.get_or_insert_with(|| format!("{} at {}", e, describe(self.space, &values)));
+                    f.get_or_insert_with(|| format!("{} at {}", e, describe(self.space, values)));
                 }
                 Ok(vec![PENALTY; self.objective.len()])
             }
         }
     }
 
-    /// The residuals at each of `points`, in parallel.
+    /// The residuals at each of `points`, in parallel: one point per task, or, for
+    /// an objective that runs in lanes, up to `LANES` points per task (fewer when
+    /// that would leave a worker idle).
     pub(crate) fn evaluate_all(
         &self,
         points: &[DVector<f64>],
     ) -> Result<Vec<Vec<f64>>, ObjectiveError> {
-        points.par_iter().map(|x| self.evaluate(x)).collect()
+        let per_task = points_per_task(self.objective, points.len());
+        let batches: Vec<Vec<Vec<f64>>> = points
+            .par_chunks(per_task)
+            .map(|xs| self.evaluate_batch(xs))
+            .collect::<Result<_, _>>()?;
+        Ok(batches.into_iter().flatten().collect())
     }
 
     /// Forward-difference Jacobian of the residuals in solver coordinates, the columns
@@ -236,14 +266,14 @@ impl<'a> Problem<'a> {
         r0: &[f64],
     ) -> Result<DMatrix<f64>, ObjectiveError> {
         let h = self.fd_step;
-        let columns: Vec<Vec<f64>> = (0..x.len())
-            .into_par_iter()
+        let shifted: Vec<DVector<f64>> = (0..x.len())
             .map(|j| {
                 let mut xj = x.clone();
                 xj[j] += h;
-                self.evaluate(&xj)
+                xj
             })
-            .collect::<Result<_, _>>()?;
+            .collect();
+        let columns = self.evaluate_all(&shifted)?;
         Ok(DMatrix::from_fn(r0.len(), x.len(), |i, j| {
             (columns[j][i] - r0[i]) / h
         }))
