@@ -63,11 +63,19 @@ impl<L: std::ops::Deref<Target = O> + Sync + Send, O: Objective + ?Sized> Object
     }
 
     fn residuals(&self, p: &crate::model::Params) -> Result<Vec<f64>, ObjectiveError> {
-        let mut r = self.linear.residuals(p)?;
-        for (r, d) in r.iter_mut().zip(&self.offset) {
-            *r += d;
-        }
-        Ok(r)
+        Ok(self.offset_by(self.linear.residuals(p)?))
+    }
+
+    fn residuals_batch(
+        &self,
+        points: &[crate::model::Params],
+    ) -> Vec<Result<Vec<f64>, ObjectiveError>> {
+        let r = self.linear.residuals_batch(points);
+        r.into_iter().map(|r| Ok(self.offset_by(r?))).collect()
+    }
+
+    fn in_lanes(&self) -> bool {
+        self.linear.in_lanes()
     }
 
     fn len(&self) -> usize {
@@ -76,6 +84,16 @@ impl<L: std::ops::Deref<Target = O> + Sync + Send, O: Objective + ?Sized> Object
 
     fn scale(&self) -> String {
         self.linear.scale()
+    }
+}
+
+impl<L> Corrected<L> {
+    /// `r` plus the offset.
+    fn offset_by(&self, mut r: Vec<f64>) -> Vec<f64> {
+        for (r, d) in r.iter_mut().zip(&self.offset) {
+            *r += d;
+        }
+        r
     }
 }
 
