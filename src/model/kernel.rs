@@ -2,7 +2,9 @@
 //! fourth-order Runge–Kutta step, for `L` independent trajectories advanced in
 //! lockstep ("lanes", structure of arrays: state `i` of lane `l` is `y[i][l]`).
 //! `L = 1` is one trajectory; wider lanes let the compiler vectorise independent
-//! simulations (e.g. the frequencies of a frequency-response sweep).
+//! simulations (the frequencies of a frequency-response sweep, or the parameter sets
+//! of a batch: every constant is read per lane from a [`LaneDrive`], so each lane may
+//! hold another drive of the same shape).
 //!
 //! Equations as implemented (SI units; the shaft slots mirror the motor in the
 //! direct topology, where Rg = 1 and there is no spur mesh):

@@ -19,8 +19,9 @@ pub const LANES: usize = 4;
 /// ([`LaneSimulation::new`]), or of `L` parameter sets whose equations have one
 /// shape ([`LaneSimulation::of`]). Each lane has its own state, clock, table load
 /// and motor torque, and can be restarted on its own; lane `l` computes bit for bit
-/// what a [`Simulation`](super::Simulation) computes for the same run alone. Every step checks every
-/// lane for divergence; an idle lane (at rest, no torque) stays at rest.
+/// what a [`Simulation`](super::Simulation) computes for the same run alone. Every
+/// step checks every lane for divergence; an idle lane (at rest, no torque) stays at
+/// rest.
 #[derive(Clone, Debug)]
 pub struct LaneSimulation<const L: usize> {
     drives: [Drive; L],
@@ -40,9 +41,9 @@ impl<const L: usize> LaneSimulation<L> {
     }
 
     /// `params[l]` in lane `l`, every lane at rest at zero angles and integrated with
-    /// step `dt` (checked for each as by [`Simulation::new`](super::Simulation::new)). The parameter sets
-    /// must give equations of one shape ([`crate::model::LaneKey`]); an error names
-    /// the first that does not.
+    /// step `dt` (checked for each as by [`Simulation::new`](super::Simulation::new)).
+    /// The parameter sets must give equations of one shape
+    /// ([`crate::model::LaneKey`]); an error names the first that does not.
     pub fn of(params: &[Params; L], dt: f64) -> Result<Self, SimError> {
         let mut drives = Vec::with_capacity(L);
         for p in params {
@@ -159,13 +160,13 @@ impl<const L: usize> LaneSimulation<L> {
             let tc = c.gains().tc;
             return Err(SimError::ControlPeriod { tc, dt: self.dt });
         }
-        // The form is chosen once, outside the step loop (kernel.rs).
         for l in 0..L {
             if self.steps[l] == 0 && failed[l].is_none() {
                 recorders[l].record(0.0, &self.state(l), controllers[l].torque());
             }
         }
         let run = (controllers, recorders);
+        // The form is chosen once, outside the step loop (kernel.rs).
         if self.lanes.form == crate::model::drive::Form::Rigid {
             self.closed_loop::<true, T, R>(run, trajectory, duration, per, failed);
         } else {
