@@ -31,6 +31,11 @@ pub trait LaneRun {
 /// a single set; a group of three is padded with a copy of its last set, whose
 /// result is dropped).
 pub fn in_lanes<R: LaneRun>(params: &[Params], test: &R) -> Vec<Result<R::Out, SimError>> {
+    if params.len() < 2 {
+        // Nothing to share: spare the grouping its drive and step (an eigenvalue
+        // problem) for each lone evaluation of a search.
+        return params.iter().map(|p| test.lone(p)).collect();
+    }
     let mut results: Vec<Option<Result<R::Out, SimError>>> = params.iter().map(|_| None).collect();
     for group in groups(params) {
         for chunk in group.chunks(LANES) {
