@@ -5,17 +5,19 @@
 //! `servo_trace/replay` — one closed-loop replay of the whole record on the published
 //! model, the unit of cost of the output-error identification (`servo-trace`
 //! objective: ~110 replays from the IDIM estimate);
+//! `servo_trace/replay_4_sets/{lanes,lone}` — four parameter sets (a Jacobian's
+//! columns) replayed in the kernel's lanes, and one after another;
 //! `servo_trace/replay_drive_functions` — the same with the drive's functions on:
 //! velocity and torque feed-forward, the symmetrising lag and four setpoint filters;
 //! `servo_trace/identify` — the whole EMPS identification as `rtid identify` runs it:
-//! the IDIM-LS start, then the output-error search of Jt, Ct, ft, Tload (50
-//! Nelder–Mead iterations) and the uncertainty at the result.
+//! the IDIM-LS start, then the output-error search of Jt, Ct, ft, Tload
+//! (Levenberg–Marquardt, its points in lanes) and the uncertainty at the result.
 
 use std::path::PathBuf;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rtid::estimation::inverse_dynamics::IdimSettings;
-use rtid::experiments::servo_trace::{replay, ServoTrace};
+use rtid::experiments::servo_trace::{replay, replay_batch, ServoTrace};
 use rtid::identify::{identify, Config, ExperimentSpec, Monitor};
 use rtid::io::experiment_file::{self, Data};
 use rtid::model::{Params, SetpointFilter};
@@ -46,11 +48,33 @@ fn bench(c: &mut Criterion) {
         b.iter(|| trace.fit_friction(&IdimSettings::default()).unwrap())
     });
     group.bench_function("replay", |b| b.iter(|| replay(&params, &trace).unwrap()));
+    // Four parameter sets (a Jacobian's columns) in lanes, and the same one by one.
+    let sets = columns(&params);
+    group.bench_function("replay_4_sets/lanes", |b| {
+        b.iter(|| replay_batch(&sets, &trace))
+    });
+    group.bench_function("replay_4_sets/lone", |b| {
+        b.iter(|| sets.iter().map(|p| replay(p, &trace)).collect::<Vec<_>>())
+    });
     let functions = with_drive_functions(&params);
     group.bench_function("replay_drive_functions", |b| {
         b.iter(|| replay(&functions, &trace).unwrap())
     });
     group.finish();
+}
+
+/// `params` with each of Jt, Ct, ft, Tload 3 % higher: the points of a
+/// forward-difference Jacobian.
+fn columns(params: &Params) -> Vec<Params> {
+    ["Jt", "Ct", "ft", "Tload"]
+        .iter()
+        .map(|name| {
+            let mut p = params.clone();
+            let v = p.get(name).unwrap().unwrap();
+            p.set(name, 1.03 * v).unwrap();
+            p
+        })
+        .collect()
 }
 
 /// `params` with feed-forward, the symmetrising lag and four setpoint filters on.

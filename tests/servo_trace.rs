@@ -12,7 +12,8 @@ use std::path::PathBuf;
 use rtid::controller::{Controller, Gains};
 use rtid::estimation::inverse_dynamics::IdimSettings;
 use rtid::experiments::servo_trace::{
-    replay, simulation_error, virtual_trace, MoveTo, ServoTrace, TraceError, TrapezoidalMoves,
+    replay, replay_batch, simulation_error, virtual_trace, MoveTo, ServoTrace, TraceError,
+    TrapezoidalMoves,
 };
 use rtid::experiments::torque_curve::idim_fit;
 use rtid::experiments::torque_curve::{self, TorqueTest};
@@ -114,6 +115,49 @@ fn the_emps_record_replays_to_the_published_simulation_error() {
     assert!((e.position_rms / 2.10e-6 - 1.0).abs() < 0.05, "{e:?}");
     assert!((e.position_max / 12.6e-6 - 1.0).abs() < 0.10, "{e:?}");
     assert!((e.force_rms / 2.41 - 1.0).abs() < 0.05, "{e:?}");
+}
+
+#[test]
+fn replays_in_lanes_give_each_parameter_set_its_lone_replay() {
+    // The first 3 s of the record on nine sets: six of one shape (Jt, Ct, ft,
+    // Tload each 3-10 % off, two velocity gains: a batch of four lanes and a pair),
+    // two with Stribeck laws (a pair), and one invalid (its own error).
+    let mut trace = emps_record();
+    let n = 3000;
+    for v in [
+        &mut trace.time_s,
+        &mut trace.reference,
+        &mut trace.position,
+        &mut trace.force,
+    ] {
+        v.truncate(n);
+    }
+    trace.controller_output = trace.controller_output.map(|c| c[..n].to_vec());
+    let base = emps_axis();
+    let sets: Vec<Params> = (0..9)
+        .map(|l| {
+            let mut p = base.clone();
+            match l {
+                0 => p.jt *= 1.03,
+                1 => p.ct *= 0.95,
+                2 => p.ft *= 1.1,
+                3 => p.tload = -p.tload,
+                4 | 5 => p.controller.kvp *= 0.1 * l as f64,
+                6 | 7 => (p.fst, p.vst) = (0.1 * l as f64 * p.ft, 0.002 * l as f64),
+                _ => p.jt = -1.0,
+            }
+            p
+        })
+        .collect();
+    let batch = replay_batch(&sets, &trace);
+    for (l, (p, got)) in sets.iter().zip(&batch).enumerate().take(8) {
+        let alone = replay(p, &trace).unwrap();
+        assert_eq!(got.as_ref().unwrap(), &alone, "set {l}");
+    }
+    assert!(batch[8].is_err(), "Jt < 0 is refused");
+    assert_ne!(batch[0], batch[1], "the sets differ");
+    assert_ne!(batch[4], batch[5], "the gains differ");
+    assert_ne!(batch[6], batch[7], "the Stribeck laws differ");
 }
 
 #[test]

@@ -66,9 +66,7 @@
 
 use super::backlash::mesh_torque_lanes;
 use super::drive::{idx::*, taylor_sin_cos, NSTATE, PHASE_RESYNC, SMALL_ANGLE};
-use super::friction::clamp::{
-    decide_direction_lanes, decide_lanes, stop_at_reversal, stop_at_reversal_lanes, Friction,
-};
+use super::friction::clamp::{decide_direction_lanes, decide_lanes, stop_at_reversal_lanes};
 use super::friction::lanes::{with_lane_law, LaneLaw};
 use super::friction::FrictionLaw;
 use super::lane_drive::LaneDrive;
@@ -665,11 +663,10 @@ fn quadratic(m: &[f64; 3], s: f64) -> f64 {
 ///
 /// with the stick/slip decision of friction/clamp.rs at the step's first stage and the stop
 /// at a velocity reversal, as for the table of the other forms. No mesh, so no
-/// contact events. Written lane by lane with the scalar friction law, out of line:
-/// built from the lane-wise helpers of the other forms, its mere presence changed how
-/// the compiler allocated registers in their step (measured: 24 more instructions
-/// per step on the roller-gear cam, mostly spills). Each lane is computed alone, so
-/// lanes equal lone runs.
+/// contact events. Lane-wise (each lane its own Ct, Jt, friction, load), out of line:
+/// its mere presence inside the other forms' step changed how the compiler allocated
+/// registers there (measured: 24 more instructions per step on the roller-gear cam,
+/// mostly spills).
 #[inline(never)]
 fn rigid_rk4<const L: usize, F: FrictionLaw>(
     d: &LaneDrive<L>,
@@ -680,92 +677,87 @@ fn rigid_rk4<const L: usize, F: FrictionLaw>(
     load: &[f64; L],
     h: f64,
 ) {
-    for l in 0..L {
-        let (law, ct, inv_jt) = (laws.law(l), d.ct.0[l], d.inv_jt.0[l]);
-        let (t1, w1) = (y[THETA_T][l], y[OMEGA_T][l]);
-        let m = [motor[0][l], motor[1][l], motor[2][l]];
-        let torque = |t: f64, w: f64, m: f64| m - ct * w + rigid_unbalance(d, l, t) + load[l];
-        let first = torque(t1, w1, m[0]);
-        let friction = RigidFriction::decide(law, first, w1);
-        let accel = |t: f64, w: f64| friction.net(t, w) * inv_jt;
-        let a1 = accel(first, w1);
-        let (t2, w2) = (t1 + 0.5 * h * w1, w1 + 0.5 * h * a1);
-        let a2 = accel(torque(t2, w2, m[1]), w2);
-        let (t3, w3) = (t1 + 0.5 * h * w2, w1 + 0.5 * h * a2);
-        let a3 = accel(torque(t3, w3, m[1]), w3);
-        let (t4, w4) = (t1 + h * w3, w1 + h * a3);
-        let a4 = accel(torque(t4, w4, m[2]), w4);
-        let sixth = h * (1.0 / 6.0);
-        let angle = t1 + sixth * (w1 + 2.0 * (w2 + w3) + w4);
-        let mut speed = w1 + sixth * (a1 + 2.0 * (a2 + a3) + a4);
-        stop_at_reversal(w1, &mut speed, law.breakaway(2));
-        for (pos, vel) in [(THETA_M, OMEGA_M), (THETA_W, OMEGA_W), (THETA_T, OMEGA_T)] {
-            y[pos][l] = angle;
-            y[vel][l] = speed;
-        }
-        // Motor and shaft are the table: they stick when it does.
-        for b in 0..3 {
-            st.free[b][l] = friction.free();
-        }
+    let (ct, inv_jt, load) = (d.ct, d.inv_jt, Lanes(*load));
+    let (t1, w1) = (Lanes(y[THETA_T]), Lanes(y[OMEGA_T]));
+    let torque =
+        |t: Lanes<L>, w: Lanes<L>, m: [f64; L]| Lanes(m) - ct * w + rigid_unbalance(d, t) + load;
+    let first = torque(t1, w1, motor[0]);
+    let friction = RigidFriction::decide(laws, first, w1);
+    let accel = |t: Lanes<L>, w: Lanes<L>| friction.net(t, w) * inv_jt;
+    let a1 = accel(first, w1);
+    let (t2, w2) = (t1 + 0.5 * h * w1, w1 + 0.5 * h * a1);
+    let a2 = accel(torque(t2, w2, motor[1]), w2);
+    let (t3, w3) = (t1 + 0.5 * h * w2, w1 + 0.5 * h * a2);
+    let a3 = accel(torque(t3, w3, motor[1]), w3);
+    let (t4, w4) = (t1 + h * w3, w1 + h * a3);
+    let a4 = accel(torque(t4, w4, motor[2]), w4);
+    let sixth = h * (1.0 / 6.0);
+    let angle = t1 + sixth * (w1 + 2.0 * (w2 + w3) + w4);
+    let speed = w1 + sixth * (a1 + 2.0 * (a2 + a3) + a4);
+    // A reversal is rare: a branch on it keeps the select off the velocity's chain
+    // from step to step (measured: the select on every step cost 4-7 % of the
+    // lone direct drive's time).
+    let speed = if (w1 * speed).any(|x| x < 0.0) {
+        stop_at_reversal_lanes(w1, speed, laws.breakaway(2))
+    } else {
+        speed
+    };
+    for (pos, vel) in [(THETA_M, OMEGA_M), (THETA_W, OMEGA_W), (THETA_T, OMEGA_T)] {
+        y[pos] = angle.0;
+        y[vel] = speed.0;
     }
+    // Motor and shaft are the table: they stick when it does.
+    st.free = [friction.free.0; 3];
 }
 
-/// The rigid body's friction over one step: with a constant level (Coulomb) its
-/// torque, else its direction with the law to evaluate at each stage.
+/// The rigid body's friction over one step, per lane: with a constant level
+/// (Coulomb) its torque, else its direction with the law to evaluate at each stage.
 #[derive(Clone, Copy)]
-struct RigidFriction<'a, F> {
+struct RigidFriction<'a, F, const L: usize> {
     /// The friction torque (constant level) or its sign (±1, 0 when stuck).
-    torque_or_direction: f64,
-    free: f64,
-    law: &'a F,
+    torque_or_direction: Lanes<L>,
+    /// 1 while the body moves, 0 while it sticks.
+    free: Lanes<L>,
+    laws: &'a LaneLaw<F, L>,
 }
 
-impl<'a, F: FrictionLaw> RigidFriction<'a, F> {
+impl<'a, F: FrictionLaw, const L: usize> RigidFriction<'a, F, L> {
     /// The stick decision from the torque `t` on the body at velocity `w`.
     #[inline(always)]
-    fn decide(law: &'a F, t: f64, w: f64) -> Self {
+    fn decide(laws: &'a LaneLaw<F, L>, t: Lanes<L>, w: Lanes<L>) -> Self {
         let (torque_or_direction, free) = if F::CONSTANT_LEVEL {
-            let f = Friction::decide(t, w, law.breakaway(2));
-            (f.torque, f.free)
+            decide_lanes(t, w, laws.breakaway(2))
         } else {
-            let (direction, free) =
-                decide_direction_lanes(Lanes([t]), Lanes([w]), Lanes([law.breakaway(2)]));
-            (direction.0[0], free.0[0])
+            decide_direction_lanes(t, w, laws.breakaway(2))
         };
         RigidFriction {
             torque_or_direction,
             free,
-            law,
+            laws,
         }
     }
 
-    /// The net torque at velocity `w` under the other torques `t` (0 while stuck).
+    /// The net torque at velocity `w` under the other torques `t` (0 while stuck):
+    /// (t − friction)·free.
     #[inline(always)]
-    fn net(self, t: f64, w: f64) -> f64 {
+    fn net(self, t: Lanes<L>, w: Lanes<L>) -> Lanes<L> {
         let torque = if F::CONSTANT_LEVEL {
             self.torque_or_direction
         } else {
-            self.torque_or_direction * self.law.sliding(2, w.abs())
+            self.torque_or_direction * self.laws.sliding(2, w.map(f64::abs))
         };
-        Friction {
-            torque,
-            free: self.free,
-        }
-        .net(t)
-    }
-
-    fn free(self) -> f64 {
-        self.free
+        (t - torque) * self.free
     }
 }
 
-/// Tu = −m·g·e·sin(θt + ψ) on the rigid body (0 without unbalance).
+/// Tu = −m·g·e·sin(θt + ψ) on the rigid body at table angles `t` (0 without
+/// unbalance).
 #[inline(always)]
-fn rigid_unbalance<const L: usize>(d: &LaneDrive<L>, l: usize, table_angle: f64) -> f64 {
+fn rigid_unbalance<const L: usize>(d: &LaneDrive<L>, t: Lanes<L>) -> Lanes<L> {
     if d.unbalance {
-        d.unbalance_torque(l, table_angle)
+        Lanes(std::array::from_fn(|l| d.unbalance_torque(l, t.0[l])))
     } else {
-        0.0
+        Lanes::splat(0.0)
     }
 }
 

@@ -16,7 +16,7 @@
 use super::definition::{Definition, Estimated, SetupError, Source};
 use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::estimation::inverse_dynamics::IdimSettings;
-use crate::experiments::servo_trace::{replay, ServoTrace, TraceError};
+use crate::experiments::servo_trace::{replay, replay_batch, Replay, ServoTrace, TraceError};
 use crate::io::experiment_file::{Data, Kind};
 use crate::model::{Params, Topology};
 
@@ -122,6 +122,22 @@ impl TraceResidual {
             trace,
         }
     }
+
+    /// The scaled residuals of `run`: force, then position, (replayed − recorded) /
+    /// scale sample by sample.
+    fn scaled(&self, run: &Replay) -> Vec<f64> {
+        let force = run
+            .force
+            .iter()
+            .zip(&self.trace.force)
+            .map(|(m, f)| (m - f) / self.force_scale);
+        let position = run
+            .position
+            .iter()
+            .zip(&self.trace.position)
+            .map(|(m, q)| (m - q) / self.position_scale);
+        force.chain(position).collect()
+    }
 }
 
 /// Largest − smallest of `x` (0 when empty).
@@ -159,17 +175,18 @@ impl Objective for TraceResidual {
 
     fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
         let run = replay(p, &self.trace).map_err(objective_error)?;
-        let force = run
-            .force
-            .iter()
-            .zip(&self.trace.force)
-            .map(|(m, f)| (m - f) / self.force_scale);
-        let position = run
-            .position
-            .iter()
-            .zip(&self.trace.position)
-            .map(|(m, q)| (m - q) / self.position_scale);
-        Ok(force.chain(position).collect())
+        Ok(self.scaled(&run))
+    }
+
+    fn residuals_batch(&self, points: &[Params]) -> Vec<Result<Vec<f64>, ObjectiveError>> {
+        replay_batch(points, &self.trace)
+            .into_iter()
+            .map(|run| Ok(self.scaled(&run.map_err(objective_error)?)))
+            .collect()
+    }
+
+    fn in_lanes(&self) -> bool {
+        true
     }
 
     fn len(&self) -> usize {

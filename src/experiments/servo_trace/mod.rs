@@ -31,7 +31,7 @@ mod replay;
 mod virtual_trace;
 
 pub use evaluate::{evaluate, EvaluateError, TraceEvaluation};
-pub use replay::{replay, simulation_error, Misfit, Replay};
+pub use replay::{replay, replay_batch, simulation_error, Misfit, Replay};
 pub use virtual_trace::{virtual_trace, MoveTo, TrapezoidalMoves};
 
 use crate::estimation::inverse_dynamics::{self, IdimError, IdimFit, IdimSettings};

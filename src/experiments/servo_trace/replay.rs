@@ -5,10 +5,12 @@
 use serde::Serialize;
 
 use super::{ServoTrace, TraceError};
+use crate::controller::Controller;
 use crate::model::params::{LoopMode, Params};
 use crate::model::rest::moving_state;
 use crate::recorder::NullRecorder;
-use crate::sim::{SimError, Simulation};
+use crate::sim::batch::{in_lanes, on_valid, LaneRun};
+use crate::sim::{common_step, LaneSimulation, SimError};
 
 /// Relative difference below which the record's sample period is taken to be the
 /// controller's `Tc` exactly (the record's mean step carries rounding and jitter).
@@ -61,6 +63,31 @@ pub struct Misfit {
 /// of the velocity loop. The trace's recorded drive functions (feed-forward,
 /// filters), if any, replace the model's controller's.
 pub fn replay(params: &Params, trace: &ServoTrace) -> Result<Replay, TraceError> {
+    let p = prepared(params, trace)?;
+    Ok(TraceRun::of(trace)?.lone(&p)?)
+}
+
+/// [`replay`] of `trace` on each of `params`, in order, in the kernel's lanes where
+/// the sets can share them (`sim::batch`): each result is what `replay` gives for
+/// its set alone.
+pub fn replay_batch(params: &[Params], trace: &ServoTrace) -> Vec<Result<Replay, TraceError>> {
+    let run = match TraceRun::of(trace) {
+        Ok(run) => run,
+        Err(e) => return params.iter().map(|_| Err(e.clone())).collect(),
+    };
+    let sets = params.iter().map(|p| prepared(p, trace)).collect();
+    on_valid(sets, |sets| {
+        in_lanes(sets, &run)
+            .into_iter()
+            .map(|r| r.map_err(TraceError::from))
+            .collect()
+    })
+}
+
+/// `params` as the replay runs them: the controller's period the record's (when
+/// they differ by more than [`SAME_PERIOD`]), the trace's recorded drive functions
+/// set; refused if the replay would take more than [`MAX_REPLAY_STEPS`] steps.
+fn prepared(params: &Params, trace: &ServoTrace) -> Result<Params, TraceError> {
     let period = trace.check()?;
     let mut p = params.clone();
     if (period / p.controller.tc - 1.0).abs() > SAME_PERIOD {
@@ -71,18 +98,54 @@ pub fn replay(params: &Params, trace: &ServoTrace) -> Result<Replay, TraceError>
         p.validate().map_err(TraceError::DriveFunctions)?;
     }
     affordable(&p, &trace.time_s)?;
-    let velocity = (trace.position[1] - trace.position[0]) / period;
-    let start = Start {
-        position: trace.position[0],
-        velocity,
-    };
-    Ok(run_servo(
-        &p,
-        &trace.time_s,
-        &trace.reference,
-        trace.controller_added.as_deref(),
-        start,
-    )?)
+    Ok(p)
+}
+
+/// A trace's replay as a [`LaneRun`]: its reference and added signal, and where
+/// the run starts.
+struct TraceRun<'a> {
+    time_s: &'a [f64],
+    reference: &'a [f64],
+    added: Option<&'a [f64]>,
+    start: Start,
+}
+
+impl<'a> TraceRun<'a> {
+    /// The replay of `trace`: from the first recorded position, the whole drive
+    /// moving at the velocity of the first two samples.
+    fn of(trace: &'a ServoTrace) -> Result<Self, TraceError> {
+        let period = trace.check()?;
+        let start = Start {
+            position: trace.position[0],
+            velocity: (trace.position[1] - trace.position[0]) / period,
+        };
+        Ok(TraceRun {
+            time_s: &trace.time_s,
+            reference: &trace.reference,
+            added: trace.controller_added.as_deref(),
+            start,
+        })
+    }
+}
+
+impl LaneRun for TraceRun<'_> {
+    type Out = Replay;
+
+    fn lone(&self, p: &Params) -> Result<Replay, SimError> {
+        run_servo(p, self.time_s, self.reference, self.added, self.start)
+    }
+
+    fn lanes<const L: usize>(
+        &self,
+        params: &[Params; L],
+    ) -> Result<[Result<Replay, SimError>; L], SimError> {
+        run_servo_lanes(
+            params,
+            self.time_s,
+            (self.reference, self.added),
+            self.start,
+        )
+    }
 }
 
 /// The replay's cost in integration steps, refused above [`MAX_REPLAY_STEPS`].
@@ -143,34 +206,81 @@ pub(super) fn run_servo(
     added: Option<&[f64]>,
     start: Start,
 ) -> Result<Replay, SimError> {
-    let mut sim = Simulation::with_default_step(p)?;
-    sim.set_state(moving_state(p, start.position, start.velocity));
-    let mut controller = sim.controller(p)?;
-    if start.velocity != 0.0 {
-        controller.start_moving(start.velocity / p.ratio());
+    let [one] = run_servo_lanes(std::array::from_ref(p), time_s, (reference, added), start)?;
+    one
+}
+
+/// [`run_servo`] on `L` models at once, one per lane, lane `l` as a lone run of
+/// `params[l]` computes it (a set that diverges fails alone); the sets must share
+/// their integration step and control period.
+fn run_servo_lanes<const L: usize>(
+    params: &[Params; L],
+    time_s: &[f64],
+    (reference, added): (&[f64], Option<&[f64]>),
+    start: Start,
+) -> Result<[Result<Replay, SimError>; L], SimError> {
+    let mut sim = LaneSimulation::<L>::of(params, common_step(params)?)?;
+    for (l, p) in params.iter().enumerate() {
+        sim.start(l, moving_state(p, start.position, start.velocity), 0.0);
     }
-    let tc = controller.gains().tc;
-    let n = reference.len();
-    let mut out = Replay {
-        time_s: time_s.to_vec(),
-        position: Vec::with_capacity(n),
-        table_position: Vec::with_capacity(n),
-        force: Vec::with_capacity(n),
-        controller_output: Vec::with_capacity(n),
-    };
+    let mut controllers = sim.controllers(params)?;
+    if start.velocity != 0.0 {
+        for (c, p) in controllers.iter_mut().zip(params) {
+            c.start_moving(start.velocity / p.ratio());
+        }
+    }
+    let tc = controllers[0].gains().tc;
+    let mut out: [Replay; L] = std::array::from_fn(|_| Replay::with_capacity(time_s));
+    let mut failed: [Option<SimError>; L] = std::array::from_fn(|_| None);
+    let mut null: [NullRecorder; L] = std::array::from_fn(|_| NullRecorder);
     for (k, &r) in reference.iter().enumerate() {
         if let Some(a) = added {
-            controller.set_added(a[k]);
+            controllers.iter_mut().for_each(|c| c.set_added(a[k]));
         }
-        // One control period: the controller samples at its first step.
-        sim.run_closed_loop(&mut controller, &move |_t: f64| r, tc, &mut NullRecorder)?;
-        out.position.push(match p.controller.loop_mode {
-            LoopMode::SemiClosed => controller.motor_reading() * p.ratio(),
+        // One control period: the controllers sample at its first step.
+        let run = (&mut controllers, &mut null);
+        sim.run_closed_loop(run, &move |_t: f64| r, tc, &mut failed)?;
+        for l in (0..L).filter(|&l| failed[l].is_none()) {
+            out[l].push(
+                &controllers[l],
+                params[l].controller.loop_mode,
+                params[l].ratio(),
+            );
+        }
+        if failed.iter().all(Option::is_some) {
+            break;
+        }
+    }
+    let mut out = out.into_iter();
+    Ok(failed.map(|f| {
+        let replay = out.next().expect("one per lane");
+        f.map_or(Ok(replay), Err)
+    }))
+}
+
+impl Replay {
+    /// An empty replay on the record's times `time_s`.
+    fn with_capacity(time_s: &[f64]) -> Replay {
+        let n = time_s.len();
+        Replay {
+            time_s: time_s.to_vec(),
+            position: Vec::with_capacity(n),
+            table_position: Vec::with_capacity(n),
+            force: Vec::with_capacity(n),
+            controller_output: Vec::with_capacity(n),
+        }
+    }
+
+    /// Records what `controller` read and applied at a sample: the loop encoder
+    /// (semi-closed loop the motor's × `ratio`), the table encoder, the force and
+    /// the controller's output.
+    fn push(&mut self, controller: &Controller, mode: LoopMode, ratio: f64) {
+        self.position.push(match mode {
+            LoopMode::SemiClosed => controller.motor_reading() * ratio,
             LoopMode::FullClosed => controller.table_reading(),
         });
-        out.table_position.push(controller.table_reading());
-        out.force.push(controller.torque());
-        out.controller_output.push(controller.output());
+        self.table_position.push(controller.table_reading());
+        self.force.push(controller.torque());
+        self.controller_output.push(controller.output());
     }
-    Ok(out)
 }

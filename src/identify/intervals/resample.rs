@@ -13,7 +13,11 @@
 //! replicate's data `model(p̂) − scale·r*` give r(p) − r(p̂) + r*: each replicate is
 //! the fitted objective plus a fixed offset, whatever the objective computes.
 //! Replicates run in parallel; replicate b's blocks come from a generator seeded by
-//! (seed, b), so the result does not depend on the order they finish in.
+//! (seed, b), so the result does not depend on the order they finish in. Where the
+//! refit is a Nelder–Mead search (one point after another) on an objective that
+//! runs in the kernel's lanes, the replicates' searches run side by side on threads
+//! of their own, [`LANES`] per worker, their evaluations gathered into lane batches
+//! (search/lockstep.rs): each replicate's numbers are those it gets alone.
 
 use crate::identify::result::resampling::{Interval, Resampling};
 use std::collections::BTreeMap;
@@ -26,12 +30,15 @@ use crate::identify::error::IdentifyError;
 use crate::identify::pipeline::correction::Corrected;
 use crate::identify::result::warning::Warning;
 use crate::identify::result::IdentifyResult;
+use crate::identify::search::lockstep::Lockstep;
 use crate::identify::search::problem::Monitor;
 use crate::identify::search::search;
-use crate::identify::search::settings::Settings;
+use crate::identify::search::settings::{Method, Settings};
 use crate::identify::space::{Bound, ParamSpace};
 use crate::model::Params;
 use crate::objectives::{Objective, ObjectiveError};
+use crate::sim::LANES;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 pub use super::request::LEVEL;
 use super::request::Z;
@@ -152,22 +159,36 @@ impl Problem<'_> {
         let segments = self.segments(r0.len());
         let errors = modified(&centre(&r0, &segments), self.names.len());
         let blocks = self.blocks(&errors, &segments)?;
-        let outcomes: Vec<Option<Result<Vec<f64>, String>>> = (0..replicates)
-            .into_par_iter()
-            .map(|b| {
-                if stop() {
-                    return None;
-                }
-                let draw = draw(&errors, &segments, &blocks, seed(self.settings.seed, b));
-                let offset: Vec<f64> = draw.iter().zip(&r0).map(|(d, r)| d - r).collect();
-                let fitted = self
-                    .refit(offset)
-                    .map_err(|e| format!("replicate {b}: {e}"));
-                on_replicate();
-                Some(fitted)
-            })
-            .collect();
+        let replicate = |b: usize, objective: &dyn Objective| {
+            if stop() {
+                return None;
+            }
+            let draw = draw(&errors, &segments, &blocks, seed(self.settings.seed, b));
+            let offset: Vec<f64> = draw.iter().zip(&r0).map(|(d, r)| d - r).collect();
+            let fitted = self
+                .refit(objective, offset)
+                .map_err(|e| format!("replicate {b}: {e}"));
+            on_replicate();
+            Some(fitted)
+        };
+        let outcomes = if self.in_lockstep() {
+            in_lockstep(self.objective, replicates, &replicate)
+        } else {
+            (0..replicates)
+                .into_par_iter()
+                .map(|b| replicate(b, self.objective))
+                .collect()
+        };
         Ok(self.summarise(replicates, blocks, outcomes))
+    }
+
+    /// Whether the replicates' searches run side by side with their evaluations in
+    /// lanes: Nelder–Mead from one start (it evaluates one point after another) on
+    /// an objective that runs in lanes.
+    fn in_lockstep(&self) -> bool {
+        self.settings.method == Method::NelderMead
+            && self.settings.starts == 1
+            && self.objective.in_lanes()
     }
 
     /// The parts' ranges in the residual vector of length `n` (one range when the
@@ -210,14 +231,18 @@ impl Problem<'_> {
 
     /// The fit repeated on the objective shifted by `offset`: the same search from
     /// the same start. The fitted values, in `names`' order.
-    fn refit(&self, offset: Vec<f64>) -> Result<Vec<f64>, IdentifyError> {
+    fn refit(
+        &self,
+        objective: &dyn Objective,
+        offset: Vec<f64>,
+    ) -> Result<Vec<f64>, IdentifyError> {
         let mut base = self.params.clone();
         for (name, &v) in self.names.iter().zip(&self.initial) {
             base.set(name, v).map_err(ObjectiveError::from)?;
         }
         let space = ParamSpace::new(base, &self.names, &self.bounds)?;
         let objective = Corrected {
-            linear: self.objective,
+            linear: objective,
             offset,
         };
         let settings = Settings {
@@ -277,6 +302,45 @@ impl Problem<'_> {
             notes,
         }
     }
+}
+
+/// `replicate(b, objective)` for b in 0..`replicates`, on threads of their own
+/// ([`LANES`] per worker thread), the objective's evaluations gathered into its
+/// lanes ([`Lockstep`]): each replicate's result is the one it gets alone.
+fn in_lockstep<T: Send>(
+    objective: &dyn Objective,
+    replicates: usize,
+    replicate: &(dyn Fn(usize, &dyn Objective) -> T + Sync),
+) -> Vec<T> {
+    let threads = (rayon::current_num_threads() * LANES)
+        .min(replicates)
+        .max(1);
+    let lockstep = Lockstep::new(objective, threads, LANES);
+    let next = AtomicUsize::new(0);
+    let mut outcomes: Vec<(usize, T)> = std::thread::scope(|s| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                s.spawn(|| {
+                    let _seat = lockstep.seat();
+                    let mut mine = Vec::new();
+                    loop {
+                        let b = next.fetch_add(1, Ordering::Relaxed);
+                        if b >= replicates {
+                            break;
+                        }
+                        mine.push((b, replicate(b, &lockstep)));
+                    }
+                    mine
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    outcomes.sort_by_key(|o| o.0);
+    outcomes.into_iter().map(|o| o.1).collect()
 }
 
 /// The residuals less each segment's mean (a bootstrap draws errors of mean zero).

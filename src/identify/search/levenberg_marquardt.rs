@@ -64,12 +64,21 @@ pub(crate) fn run(
     x0: DVector<f64>,
     max_iters: u64,
 ) -> Result<Found, ObjectiveError> {
-    let r0 = problem.residuals(&x0)?;
+    if max_iters == 0 {
+        let r0 = problem.residuals(&x0)?;
+        return Ok(done(Point::new(x0, r0), 0, Termination::IterationLimit));
+    }
+    // The start's residuals with its Jacobian's columns: one batch.
+    let (r0, j0) = problem.residuals_and_jacobian(&x0)?;
     let mut at = Point::new(x0, r0);
+    let mut first = Some(j0);
     let mut lambda = FIRST_DAMPING;
     for iteration in 1..=max_iters {
         problem.monitor.progress().advance(1);
-        let j = problem.jacobian_at(&at.x, &at.r)?;
+        let j = match first.take() {
+            Some(j) => j,
+            None => problem.jacobian_at(&at.x, &at.r)?,
+        };
         problem.monitor.keep_jacobian(SearchJacobian {
             x: at.x.iter().copied().collect(),
             j: j.clone(),

@@ -4,6 +4,7 @@
 //! interrupted continues from where it had got to.
 
 mod levenberg_marquardt;
+pub(crate) mod lockstep;
 pub mod problem;
 pub mod progress;
 pub mod settings;
@@ -38,19 +39,22 @@ pub fn search(
         .filter(|i| !done.iter().any(|d| d.index == *i && d.finished()))
         .count();
     monitor.progress().plan(to_run as u64 * settings.max_iters);
-    let mut records: Vec<StartRecord> = space
-        .starts(settings.starts, settings.seed)
-        .into_par_iter()
-        .enumerate()
-        .map(|(index, initial)| {
-            if let Some(d) = done.iter().find(|d| d.index == index && d.finished()) {
-                return d.clone();
-            }
-            let record = one_start(space, objective, settings, monitor, index, initial);
-            on_done(&record);
-            record
-        })
-        .collect();
+    let start = |(index, initial): (usize, Vec<f64>)| {
+        if let Some(d) = done.iter().find(|d| d.index == index && d.finished()) {
+            return d.clone();
+        }
+        let record = one_start(space, objective, settings, monitor, index, initial);
+        on_done(&record);
+        record
+    };
+    let starts = space.starts(settings.starts, settings.seed);
+    // One start runs on the calling thread (a bootstrap's searches side by side,
+    // search/lockstep.rs, each on a thread of its own), several in parallel.
+    let mut records: Vec<StartRecord> = if starts.len() == 1 {
+        starts.into_iter().enumerate().map(start).collect()
+    } else {
+        starts.into_par_iter().enumerate().map(start).collect()
+    };
     records.sort_by_key(|r| r.index);
     records
 }

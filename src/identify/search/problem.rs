@@ -265,18 +265,42 @@ impl<'a> Problem<'a> {
         x: &DVector<f64>,
         r0: &[f64],
     ) -> Result<DMatrix<f64>, ObjectiveError> {
-        let h = self.fd_step;
-        let shifted: Vec<DVector<f64>> = (0..x.len())
+        let columns = self.evaluate_all(&self.shifted(x))?;
+        Ok(self.differences(r0, &columns))
+    }
+
+    /// The residuals at `x` and their forward-difference Jacobian there, evaluated
+    /// together (one batch, `x` with its shifted points): for a search that starts
+    /// from a point it has not evaluated.
+    pub(crate) fn residuals_and_jacobian(
+        &self,
+        x: &DVector<f64>,
+    ) -> Result<(Vec<f64>, DMatrix<f64>), ObjectiveError> {
+        let mut points = vec![x.clone()];
+        points.extend(self.shifted(x));
+        let mut all = self.evaluate_all(&points)?;
+        let columns = all.split_off(1);
+        let r0 = all.pop().expect("the point's own residuals");
+        let j = self.differences(&r0, &columns);
+        Ok((r0, j))
+    }
+
+    /// `x` shifted by the difference step along each coordinate.
+    fn shifted(&self, x: &DVector<f64>) -> Vec<DVector<f64>> {
+        (0..x.len())
             .map(|j| {
                 let mut xj = x.clone();
-                xj[j] += h;
+                xj[j] += self.fd_step;
                 xj
             })
-            .collect();
-        let columns = self.evaluate_all(&shifted)?;
-        Ok(DMatrix::from_fn(r0.len(), x.len(), |i, j| {
-            (columns[j][i] - r0[i]) / h
-        }))
+            .collect()
+    }
+
+    /// The Jacobian from the residuals `r0` at a point and `columns[j]` at the
+    /// point shifted along coordinate j.
+    fn differences(&self, r0: &[f64], columns: &[Vec<f64>]) -> DMatrix<f64> {
+        let h = self.fd_step;
+        DMatrix::from_fn(r0.len(), columns.len(), |i, j| (columns[j][i] - r0[i]) / h)
     }
 }
 

@@ -16,41 +16,9 @@
 
 use crate::model::lanes::Lanes;
 
-/// The friction state of one body over one step.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Friction {
-    /// Friction torque opposing the motion, N·m (signed; 0 when stuck).
-    pub torque: f64,
-    /// 1 while the body moves, 0 while it sticks (multiplies its acceleration).
-    pub free: f64,
-}
-
-impl Friction {
-    /// Decides, from the sum `t` of all other torques on a body, its velocity `w`
-    /// and its Coulomb friction `fc`, whether it sticks, and against which friction
-    /// torque it slides otherwise (breaking away from rest: opposing `t`).
-    #[inline(always)]
-    pub(crate) fn decide(t: f64, w: f64, fc: f64) -> Self {
-        Friction {
-            torque: decided_torque(t, w, fc),
-            free: decided_free(t, w, fc),
-        }
-    }
-
-    /// The net torque on the body (0 while stuck).
-    #[inline(always)]
-    pub(crate) fn net(self, t: f64) -> f64 {
-        (t - self.torque) * self.free
-    }
-
-    /// Whether the body sticks.
-    pub fn stuck(self) -> bool {
-        self.free == 0.0
-    }
-}
-
-/// The friction torque of [`Friction::decide`]: fc against the motion, or against
-/// `t` when breaking away from rest; 0 when stuck.
+/// The friction torque on a body at velocity `w` under the sum `t` of all its other
+/// torques, with Coulomb level `fc`: fc against the motion, or against `t` when
+/// breaking away from rest; 0 when it sticks (|t| within ±fc at rest).
 #[inline(always)]
 fn decided_torque(t: f64, w: f64, fc: f64) -> f64 {
     // Written as selects (non-short-circuit `|`, one level of `if`) so that the
@@ -65,7 +33,7 @@ fn decided_torque(t: f64, w: f64, fc: f64) -> f64 {
     }
 }
 
-/// The direction the friction of [`Friction::decide`] acts in, with the static level
+/// The direction the friction of [`decided_torque`] acts in, with the static level
 /// `fs`: ±1 against the motion (against `t` when breaking away), 0 when stuck.
 #[inline(always)]
 fn decided_direction(t: f64, w: f64, fs: f64) -> f64 {
@@ -79,7 +47,7 @@ fn decided_direction(t: f64, w: f64, fs: f64) -> f64 {
     }
 }
 
-/// 1 if the body of [`Friction::decide`] moves, 0 if it sticks.
+/// 1 if the body of [`decided_torque`] moves, 0 if it sticks.
 #[inline(always)]
 fn decided_free(t: f64, w: f64, fc: f64) -> f64 {
     if (w > 0.0) | (w < 0.0) | (t > fc) | (t < -fc) {
@@ -89,8 +57,9 @@ fn decided_free(t: f64, w: f64, fc: f64) -> f64 {
     }
 }
 
-/// [`Friction::decide`] for each lane, with each lane's level `fc`: (friction
-/// torques, free flags).
+/// The stick decision of a body with a constant friction level, for each lane with
+/// its own level `fc`: (friction torques [`decided_torque`], free flags 1 or 0).
+/// The net torque on a body is then (t − torque)·free.
 #[inline(always)]
 pub(crate) fn decide_lanes<const L: usize>(
     t: Lanes<L>,
@@ -117,7 +86,9 @@ pub(crate) fn decide_direction_lanes<const L: usize>(
     )
 }
 
-/// [`stop_at_reversal`] for each lane, with each lane's level `fc`.
+/// After a step: a sliding body (with friction, level `fc` > 0) whose velocity
+/// changed sign is put to rest, so that the next step decides between sticking and
+/// reversing; for each lane, with its own level.
 #[inline(always)]
 pub(crate) fn stop_at_reversal_lanes<const L: usize>(
     w_before: Lanes<L>,
@@ -149,42 +120,37 @@ fn lane_wise<const L: usize>(
     Lanes(out)
 }
 
-/// After a step: a sliding body (with friction) whose velocity changed sign is put
-/// to rest, so that the next step decides between sticking and reversing.
-#[inline(always)]
-pub(crate) fn stop_at_reversal(w_before: f64, w_after: &mut f64, fc: f64) {
-    if fc > 0.0 && w_before * *w_after < 0.0 {
-        *w_after = 0.0;
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// The decision of one body: (net torque under `t`, stuck).
+    fn decide(t: f64, w: f64, fc: f64) -> (f64, bool) {
+        let (torque, free) = decide_lanes(Lanes([t]), Lanes([w]), Lanes([fc]));
+        ((t - torque.0[0]) * free.0[0], free.0[0] == 0.0)
+    }
+
     #[test]
     fn holds_within_the_friction_band() {
-        let f = Friction::decide(0.13, 0.0, 0.26);
-        assert!(f.stuck());
-        assert_eq!(f.net(0.13), 0.0);
+        assert_eq!(decide(0.13, 0.0, 0.26), (0.0, true));
     }
 
     #[test]
     fn breaks_away_above_it_with_exactly_fc_opposing() {
-        assert_eq!(Friction::decide(0.5, 0.0, 0.26).net(0.5), 0.5 - 0.26);
-        assert_eq!(Friction::decide(-0.5, 0.0, 0.26).net(-0.5), -0.5 + 0.26);
+        assert_eq!(decide(0.5, 0.0, 0.26), (0.5 - 0.26, false));
+        assert_eq!(decide(-0.5, 0.0, 0.26), (-0.5 + 0.26, false));
     }
 
     #[test]
     fn slides_against_the_velocity() {
-        assert_eq!(Friction::decide(0.0, 1.0, 0.26).net(0.0), -0.26);
-        assert_eq!(Friction::decide(0.0, -1e-9, 0.26).net(0.0), 0.26);
+        assert_eq!(decide(0.0, 1.0, 0.26).0, -0.26);
+        assert_eq!(decide(0.0, -1e-9, 0.26).0, 0.26);
     }
 
     #[test]
     fn without_friction_only_a_balanced_body_at_rest_sticks() {
-        assert!(Friction::decide(0.0, 0.0, 0.0).stuck());
-        assert_eq!(Friction::decide(1e-9, 0.0, 0.0).net(1e-9), 1e-9);
+        assert!(decide(0.0, 0.0, 0.0).1);
+        assert_eq!(decide(1e-9, 0.0, 0.0), (1e-9, false));
     }
 
     #[test]
@@ -199,11 +165,9 @@ mod tests {
 
     #[test]
     fn reversal_only_stops_bodies_with_friction() {
-        let mut w = -1e-6;
-        stop_at_reversal(1e-6, &mut w, 0.26);
-        assert_eq!(w, 0.0);
-        let mut w = -1e-6;
-        stop_at_reversal(1e-6, &mut w, 0.0);
-        assert_eq!(w, -1e-6);
+        let stop =
+            |fc: f64| stop_at_reversal_lanes(Lanes([1e-6]), Lanes([-1e-6]), Lanes([fc])).0[0];
+        assert_eq!(stop(0.26), 0.0);
+        assert_eq!(stop(0.0), -1e-6);
     }
 }

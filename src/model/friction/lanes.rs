@@ -54,12 +54,6 @@ impl<F: FrictionLaw, const L: usize> LaneLaw<F, L> {
         Lanes(out)
     }
 
-    /// Lane `l`'s law.
-    #[inline(always)]
-    pub(crate) fn law(&self, l: usize) -> &F {
-        &self.laws[l]
-    }
-
     /// Lane `l` alone.
     pub(crate) fn lane(&self, l: usize) -> LaneLaw<F, 1> {
         LaneLaw::gather([self.laws[l]])

@@ -32,7 +32,6 @@ mod stribeck;
 #[cfg(test)]
 mod tests;
 
-pub use clamp::Friction;
 pub use coulomb::Coulomb;
 pub use steady::{Body, BodyNames, Rise, SteadyFriction, SHAPE};
 pub use stribeck::Stribeck;
