@@ -510,3 +510,30 @@ fn a_sweep_of_the_positioning_test_in_lanes_gives_each_point_its_lone_outputs() 
         assert_eq!(fields[3..5], alone[..], "row {row}");
     }
 }
+
+#[test]
+fn the_fluctuation_and_torque_outputs_in_lanes_equal_each_point_alone() {
+    // Three points (friction and stiffness 10 % apart): the short fluctuation and
+    // torque-curve tests of all three run in lanes, each point's outputs its own.
+    let p = presets::load("worm-gear").unwrap();
+    let points: Vec<rtid::model::Params> = [0.9, 1.0, 1.1]
+        .iter()
+        .map(|f| {
+            let mut q = p.clone();
+            q.fm *= f;
+            q.kw *= f;
+            q
+        })
+        .collect();
+    let evaluator = sweep::Evaluator {
+        outputs: vec![Output::FluctuationPp, Output::TorqueRms],
+        tests: TestLength::Short,
+        topology: p.topology,
+    };
+    let batch = evaluator.evaluate_batch(&points);
+    for (l, (q, got)) in points.iter().zip(&batch).enumerate() {
+        let alone = evaluator.evaluate(q).unwrap();
+        assert_eq!(got.as_ref().unwrap(), &alone, "point {l}");
+    }
+    assert_ne!(batch[0].as_ref().unwrap(), batch[2].as_ref().unwrap());
+}

@@ -37,7 +37,8 @@
 //!
 //! **Lanes.** The common path of a step has no per-lane control flow: the dead
 //! zones, the contact clamp, the friction decision and the stop at a velocity
-//! reversal are selects between values computed for every lane (backlash.rs,
+//! reversal (in the rigid step: after a branch on whether any lane reverses) are
+//! selects between values computed for every lane (backlash.rs,
 //! friction/clamp.rs, lanes.rs), so the compiler vectorises the `L` lanes. What is rare
 //! is taken out of line, and only when some lane needs it: the library `sin_cos` of
 //! the fluctuation phase (every 1024 steps, or after a jump), and the re-integration
@@ -677,13 +678,23 @@ fn rigid_rk4<const L: usize, F: FrictionLaw>(
     load: &[f64; L],
     h: f64,
 ) {
-    let (ct, inv_jt, load) = (d.ct, d.inv_jt, Lanes(*load));
+    let (ct, load) = (d.ct, Lanes(*load));
     let (t1, w1) = (Lanes(y[THETA_T]), Lanes(y[OMEGA_T]));
-    let torque =
-        |t: Lanes<L>, w: Lanes<L>, m: [f64; L]| Lanes(m) - ct * w + rigid_unbalance(d, t) + load;
+    // Without unbalance its term is left out rather than added as 0: (x + 0) + load
+    // is x + load for every x and a load that is not −0 (a load is 0 + Tload), one
+    // addition fewer on the chain from stage to stage.
+    let torque = |t: Lanes<L>, w: Lanes<L>, m: [f64; L]| {
+        let own = Lanes(m) - ct * w;
+        let own = if d.unbalance {
+            own + rigid_unbalance(d, t)
+        } else {
+            own
+        };
+        own + load
+    };
     let first = torque(t1, w1, motor[0]);
-    let friction = RigidFriction::decide(laws, first, w1);
-    let accel = |t: Lanes<L>, w: Lanes<L>| friction.net(t, w) * inv_jt;
+    let friction = RigidFriction::decide(laws, first, w1, d.inv_jt);
+    let accel = |t: Lanes<L>, w: Lanes<L>| friction.accel(t, w);
     let a1 = accel(first, w1);
     let (t2, w2) = (t1 + 0.5 * h * w1, w1 + 0.5 * h * a1);
     let a2 = accel(torque(t2, w2, motor[1]), w2);
@@ -718,13 +729,16 @@ struct RigidFriction<'a, F, const L: usize> {
     torque_or_direction: Lanes<L>,
     /// 1 while the body moves, 0 while it sticks.
     free: Lanes<L>,
+    /// free / Jt: net torque → acceleration (0 while stuck).
+    gain: Lanes<L>,
     laws: &'a LaneLaw<F, L>,
 }
 
 impl<'a, F: FrictionLaw, const L: usize> RigidFriction<'a, F, L> {
-    /// The stick decision from the torque `t` on the body at velocity `w`.
+    /// The stick decision from the torque `t` on the body at velocity `w`, its
+    /// inverse inertia `inv_j`.
     #[inline(always)]
-    fn decide(laws: &'a LaneLaw<F, L>, t: Lanes<L>, w: Lanes<L>) -> Self {
+    fn decide(laws: &'a LaneLaw<F, L>, t: Lanes<L>, w: Lanes<L>, inv_j: Lanes<L>) -> Self {
         let (torque_or_direction, free) = if F::CONSTANT_LEVEL {
             decide_lanes(t, w, laws.breakaway(2))
         } else {
@@ -733,20 +747,23 @@ impl<'a, F: FrictionLaw, const L: usize> RigidFriction<'a, F, L> {
         RigidFriction {
             torque_or_direction,
             free,
+            gain: free * inv_j,
             laws,
         }
     }
 
-    /// The net torque at velocity `w` under the other torques `t` (0 while stuck):
-    /// (t − friction)·free.
+    /// The acceleration at velocity `w` under the other torques `t`:
+    /// (t − friction)·(free/Jt), 0 while stuck. (free ∈ {0, 1} and 1/Jt > 0, so
+    /// this equals ((t − friction)·free)/Jt bit for bit, one multiplication fewer
+    /// on the chain from stage to stage.)
     #[inline(always)]
-    fn net(self, t: Lanes<L>, w: Lanes<L>) -> Lanes<L> {
+    fn accel(self, t: Lanes<L>, w: Lanes<L>) -> Lanes<L> {
         let torque = if F::CONSTANT_LEVEL {
             self.torque_or_direction
         } else {
             self.torque_or_direction * self.laws.sliding(2, w.map(f64::abs))
         };
-        (t - torque) * self.free
+        (t - torque) * self.gain
     }
 }
 

@@ -26,10 +26,12 @@ use super::definition::{Definition, SetupError, Source};
 use super::detail::list;
 use super::{Detail, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::fluctuation::{
-    self, locate_step, pass_samples, run_window, FluctuationTest, STEP_LOCATE_HALF_WIDTH,
+    self, locate_step, pass_samples, run_window, run_window_batch, FluctuationTest, Record,
+    STEP_LOCATE_HALF_WIDTH,
 };
 use crate::io::experiment_file::{Direction, Experiment, Kind};
 use crate::model::Params;
+use crate::sim::SimError;
 
 /// The unbalance-step objective: closed-loop simulations (rough); determines the
 /// table's Coulomb friction ft.
@@ -170,21 +172,45 @@ impl UnbalanceStep {
     }
 
     fn model_step(&self, p: &Params, st: &MeasuredStep) -> Result<Option<f64>, ObjectiveError> {
+        let (from, to) = self.window(st);
+        let record = run_window(p, &self.test, from, to)?;
+        Ok(self.located(&record, p, st))
+    }
+
+    /// The table angles (rad) from and to which the model runs to find the step
+    /// `st`: a run-in before its window, a run-out after.
+    fn window(&self, st: &MeasuredStep) -> (f64, f64) {
         let sense = st.sense();
         let h = STEP_LOCATE_HALF_WIDTH;
         let from = sense * (st.center - h - self.run_in);
         let to = sense * (st.center + h + WINDOW_RUN_OUT);
-        let record = run_window(p, &self.test, from, to)?;
-        let Some(pass) = pass_samples(&record, p.ratio())
+        (from, to)
+    }
+
+    /// The step of `record` (a run of `p` through `st`'s window) in `st`'s window,
+    /// deg, if it has one of the measured step's sign and at least half its size.
+    fn located(&self, record: &Record, p: &Params, st: &MeasuredStep) -> Option<f64> {
+        let sense = st.sense();
+        let h = STEP_LOCATE_HALF_WIDTH;
+        let pass = pass_samples(record, p.ratio())
             .into_iter()
-            .find(|s| s.sense == sense)
-        else {
-            return Ok(None);
-        };
-        Ok(locate_step(&pass, st.center, h).and_then(|(x, size)| {
+            .find(|s| s.sense == sense)?;
+        locate_step(&pass, st.center, h).and_then(|(x, size)| {
             let same = size * st.size_arcsec > 0.0 && size.abs() >= 0.5 * st.size_arcsec.abs();
             same.then(|| (sense * x).to_degrees())
-        }))
+        })
+    }
+
+    /// The scaled residuals of the model's step angles `model` (deg).
+    fn scaled(&self, model: &[Option<f64>]) -> Vec<f64> {
+        model
+            .iter()
+            .zip(&self.steps)
+            .map(|(m, st)| match m {
+                Some(a) => (a - st.angle_deg) / SCALE_DEG,
+                None => MISSING_STEP_RESIDUAL,
+            })
+            .collect()
     }
 }
 
@@ -194,15 +220,36 @@ impl Objective for UnbalanceStep {
     }
 
     fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
-        Ok(self
-            .model_deg(p)?
+        Ok(self.scaled(&self.model_deg(p)?))
+    }
+
+    /// Each step's window run for all the points together in the kernel's lanes
+    /// (the windows in parallel): each point's residuals what it gives alone.
+    fn residuals_batch(&self, points: &[Params]) -> Vec<Result<Vec<f64>, ObjectiveError>> {
+        let per_step: Vec<Vec<Result<Record, SimError>>> = self
+            .steps
+            .par_iter()
+            .map(|st| run_window_batch(points, &self.test, self.window(st)))
+            .collect();
+        let mut per_step: Vec<_> = per_step.into_iter().map(Vec::into_iter).collect();
+        points
             .iter()
-            .zip(&self.steps)
-            .map(|(m, st)| match m {
-                Some(a) => (a - st.angle_deg) / SCALE_DEG,
-                None => MISSING_STEP_RESIDUAL,
+            .map(|p| {
+                let records: Vec<_> = per_step
+                    .iter_mut()
+                    .map(|r| r.next().expect("one record per point"))
+                    .collect();
+                let mut model = Vec::with_capacity(self.steps.len());
+                for (st, record) in self.steps.iter().zip(records) {
+                    model.push(self.located(&record?, p, st));
+                }
+                Ok(self.scaled(&model))
             })
-            .collect())
+            .collect()
+    }
+
+    fn in_lanes(&self) -> bool {
+        true
     }
 
     fn len(&self) -> usize {

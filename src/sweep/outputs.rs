@@ -229,41 +229,46 @@ impl Evaluator {
 
     /// The outputs at `p`, one value per column (`None`: no such peak).
     pub fn evaluate(&self, p: &Params) -> Result<Vec<Option<f64>>, OutputError> {
-        self.evaluate_with(p, None)
+        self.evaluate_with(p, Runs::default())
     }
 
     /// The outputs at each of `points`, in order, each what [`Evaluator::evaluate`]
-    /// gives for it: the positioning tests of all the points run together in the
-    /// kernel's lanes (`positioning::run_batch`), the other outputs point by point.
+    /// gives for it: the closed-loop tests of all the points (positioning,
+    /// fluctuation, torque curve) run together in the kernel's lanes (their
+    /// `run_batch`), the other outputs point by point.
     pub fn evaluate_batch(&self, points: &[Params]) -> Vec<Result<Vec<Option<f64>>, OutputError>> {
-        let positioning = self.outputs.iter().any(|o| {
-            matches!(
-                o,
-                Output::Reversal | Output::Repeatability | Output::Accuracy
-            )
-        });
-        let mut measured: Vec<Option<_>> = if positioning && points.len() > 1 {
-            positioning::run_batch(points, &self.tests.positioning())
-                .into_iter()
-                .map(Some)
-                .collect()
-        } else {
-            points.iter().map(|_| None).collect()
+        let wants = |outputs: &[Output]| {
+            points.len() > 1 && self.outputs.iter().any(|o| outputs.contains(o))
         };
+        let mut runs: Vec<Runs> = points.iter().map(|_| Runs::default()).collect();
+        if wants(&[Output::Reversal, Output::Repeatability, Output::Accuracy]) {
+            let batch = positioning::run_batch(points, &self.tests.positioning());
+            runs.iter_mut()
+                .zip(batch)
+                .for_each(|(r, m)| r.positioning = Some(m));
+        }
+        if wants(&[Output::FluctuationPp]) {
+            let batch = fluctuation::run_batch(points, &self.tests.fluctuation());
+            runs.iter_mut()
+                .zip(batch)
+                .for_each(|(r, m)| r.fluctuation = Some(m));
+        }
+        if wants(&[Output::TorqueRms]) {
+            let batch = torque_curve::run_batch(points, &self.tests.torque());
+            runs.iter_mut()
+                .zip(batch)
+                .for_each(|(r, m)| r.torque = Some(m));
+        }
         points
             .iter()
-            .zip(&mut measured)
-            .map(|(p, m)| self.evaluate_with(p, m.take()))
+            .zip(runs)
+            .map(|(p, r)| self.evaluate_with(p, r))
             .collect()
     }
 
-    /// [`Evaluator::evaluate`], with the positioning test's readings at `p` when
-    /// they were measured already (`measured`).
-    fn evaluate_with(
-        &self,
-        p: &Params,
-        mut measured: Option<Result<Vec<iso230::Measurement>, SimError>>,
-    ) -> Result<Vec<Option<f64>>, OutputError> {
+    /// [`Evaluator::evaluate`], with the closed-loop tests at `p` that were run
+    /// already (`runs`).
+    fn evaluate_with(&self, p: &Params, mut runs: Runs) -> Result<Vec<Option<f64>>, OutputError> {
         p.validate()?;
         let mut out = Vec::new();
         let mut peaks: Option<Vec<Peak>> = None;
@@ -288,7 +293,7 @@ impl Evaluator {
                 }
                 Output::Reversal | Output::Repeatability | Output::Accuracy => {
                     if iso.is_none() {
-                        let m = match measured.take() {
+                        let m = match runs.positioning.take() {
                             Some(m) => m?,
                             None => positioning::run(p, &self.tests.positioning(), |_, _| {})?,
                         };
@@ -303,7 +308,10 @@ impl Evaluator {
                 }
                 Output::FluctuationPp => {
                     let test = self.tests.fluctuation();
-                    let record = fluctuation::run(p, &test, |_, _| {})?;
+                    let record = match runs.fluctuation.take() {
+                        Some(r) => r?,
+                        None => fluctuation::run(p, &test, |_, _| {})?,
+                    };
                     out.push(Some(match self.tests {
                         TestLength::Full => fluctuation::evaluate(&record, p.ratio())?.pp_arcsec,
                         TestLength::Short => short_fluctuation_pp(&record, &test, p.ratio()),
@@ -311,7 +319,10 @@ impl Evaluator {
                 }
                 Output::TorqueRms => {
                     let test = self.tests.torque();
-                    let curve = torque_curve::run(p, &test, |_, _| {})?;
+                    let curve = match runs.torque.take() {
+                        Some(c) => c?,
+                        None => torque_curve::run(p, &test, |_, _| {})?,
+                    };
                     out.push(Some(torque_curve::evaluate(&curve, &test)?.rms_nm));
                 }
             }
@@ -325,6 +336,15 @@ impl Evaluator {
         }
         Ok(out)
     }
+}
+
+/// The closed-loop tests of one point run already (in a batch's lanes), each taken
+/// by the output that reads it.
+#[derive(Default)]
+struct Runs {
+    positioning: Option<Result<Vec<iso230::Measurement>, SimError>>,
+    fluctuation: Option<Result<fluctuation::Record, SimError>>,
+    torque: Option<Result<torque_curve::TorqueCurve, SimError>>,
 }
 
 /// Travel skipped at each end of a pass of the short fluctuation test, rad: the

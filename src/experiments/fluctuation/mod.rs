@@ -30,8 +30,8 @@ mod tests;
 
 pub use evaluate::{evaluate, evaluate_experiment, ratio, Evaluation, Pass};
 pub use record::{from_data, manifest, to_data};
-pub(crate) use run::run_window;
-pub use run::{run, Record};
+pub use run::{run, run_batch, Record};
+pub(crate) use run::{run_window, run_window_batch};
 pub(crate) use steps::pass_samples;
 pub use steps::{locate_step, PassSamples, Step};
 

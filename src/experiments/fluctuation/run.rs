@@ -10,7 +10,8 @@ use crate::model::params::Params;
 use crate::model::rest::{rest_state, Preload};
 use crate::model::NSTATE;
 use crate::recorder::Recorder;
-use crate::sim::{SimError, Simulation};
+use crate::sim::batch::{in_lanes, LaneRun};
+use crate::sim::{common_step, LaneSimulation, SimError};
 
 /// Keeps every `every`-th step's encoder readings in vectors reserved up front.
 struct Sampler {
@@ -21,6 +22,22 @@ struct Sampler {
     time: Vec<f64>,
     motor: Vec<f64>,
     table: Vec<f64>,
+}
+
+impl Sampler {
+    /// Every `every`-th step of a run of `p`, about `samples` of them.
+    fn new(p: &Params, every: u64, samples: usize) -> Sampler {
+        let counts = p.controller.motor_encoder_counts;
+        Sampler {
+            every,
+            count: 0,
+            motor_quantum: if counts > 0.0 { TAU / counts } else { 0.0 },
+            table_quantum: p.controller.table_encoder_resolution,
+            time: Vec::with_capacity(samples),
+            motor: Vec::with_capacity(samples),
+            table: Vec::with_capacity(samples),
+        }
+    }
 }
 
 impl Recorder for Sampler {
@@ -73,16 +90,78 @@ pub(crate) fn run_window(
     from: f64,
     to: f64,
 ) -> Result<Record, SimError> {
+    let (reference, duration) = window(test, from, to);
+    run_reference(params, test, &reference, duration, |_, _| {})
+}
+
+/// The test on each of `params`, in order, in the kernel's lanes where the sets can
+/// share them (`sim::batch`): each record is what [`run`] gives for its set alone.
+pub fn run_batch(params: &[Params], test: &FluctuationTest) -> Vec<Result<Record, SimError>> {
+    let sets: Vec<Params> = params.iter().map(|p| test_params(p, test)).collect();
+    let reference = |t: f64| test.reference(t);
+    let passes = Passes {
+        test,
+        reference: &reference,
+        duration: test.duration(),
+    };
+    in_lanes(&sets, &passes)
+}
+
+/// The windows of [`run_window`] on each of `params` (`windows[i]` for set i,
+/// radians from, to), in the kernel's lanes where the sets and their windows can
+/// share them: each record is what `run_window` gives alone.
+pub(crate) fn run_window_batch(
+    params: &[Params],
+    test: &FluctuationTest,
+    (from, to): (f64, f64),
+) -> Vec<Result<Record, SimError>> {
+    let sets: Vec<Params> = params.iter().map(|p| test_params(p, test)).collect();
+    let (reference, duration) = window(test, from, to);
+    let passes = Passes {
+        test,
+        reference: &reference,
+        duration,
+    };
+    in_lanes(&sets, &passes)
+}
+
+/// The reference of a window: at rest at `from` for the test's dwell, then at the
+/// test's speed to `to`; and its duration.
+fn window(test: &FluctuationTest, from: f64, to: f64) -> (impl Fn(f64) -> f64 + '_, f64) {
     let sense = (to - from).signum();
     let ramp = (to - from).abs() / test.speed;
-    let reference = |t: f64| {
+    let reference = move |t: f64| {
         if t < test.dwell {
             from
         } else {
             from + sense * test.speed * (t - test.dwell).min(ramp)
         }
     };
-    run_reference(params, test, &reference, test.dwell + ramp, |_, _| {})
+    (reference, test.dwell + ramp)
+}
+
+/// A run of the test along `reference` (table angle over time, starting at rest at
+/// `reference(0)`) for `duration` s, as a [`LaneRun`].
+struct Passes<'a> {
+    test: &'a FluctuationTest,
+    reference: &'a dyn Fn(f64) -> f64,
+    duration: f64,
+}
+
+impl LaneRun for Passes<'_> {
+    type Out = Record;
+
+    fn lone(&self, p: &Params) -> Result<Record, SimError> {
+        let [one] = run_lanes(std::array::from_ref(p), self, |_, _| {})?;
+        one
+    }
+
+    fn lanes<const L: usize>(
+        &self,
+        params: &[Params; L],
+    ) -> Result<[Result<Record, SimError>; L], SimError> {
+        run_lanes(params, self, |_, _| {})
+    }
 }
 
 /// Runs `reference` (table angle over time, starting at rest at `reference(0)`) for
@@ -92,34 +171,55 @@ fn run_reference(
     test: &FluctuationTest,
     reference: &dyn Fn(f64) -> f64,
     duration: f64,
-    mut progress: impl FnMut(usize, usize),
+    progress: impl FnMut(usize, usize),
 ) -> Result<Record, SimError> {
     let p = test_params(params, test);
-    let mut sim = Simulation::with_default_step(&p)?;
-    let start = reference(0.0);
-    sim.set_state(rest_state(&p, start, Preload::None));
-    let mut controller = sim.controller(&p)?;
-    let every = ((test.sample_period / sim.dt()).round() as u64).max(1);
-    let samples = (duration / sim.dt()) as usize / every as usize + 2;
-    let counts = p.controller.motor_encoder_counts;
-    let mut rec = Sampler {
-        every,
-        count: 0,
-        motor_quantum: if counts > 0.0 { TAU / counts } else { 0.0 },
-        table_quantum: p.controller.table_encoder_resolution,
-        time: Vec::with_capacity(samples),
-        motor: Vec::with_capacity(samples),
-        table: Vec::with_capacity(samples),
+    let passes = Passes {
+        test,
+        reference,
+        duration,
     };
-    let total = duration.ceil() as usize;
-    for second in 0..total {
-        let chunk = (duration - second as f64).min(1.0);
-        sim.run_closed_loop(&mut controller, &reference, chunk, &mut rec)?;
-        progress(second + 1, total);
+    let [one] = run_lanes(std::array::from_ref(&p), &passes, progress)?;
+    one
+}
+
+/// [`Passes`] on `L` parameter sets at once (already [`test_params`]), lane `l` as a
+/// lone run of `params[l]` computes it (a set that diverges fails alone);
+/// `progress(done, total)` reports simulated seconds.
+fn run_lanes<const L: usize>(
+    params: &[Params; L],
+    passes: &Passes<'_>,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<[Result<Record, SimError>; L], SimError> {
+    let dt = common_step(params)?;
+    let mut sim = LaneSimulation::<L>::of(params, dt)?;
+    let start = (passes.reference)(0.0);
+    for (l, p) in params.iter().enumerate() {
+        sim.start(l, rest_state(p, start, Preload::None), 0.0);
     }
-    Ok(Record {
-        time: rec.time,
-        motor_angle: rec.motor,
-        table_angle: rec.table,
-    })
+    let mut controllers = sim.controllers(params)?;
+    let every = ((passes.test.sample_period / dt).round() as u64).max(1);
+    let samples = (passes.duration / dt) as usize / every as usize + 2;
+    let mut rec: [Sampler; L] = std::array::from_fn(|l| Sampler::new(&params[l], every, samples));
+    let mut failed: [Option<SimError>; L] = std::array::from_fn(|_| None);
+    let total = passes.duration.ceil() as usize;
+    for second in 0..total {
+        let chunk = (passes.duration - second as f64).min(1.0);
+        let run = (&mut controllers, &mut rec);
+        sim.run_closed_loop(run, &passes.reference, chunk, &mut failed)?;
+        progress(second + 1, total);
+        if failed.iter().all(Option::is_some) {
+            break;
+        }
+    }
+    let mut rec = rec.into_iter();
+    Ok(failed.map(|f| {
+        let r = rec.next().expect("one per lane");
+        let record = Record {
+            time: r.time,
+            motor_angle: r.motor,
+            table_angle: r.table,
+        };
+        f.map_or(Ok(record), Err)
+    }))
 }

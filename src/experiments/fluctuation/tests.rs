@@ -94,3 +94,27 @@ fn standstill_is_an_error_and_a_bad_ratio_too() {
         Err(FluctuationError::BadRatio { .. })
     ));
 }
+
+#[test]
+fn windows_in_lanes_equal_each_set_s_lone_window() {
+    // Three worm sets of one shape (a fourth lane padded), an unbalance test's
+    // window through 3°: each record bit for bit the lone run's.
+    let test = FluctuationTest::unbalance(10.0, 0.1);
+    let base = crate::model::presets::load("worm-gear").unwrap();
+    let sets: Vec<crate::model::Params> = [0.5, 1.0, 2.0]
+        .iter()
+        .map(|f| {
+            let mut p = base.clone();
+            p.ft *= f;
+            p.fm *= f;
+            p
+        })
+        .collect();
+    let window = (-0.5f64.to_radians(), 3f64.to_radians());
+    let batch = run_window_batch(&sets, &test, window);
+    for (l, (p, got)) in sets.iter().zip(&batch).enumerate() {
+        let alone = run_window(p, &test, window.0, window.1).unwrap();
+        assert_eq!(got.as_ref().unwrap(), &alone, "set {l}");
+    }
+    assert_ne!(batch[0], batch[2], "the sets differ");
+}

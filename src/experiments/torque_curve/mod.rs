@@ -29,7 +29,7 @@ pub use evaluate::{
     TorqueReport,
 };
 pub use record::{from_data, manifest, to_data};
-pub use run::{run, simulate_torque, simulate_torque_batch};
+pub use run::{run, run_batch, simulate_torque, simulate_torque_batch};
 
 use crate::input::Harmonic;
 use crate::io::experiment_file::{Conditions, Kind};

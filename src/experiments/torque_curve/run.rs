@@ -123,6 +123,32 @@ pub fn run(
     one
 }
 
+/// [`run`] on each of `params`, in order, in the kernel's lanes where the sets can
+/// share them (`sim::batch`): each curve is what `run` gives for its set alone.
+pub fn run_batch(params: &[Params], test: &TorqueTest) -> Vec<Result<TorqueCurve, SimError>> {
+    let sets: Vec<Params> = params.iter().map(|p| test_params(p, test)).collect();
+    in_lanes(&sets, &Curves(test))
+}
+
+/// The whole test, for `sim::batch`.
+struct Curves<'a>(&'a TorqueTest);
+
+impl LaneRun for Curves<'_> {
+    type Out = TorqueCurve;
+
+    fn lone(&self, p: &Params) -> Result<TorqueCurve, SimError> {
+        let [one] = self.lanes(std::array::from_ref(p))?;
+        one
+    }
+
+    fn lanes<const L: usize>(
+        &self,
+        params: &[Params; L],
+    ) -> Result<[Result<TorqueCurve, SimError>; L], SimError> {
+        simulate_lanes(params, self.0, self.0.duration(), |_, _| {})
+    }
+}
+
 /// The motor torque of the test on the model at `times` (s after the run-in, as in a
 /// recorded file), linearly interpolated between the recorded samples; times before 0
 /// give the first sample. `test.periods` is ignored: the run lasts to the last time.
