@@ -4,7 +4,7 @@
 //! `servo_trace/idim` — the IDIM-LS friction law (filters, decimation, least squares);
 //! `servo_trace/replay` — one closed-loop replay of the whole record on the published
 //! model, the unit of cost of the output-error identification (`servo-trace`
-//! objective: ~110 replays from the IDIM estimate);
+//! objective: 14 replays from the IDIM estimate with Levenberg–Marquardt);
 //! `servo_trace/replay_4_sets/{lanes,lone}` — four parameter sets (a Jacobian's
 //! columns) replayed in the kernel's lanes, and one after another;
 //! `servo_trace/replay_drive_functions` — the same with the drive's functions on:
