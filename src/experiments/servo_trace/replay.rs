@@ -63,8 +63,9 @@ pub struct Misfit {
 /// of the velocity loop. The trace's recorded drive functions (feed-forward,
 /// filters), if any, replace the model's controller's.
 pub fn replay(params: &Params, trace: &ServoTrace) -> Result<Replay, TraceError> {
-    let p = prepared(params, trace)?;
-    Ok(TraceRun::of(trace)?.lone(&p)?)
+    let run = TraceRun::of(trace)?;
+    let p = prepared(params, trace, run.period)?;
+    Ok(run.lone(&p)?)
 }
 
 /// [`replay`] of `trace` on each of `params`, in order, in the kernel's lanes where
@@ -75,7 +76,10 @@ pub fn replay_batch(params: &[Params], trace: &ServoTrace) -> Vec<Result<Replay,
         Ok(run) => run,
         Err(e) => return params.iter().map(|_| Err(e.clone())).collect(),
     };
-    let sets = params.iter().map(|p| prepared(p, trace)).collect();
+    let sets = params
+        .iter()
+        .map(|p| prepared(p, trace, run.period))
+        .collect();
     on_valid(sets, |sets| {
         in_lanes(sets, &run)
             .into_iter()
@@ -84,11 +88,11 @@ pub fn replay_batch(params: &[Params], trace: &ServoTrace) -> Vec<Result<Replay,
     })
 }
 
-/// `params` as the replay runs them: the controller's period the record's (when
-/// they differ by more than [`SAME_PERIOD`]), the trace's recorded drive functions
-/// set; refused if the replay would take more than [`MAX_REPLAY_STEPS`] steps.
-fn prepared(params: &Params, trace: &ServoTrace) -> Result<Params, TraceError> {
-    let period = trace.check()?;
+/// `params` as the replay of `trace` (its sample period `period`, checked) runs
+/// them: the controller's period the record's (when they differ by more than
+/// [`SAME_PERIOD`]), the trace's recorded drive functions set; refused if the replay
+/// would take more than [`MAX_REPLAY_STEPS`] steps.
+fn prepared(params: &Params, trace: &ServoTrace, period: f64) -> Result<Params, TraceError> {
     let mut p = params.clone();
     if (period / p.controller.tc - 1.0).abs() > SAME_PERIOD {
         p.controller.tc = period;
@@ -104,6 +108,8 @@ fn prepared(params: &Params, trace: &ServoTrace) -> Result<Params, TraceError> {
 /// A trace's replay as a [`LaneRun`]: its reference and added signal, and where
 /// the run starts.
 struct TraceRun<'a> {
+    /// The record's sample period, s ([`ServoTrace::check`]).
+    period: f64,
     time_s: &'a [f64],
     reference: &'a [f64],
     added: Option<&'a [f64]>,
@@ -120,6 +126,7 @@ impl<'a> TraceRun<'a> {
             velocity: (trace.position[1] - trace.position[0]) / period,
         };
         Ok(TraceRun {
+            period,
             time_s: &trace.time_s,
             reference: &trace.reference,
             added: trace.controller_added.as_deref(),
