@@ -7,6 +7,8 @@
 //! objective: 14 replays from the IDIM estimate with Levenberg–Marquardt);
 //! `servo_trace/replay_4_sets/{lanes,lone}` — four parameter sets (a Jacobian's
 //! columns) replayed in the kernel's lanes, and one after another;
+//! `servo_trace/replay_2_sets/lanes` — two of them, as each core runs a Jacobian's
+//! four columns on two cores;
 //! `servo_trace/replay_drive_functions` — the same with the drive's functions on:
 //! velocity and torque feed-forward, the symmetrising lag and four setpoint filters;
 //! `servo_trace/identify` — the whole EMPS identification as `rtid identify` runs it:
@@ -55,6 +57,10 @@ fn bench(c: &mut Criterion) {
     });
     group.bench_function("replay_4_sets/lone", |b| {
         b.iter(|| sets.iter().map(|p| replay(p, &trace)).collect::<Vec<_>>())
+    });
+    // Two sets in lanes: a Jacobian of four columns split over two cores.
+    group.bench_function("replay_2_sets/lanes", |b| {
+        b.iter(|| replay_batch(&sets[..2], &trace))
     });
     let functions = with_drive_functions(&params);
     group.bench_function("replay_drive_functions", |b| {

@@ -3,7 +3,9 @@
 //! keeps a 6000-sample torque curve from drowning two resonance frequencies; the
 //! weight (`--weight`) says how much each experiment should count.
 
-use super::{Objective, ObjectiveError, ObjectiveKind, Smoothness};
+use std::sync::Mutex;
+
+use super::{sum_of_squares, Objective, ObjectiveError, ObjectiveKind, Smoothness};
 use crate::model::Params;
 
 /// One weighted part of a joint objective.
@@ -20,6 +22,16 @@ pub struct Part {
 #[derive(Default)]
 pub struct Joint {
     pub parts: Vec<Part>,
+    /// The point of lowest cost evaluated so far, with its parts' residuals: the
+    /// identified point's report reads them instead of running every test again.
+    lowest: Mutex<Option<Lowest>>,
+}
+
+/// A point and each part's residuals there.
+struct Lowest {
+    params: Params,
+    parts: Vec<Vec<f64>>,
+    cost: f64,
 }
 
 impl Joint {
@@ -62,12 +74,35 @@ impl Joint {
             .collect()
     }
 
-    /// Each part's own (unweighted) residuals, for reports.
+    /// Each part's own (unweighted) residuals, for reports: those kept where `p` is
+    /// the lowest point evaluated (the search's result), else evaluated.
     pub(crate) fn part_residuals(&self, p: &Params) -> Result<Vec<Vec<f64>>, ObjectiveError> {
+        if let Ok(lowest) = self.lowest.lock() {
+            if let Some(l) = lowest.as_ref().filter(|l| l.params == *p) {
+                return Ok(l.parts.clone());
+            }
+        }
         self.parts
             .iter()
             .map(|part| part.objective.residuals(p))
             .collect()
+    }
+
+    /// The joint residuals at `p` from its parts' `parts`, the point kept if its
+    /// cost is the lowest so far.
+    fn stacked(&self, p: &Params, parts: Vec<Vec<f64>>) -> Vec<f64> {
+        let all = self.stack(&parts);
+        let cost = sum_of_squares(&all);
+        if let Ok(mut lowest) = self.lowest.lock() {
+            if cost.is_finite() && lowest.as_ref().map_or(true, |l| cost < l.cost) {
+                *lowest = Some(Lowest {
+                    params: p.clone(),
+                    parts,
+                    cost,
+                });
+            }
+        }
+        all
     }
 }
 
@@ -77,31 +112,33 @@ impl Objective for Joint {
     }
 
     fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
-        let mut all = Vec::with_capacity(self.len());
-        for part in &self.parts {
-            let k = Self::factor(part);
-            all.extend(part.objective.residuals(p)?.into_iter().map(|r| k * r));
-        }
-        Ok(all)
+        let parts = self
+            .parts
+            .iter()
+            .map(|part| part.objective.residuals(p))
+            .collect::<Result<_, _>>()?;
+        Ok(self.stacked(p, parts))
     }
 
     fn residuals_batch(&self, points: &[Params]) -> Vec<Result<Vec<f64>, ObjectiveError>> {
-        let mut all: Vec<Result<Vec<f64>, ObjectiveError>> = points
+        let mut each: Vec<Result<Vec<Vec<f64>>, ObjectiveError>> = points
             .iter()
-            .map(|_| Ok(Vec::with_capacity(self.len())))
+            .map(|_| Ok(Vec::with_capacity(self.parts.len())))
             .collect();
         for part in &self.parts {
-            let k = Self::factor(part);
-            for (acc, r) in all.iter_mut().zip(part.objective.residuals_batch(points)) {
-                if let Ok(v) = acc {
+            for (acc, r) in each.iter_mut().zip(part.objective.residuals_batch(points)) {
+                if let Ok(parts) = acc {
                     match r {
-                        Ok(r) => v.extend(r.into_iter().map(|r| k * r)),
+                        Ok(r) => parts.push(r),
                         Err(e) => *acc = Err(e),
                     }
                 }
             }
         }
-        all
+        each.into_iter()
+            .zip(points)
+            .map(|(parts, p)| Ok(self.stacked(p, parts?)))
+            .collect()
     }
 
     fn in_lanes(&self) -> bool {
@@ -119,8 +156,10 @@ impl Objective for Joint {
 
 #[cfg(test)]
 mod tests {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Arc;
+
     use super::*;
-    use crate::objectives::sum_of_squares;
 
     struct Constant(Vec<f64>);
     impl Objective for Constant {
@@ -149,5 +188,45 @@ mod tests {
         assert!((cost - (2.0 * 5.0 + 0.5 * 16.0)).abs() < 1e-12, "{cost}");
         let parts = j.part_residuals(&p).unwrap();
         assert_eq!(j.stack(&parts), j.residuals(&p).unwrap());
+    }
+
+    /// Residuals Kw / 3e5 − 1 and 1, counting its evaluations.
+    struct Counted(Arc<AtomicUsize>);
+    impl Objective for Counted {
+        fn name(&self) -> &'static str {
+            "counted"
+        }
+        fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
+            self.0.fetch_add(1, Ordering::Relaxed);
+            Ok(vec![p.kw / 3e5 - 1.0, 1.0])
+        }
+        fn len(&self) -> usize {
+            2
+        }
+        fn scale(&self) -> String {
+            String::new()
+        }
+    }
+
+    /// The identified point's report reads the parts kept at the lowest point
+    /// evaluated — the numbers an evaluation gives — and evaluates any other point.
+    #[test]
+    fn the_lowest_point_s_parts_are_kept_not_evaluated_again() {
+        let base = crate::model::presets::load("worm-gear").unwrap();
+        let at = |kw: f64| Params { kw, ..base.clone() };
+        let count = Arc::new(AtomicUsize::new(0));
+        let mut j = Joint::default();
+        let kind = ObjectiveKind::named("resonance").unwrap();
+        j.push("a", 1.0, kind, Box::new(Counted(Arc::clone(&count))));
+        let batch = j.residuals_batch(&[at(2e5), at(2.9e5), at(4e5)]);
+        j.residuals(&at(3.5e5)).unwrap();
+        assert_eq!(count.load(Ordering::Relaxed), 4);
+        let kept = j.part_residuals(&at(2.9e5)).unwrap();
+        assert_eq!(count.load(Ordering::Relaxed), 4, "the lowest point kept");
+        assert_eq!(kept, vec![vec![2.9e5 / 3e5 - 1.0, 1.0]]);
+        assert_eq!(j.stack(&kept), *batch[1].as_ref().unwrap());
+        let other = j.part_residuals(&at(3.5e5)).unwrap();
+        assert_eq!(count.load(Ordering::Relaxed), 5, "another point evaluated");
+        assert_eq!(other, vec![vec![3.5e5 / 3e5 - 1.0, 1.0]]);
     }
 }

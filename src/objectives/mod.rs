@@ -28,6 +28,8 @@ pub mod definition;
 pub mod detail;
 pub mod friction_map;
 pub mod gain_curve;
+#[cfg(test)]
+pub(crate) mod in_lanes;
 pub mod joint;
 pub mod measured_peaks;
 pub mod model_peaks;

@@ -2,7 +2,7 @@
 //! from them, in the units the field reports them in.
 
 use crate::controller::Compensation;
-use crate::experiments::positioning::iso230::{self, Iso230Error, ReportUnits};
+use crate::experiments::positioning::iso230::{self, Iso230Error, Measurement, ReportUnits};
 use crate::experiments::positioning::{self, PositioningTest};
 use crate::model::params::ControllerParams;
 use crate::model::{Axis, Params};
@@ -52,45 +52,37 @@ pub enum CaseError {
 impl Case {
     /// The outputs on the model `p`.
     pub fn run(&self, p: &Params) -> Result<Vec<Output>, CaseError> {
-        let tuned;
-        let p = match &self.controller {
-            Some(c) => {
-                tuned = Params {
-                    controller: c.clone(),
-                    ..p.clone()
-                };
-                &tuned
-            }
-            None => p,
-        };
-        let values: Vec<(&'static str, f64)> = match &self.test {
-            Test::Positioning { test, axis } => {
-                let readings = positioning::run(p, test, |_, _| {})?;
-                let stats = iso230::evaluate(&readings)?.axis;
-                let s = stats.scaled(ReportUnits::of(*axis).deviation_per_si);
-                vec![
-                    ("B_mean", s.b_mean),
-                    ("B", s.b),
-                    ("E", s.e),
-                    ("M", s.m),
-                    ("R", s.r),
-                    ("A", s.a),
-                ]
-            }
-            Test::Servo { compensation, .. } => {
-                let r = verify::responses_with(p, compensation)?;
-                vec![
-                    ("step_overshoot_percent", r.step_overshoot_percent),
-                    ("following_error", r.following_error),
-                    ("reversal_spike", r.reversal_spike),
-                    ("peak_effort", r.peak_effort),
-                ]
-            }
-        };
-        Ok(values
-            .into_iter()
-            .map(|(name, value)| Output { name, value })
-            .collect())
+        self.run_batch(std::slice::from_ref(p))
+            .pop()
+            .expect("one set, one result")
+    }
+
+    /// The outputs on each of the models `ps`, in order: the positioning test in
+    /// the kernel's lanes (each set's outputs are those it gives alone), the
+    /// servo's responses one set after another.
+    pub fn run_batch(&self, ps: &[Params]) -> Vec<Result<Vec<Output>, CaseError>> {
+        let sets: Vec<Params> = ps.iter().map(|p| self.tuned(p)).collect();
+        match &self.test {
+            Test::Positioning { test, axis } => positioning::run_batch(&sets, test)
+                .into_iter()
+                .map(|readings| positioning_outputs(&readings?, *axis))
+                .collect(),
+            Test::Servo { compensation, .. } => sets
+                .iter()
+                .map(|p| servo_outputs(p, compensation))
+                .collect(),
+        }
+    }
+
+    /// `p` with the case's controller settings, if it has its own.
+    fn tuned(&self, p: &Params) -> Params {
+        match &self.controller {
+            Some(c) => Params {
+                controller: c.clone(),
+                ..p.clone()
+            },
+            None => p.clone(),
+        }
     }
 
     /// The test's name (`positioning`, `servo`).
@@ -107,6 +99,76 @@ impl Case {
             Test::Positioning { axis, .. } | Test::Servo { axis, .. } => {
                 ReportUnits::of(*axis).deviation
             }
+        }
+    }
+}
+
+/// B̄, B, E, M, R, A of an ISO 230-2 run's `readings`, in the axis's report units.
+fn positioning_outputs(readings: &[Measurement], axis: Axis) -> Result<Vec<Output>, CaseError> {
+    let stats = iso230::evaluate(readings)?.axis;
+    let s = stats.scaled(ReportUnits::of(axis).deviation_per_si);
+    Ok(outputs(vec![
+        ("B_mean", s.b_mean),
+        ("B", s.b),
+        ("E", s.e),
+        ("M", s.m),
+        ("R", s.r),
+        ("A", s.a),
+    ]))
+}
+
+/// The servo's responses on `p` with `compensation`.
+fn servo_outputs(p: &Params, compensation: &Compensation) -> Result<Vec<Output>, CaseError> {
+    let r = verify::responses_with(p, compensation)?;
+    Ok(outputs(vec![
+        ("step_overshoot_percent", r.step_overshoot_percent),
+        ("following_error", r.following_error),
+        ("reversal_spike", r.reversal_spike),
+        ("peak_effort", r.peak_effort),
+    ]))
+}
+
+fn outputs(values: Vec<(&'static str, f64)>) -> Vec<Output> {
+    values
+        .into_iter()
+        .map(|(name, value)| Output { name, value })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets;
+
+    /// A group of drawn sets runs the positioning test in lanes: each set's outputs
+    /// are those it gives alone, bit for bit.
+    #[test]
+    fn a_group_of_sets_gives_each_its_lone_outputs() {
+        let case = Case {
+            label: "before".into(),
+            test: Test::Positioning {
+                test: PositioningTest {
+                    targets: vec![0.0, 10f64.to_radians()],
+                    runs: 2,
+                    ..Default::default()
+                },
+                axis: Axis::Rotary,
+            },
+            controller: None,
+        };
+        let base = presets::load("worm-gear").unwrap();
+        let sets: Vec<Params> = [(0.14, 8e-5), (0.16, 7e-5), (0.12, 9e-5)]
+            .iter()
+            .map(|&(fm, theta_bw)| Params {
+                fm,
+                theta_bw,
+                ..base.clone()
+            })
+            .collect();
+        let together = case.run_batch(&sets);
+        for (p, r) in sets.iter().zip(together) {
+            let alone = case.run(p).unwrap();
+            assert_eq!(r.unwrap(), alone, "fm {}", p.fm);
         }
     }
 }

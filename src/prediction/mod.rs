@@ -15,6 +15,8 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use crate::model::{ParamError, Params};
+use crate::sim::batch::on_valid;
+use crate::sim::LANES;
 pub use cases::{Case, CaseError, Output, Test};
 pub use draws::{DrawSource, Draws};
 
@@ -133,18 +135,19 @@ pub fn predict(
         })
         .collect::<Result<Vec<_>, _>>()?;
     let skipped = AtomicUsize::new(0);
+    // Draws in groups of the kernel's lane count: each case runs a group together.
     let runs: Vec<Result<Vec<Vec<Output>>, String>> = s
         .draws
         .sets
-        .par_iter()
-        .filter_map(|set| {
+        .par_chunks(LANES)
+        .flat_map_iter(|sets| {
             if stop.load(Ordering::Relaxed) {
-                skipped.fetch_add(1, Ordering::Relaxed);
-                return None;
+                skipped.fetch_add(sets.len(), Ordering::Relaxed);
+                return Vec::new();
             }
-            let r = run_draw(s, set);
-            progress();
-            Some(r)
+            let runs = run_draws(s, sets);
+            sets.iter().for_each(|_| progress());
+            runs
         })
         .collect();
     let total = runs.len();
@@ -189,17 +192,34 @@ impl Prediction {
     }
 }
 
-/// Every case on one drawn set.
-fn run_draw(s: &Setup, set: &[f64]) -> Result<Vec<Vec<Output>>, String> {
+/// Every case on each of the drawn `sets`, the sets of a case run together.
+fn run_draws(s: &Setup, sets: &[Vec<f64>]) -> Vec<Result<Vec<Vec<Output>>, String>> {
+    let params: Vec<Result<Params, String>> = sets.iter().map(|set| drawn(s, set)).collect();
+    on_valid(params, |ps| {
+        let mut each: Vec<Result<Vec<Vec<Output>>, String>> =
+            ps.iter().map(|_| Ok(Vec::new())).collect();
+        for c in s.cases {
+            for (acc, r) in each.iter_mut().zip(c.run_batch(ps)) {
+                if let Ok(outputs) = acc {
+                    match r {
+                        Ok(r) => outputs.push(r),
+                        Err(e) => *acc = Err(format!("{}: {e}", c.label)),
+                    }
+                }
+            }
+        }
+        each
+    })
+}
+
+/// The model with a drawn set's values.
+fn drawn(s: &Setup, set: &[f64]) -> Result<Params, String> {
     let mut p = s.params.clone();
     for (name, &v) in s.draws.names.iter().zip(set) {
         p.set(name, v).map_err(|e| e.to_string())?;
     }
     p.validate().map_err(|e| e.to_string())?;
-    s.cases
-        .iter()
-        .map(|c| c.run(&p).map_err(|e| format!("{}: {e}", c.label)))
-        .collect()
+    Ok(p)
 }
 
 fn note_missing(notes: &mut Vec<String>, failed: usize, skipped: usize, done: usize) {

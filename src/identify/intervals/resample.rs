@@ -16,8 +16,9 @@
 //! (seed, b), so the result does not depend on the order they finish in. Where the
 //! refit is a Nelder–Mead search (one point after another) on an objective that
 //! runs in the kernel's lanes, the replicates' searches run side by side on threads
-//! of their own, [`LANES`] per worker, their evaluations gathered into lane batches
-//! (search/lockstep.rs): each replicate's numbers are those it gets alone.
+//! of their own, [`crate::sim::LANES`] per worker, their evaluations gathered into
+//! lane batches (search/lockstep.rs): each replicate's numbers are those it gets
+//! alone.
 
 use crate::identify::result::resampling::{Interval, Resampling};
 use std::collections::BTreeMap;
@@ -30,15 +31,13 @@ use crate::identify::error::IdentifyError;
 use crate::identify::pipeline::correction::Corrected;
 use crate::identify::result::warning::Warning;
 use crate::identify::result::IdentifyResult;
-use crate::identify::search::lockstep::Lockstep;
+use crate::identify::search::lockstep::side_by_side;
 use crate::identify::search::problem::Monitor;
 use crate::identify::search::search;
 use crate::identify::search::settings::{Method, Settings};
 use crate::identify::space::{Bound, ParamSpace};
 use crate::model::Params;
 use crate::objectives::{Objective, ObjectiveError};
-use crate::sim::LANES;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 pub use super::request::LEVEL;
 use super::request::Z;
@@ -172,7 +171,7 @@ impl Problem<'_> {
             Some(fitted)
         };
         let outcomes = if self.in_lockstep() {
-            in_lockstep(self.objective, replicates, &replicate)
+            side_by_side(self.objective, replicates, &replicate)
         } else {
             (0..replicates)
                 .into_par_iter()
@@ -302,45 +301,6 @@ impl Problem<'_> {
             notes,
         }
     }
-}
-
-/// `replicate(b, objective)` for b in 0..`replicates`, on threads of their own
-/// ([`LANES`] per worker thread), the objective's evaluations gathered into its
-/// lanes ([`Lockstep`]): each replicate's result is the one it gets alone.
-fn in_lockstep<T: Send>(
-    objective: &dyn Objective,
-    replicates: usize,
-    replicate: &(dyn Fn(usize, &dyn Objective) -> T + Sync),
-) -> Vec<T> {
-    let threads = (rayon::current_num_threads() * LANES)
-        .min(replicates)
-        .max(1);
-    let lockstep = Lockstep::new(objective, threads, LANES);
-    let next = AtomicUsize::new(0);
-    let mut outcomes: Vec<(usize, T)> = std::thread::scope(|s| {
-        let workers: Vec<_> = (0..threads)
-            .map(|_| {
-                s.spawn(|| {
-                    let _seat = lockstep.seat();
-                    let mut mine = Vec::new();
-                    loop {
-                        let b = next.fetch_add(1, Ordering::Relaxed);
-                        if b >= replicates {
-                            break;
-                        }
-                        mine.push((b, replicate(b, &lockstep)));
-                    }
-                    mine
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|w| w.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
-    });
-    outcomes.sort_by_key(|o| o.0);
-    outcomes.into_iter().map(|o| o.1).collect()
 }
 
 /// The residuals less each segment's mean (a bootstrap draws errors of mean zero).

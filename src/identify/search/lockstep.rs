@@ -9,11 +9,13 @@
 //! full one.
 
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex, MutexGuard};
 use std::time::Duration;
 
 use crate::model::Params;
 use crate::objectives::{Objective, ObjectiveError};
+use crate::sim::LANES;
 
 /// How long a waiting thread sleeps before it evaluates what waits anyway: the
 /// guard against callers the count of running searches does not know of (an
@@ -193,11 +195,50 @@ impl Objective for Lockstep<'_> {
     }
 }
 
+/// `task(i, objective)` for i in 0..`count`, on threads of their own ([`LANES`] per
+/// worker thread of rayon's pool), the objective's evaluations gathered into lane
+/// batches ([`Lockstep`]): each task's result is the one it gets alone. A batch
+/// holds up to as many points as spread the running searches over the workers
+/// (two each for four searches on two cores: two batches at once, not one of four).
+pub(crate) fn side_by_side<T: Send>(
+    objective: &dyn Objective,
+    count: usize,
+    task: &(dyn Fn(usize, &dyn Objective) -> T + Sync),
+) -> Vec<T> {
+    let workers = rayon::current_num_threads();
+    let threads = (workers * LANES).min(count).max(1);
+    let lockstep = Lockstep::new(objective, threads, threads.div_ceil(workers));
+    let next = AtomicUsize::new(0);
+    let mut outcomes: Vec<(usize, T)> = std::thread::scope(|s| {
+        let spawned: Vec<_> = (0..threads)
+            .map(|_| {
+                s.spawn(|| {
+                    let _seat = lockstep.seat();
+                    let mut mine = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, Ordering::Relaxed);
+                        if i >= count {
+                            break;
+                        }
+                        mine.push((i, task(i, &lockstep)));
+                    }
+                    mine
+                })
+            })
+            .collect();
+        spawned
+            .into_iter()
+            .flat_map(|w| w.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    outcomes.sort_by_key(|o| o.0);
+    outcomes.into_iter().map(|o| o.1).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::model::presets;
-    use std::sync::atomic::{AtomicUsize, Ordering};
 
     /// r = (Kw, Kg), counting the batches and their sizes.
     struct Counted {

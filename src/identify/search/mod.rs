@@ -15,8 +15,9 @@ use rayon::prelude::*;
 use crate::identify::result::starts::StartRecord;
 use crate::identify::space::ParamSpace;
 use crate::objectives::Objective;
+use lockstep::side_by_side;
 use problem::{Monitor, Problem};
-use settings::Settings;
+use settings::{Method, Settings};
 use solvers::Limits;
 
 /// Runs the starts of `settings` (skipping those `done` already holds as finished),
@@ -39,7 +40,7 @@ pub fn search(
         .filter(|i| !done.iter().any(|d| d.index == *i && d.finished()))
         .count();
     monitor.progress().plan(to_run as u64 * settings.max_iters);
-    let start = |(index, initial): (usize, Vec<f64>)| {
+    let start = |objective: &dyn Objective, (index, initial): (usize, Vec<f64>)| {
         if let Some(d) = done.iter().find(|d| d.index == index && d.finished()) {
             return d.clone();
         }
@@ -49,11 +50,21 @@ pub fn search(
     };
     let starts = space.starts(settings.starts, settings.seed);
     // One start runs on the calling thread (a bootstrap's searches side by side,
-    // search/lockstep.rs, each on a thread of its own), several in parallel.
+    // search/lockstep.rs, each on a thread of its own); Nelder–Mead's starts on an
+    // objective in lanes side by side, their points in shared batches; other
+    // searches' starts in parallel.
     let mut records: Vec<StartRecord> = if starts.len() == 1 {
-        starts.into_iter().enumerate().map(start).collect()
+        starts
+            .into_iter()
+            .enumerate()
+            .map(|s| start(objective, s))
+            .collect()
+    } else if settings.method == Method::NelderMead && to_run > 1 && objective.in_lanes() {
+        let task = |i: usize, o: &dyn Objective| start(o, (i, starts[i].clone()));
+        side_by_side(objective, starts.len(), &task)
     } else {
-        starts.into_par_iter().enumerate().map(start).collect()
+        let each = |s| start(objective, s);
+        starts.into_par_iter().enumerate().map(each).collect()
     };
     records.sort_by_key(|r| r.index);
     records
@@ -99,9 +110,9 @@ fn one_start(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identify::search::settings::Method;
     use crate::identify::Bound;
     use crate::model::{presets, Params};
+    use crate::objectives::in_lanes::InLanes;
     use crate::objectives::ObjectiveError;
 
     /// Residuals of Kw and Kg from 3e5 and 900, relative.
@@ -126,18 +137,43 @@ mod tests {
         }
     }
 
-    /// Every method's iterations, counted by the observer, plus the budget the
-    /// converged starts give back, add up to the budget exactly: the bar ends full,
-    /// never past it.
-    #[test]
-    fn the_iterations_done_end_equal_to_the_budget() {
+    fn space() -> ParamSpace {
         let base = presets::load("worm-gear").unwrap();
         let names = ["Kw".to_string(), "Kg".to_string()];
         let bounds = [
             ("Kw".to_string(), Bound { lo: 1e5, hi: 1e6 }),
             ("Kg".to_string(), Bound { lo: 1e2, hi: 1e4 }),
         ];
-        let space = ParamSpace::new(base, &names, &bounds).unwrap();
+        ParamSpace::new(base, &names, &bounds).unwrap()
+    }
+
+    /// Nelder–Mead's starts side by side (their points in shared batches) and the
+    /// swarm's particles in batches end where each start ends alone, bit for bit.
+    #[test]
+    fn starts_and_particles_in_lanes_end_where_they_end_alone() {
+        let space = space();
+        for method in [Method::NelderMead, Method::Pso] {
+            let settings = Settings {
+                method,
+                starts: 4,
+                max_iters: 40,
+                ..Settings::default()
+            };
+            let alone = search(&space, &Bowl, &settings, &Monitor::default(), &[], &|_| {});
+            let lanes = InLanes::new(Bowl);
+            let together = search(&space, &lanes, &settings, &Monitor::default(), &[], &|_| {});
+            assert_eq!(alone, together, "{method:?}");
+            let largest = lanes.largest();
+            assert!(largest > 1, "{method:?}: batches of {largest} at most");
+        }
+    }
+
+    /// Every method's iterations, counted by the observer, plus the budget the
+    /// converged starts give back, add up to the budget exactly: the bar ends full,
+    /// never past it.
+    #[test]
+    fn the_iterations_done_end_equal_to_the_budget() {
+        let space = space();
         for method in [Method::Lsq, Method::Lm, Method::NelderMead, Method::Pso] {
             let monitor = Monitor::default();
             let settings = Settings {

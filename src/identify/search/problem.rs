@@ -13,7 +13,7 @@
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
-use argmin::core::{CostFunction, Error, Jacobian, Operator};
+use argmin::core::{CostFunction, Error, Jacobian, Operator, SendAlias, SyncAlias};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
@@ -22,6 +22,10 @@ use crate::identify::search::settings::Settings;
 use crate::identify::space::ParamSpace;
 use crate::objectives::{points_per_task, sum_of_squares, Objective, ObjectiveError};
 use crate::sim::batch::on_valid;
+use crate::sim::LANES;
+
+/// Residuals at points, and the Jacobian at one of them if asked for.
+type WithJacobian = (Vec<Vec<f64>>, Option<DMatrix<f64>>);
 
 /// The scaled residual given to every entry at a point the model cannot evaluate.
 pub const PENALTY: f64 = 1e6;
@@ -258,6 +262,13 @@ impl<'a> Problem<'a> {
         Ok(batches.into_iter().flatten().collect())
     }
 
+    /// Whether `n` points take one batch per worker: an objective that runs in
+    /// lanes, at most [`LANES`] points per worker. Up to there a point added costs a
+    /// lane of a batch that runs anyway, not a batch of its own.
+    pub(crate) fn one_round(&self, n: usize) -> bool {
+        self.objective.in_lanes() && n <= LANES * rayon::current_num_threads()
+    }
+
     /// Forward-difference Jacobian of the residuals in solver coordinates, the columns
     /// in parallel; `r0` are the residuals at `x`.
     pub(crate) fn jacobian_at(
@@ -276,13 +287,27 @@ impl<'a> Problem<'a> {
         &self,
         x: &DVector<f64>,
     ) -> Result<(Vec<f64>, DMatrix<f64>), ObjectiveError> {
-        let mut points = vec![x.clone()];
-        points.extend(self.shifted(x));
-        let mut all = self.evaluate_all(&points)?;
-        let columns = all.split_off(1);
-        let r0 = all.pop().expect("the point's own residuals");
-        let j = self.differences(&r0, &columns);
-        Ok((r0, j))
+        let (mut r, j) = self.evaluate_with_jacobian(std::slice::from_ref(x), Some(0))?;
+        let j = j.expect("a Jacobian asked for");
+        Ok((r.pop().expect("the point's own residuals"), j))
+    }
+
+    /// The residuals at each of `points` and, where `at` names one of them, the
+    /// forward-difference Jacobian there: its shifted points evaluated in the same
+    /// batch.
+    pub(crate) fn evaluate_with_jacobian(
+        &self,
+        points: &[DVector<f64>],
+        at: Option<usize>,
+    ) -> Result<WithJacobian, ObjectiveError> {
+        let mut all = points.to_vec();
+        if let Some(k) = at {
+            all.extend(self.shifted(&points[k]));
+        }
+        let mut residuals = self.evaluate_all(&all)?;
+        let columns = residuals.split_off(points.len());
+        let j = at.map(|k| self.differences(&residuals[k], &columns));
+        Ok((residuals, j))
     }
 
     /// `x` shifted by the difference step along each coordinate.
@@ -321,6 +346,20 @@ impl CostFunction for Problem<'_> {
 
     fn cost(&self, x: &Self::Param) -> Result<f64, Error> {
         Ok(sum_of_squares(&self.residuals(x)?))
+    }
+
+    /// A swarm's particles, evaluated in parallel and, where the objective runs in
+    /// lanes, in lane batches ([`Problem::evaluate_all`]): argmin's own bulk cost
+    /// evaluates them one after another without its `rayon` feature.
+    fn bulk_cost<P>(&self, params: &[P]) -> Result<Vec<f64>, Error>
+    where
+        P: std::borrow::Borrow<Self::Param> + SyncAlias,
+        f64: SendAlias,
+        Self: SyncAlias,
+    {
+        let points: Vec<DVector<f64>> = params.iter().map(|p| p.borrow().clone()).collect();
+        let residuals = self.evaluate_all(&points)?;
+        Ok(residuals.iter().map(|r| sum_of_squares(r)).collect())
     }
 }
 
