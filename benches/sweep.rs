@@ -114,10 +114,13 @@ fn benches(c: &mut Criterion) {
     group.finish();
 }
 
-/// `reversal` at 4 design points, lone and batched.
+/// `reversal` at 4 design points, lone and batched, and at 8 batched (two batches
+/// of [`rtid::sim::LANES`] = 4 lanes; one of 8 where the width is 8: the width's
+/// measurement, docs/performance.md).
 fn reversal(group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>) {
     let base = presets::load("worm-gear").unwrap();
-    let points: Vec<_> = [0.8, 0.93, 1.07, 1.2]
+    let factors = [0.8, 0.93, 1.07, 1.2, 0.85, 0.97, 1.03, 1.15];
+    let all: Vec<_> = factors
         .iter()
         .map(|f| {
             let mut p = base.clone();
@@ -125,6 +128,7 @@ fn reversal(group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTi
             p
         })
         .collect();
+    let points = &all[..4];
     let reversal = sweep::Evaluator {
         outputs: vec![Output::Reversal],
         tests: TestLength::Short,
@@ -137,7 +141,10 @@ fn reversal(group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTi
         })
     });
     group.bench_function("reversal/batch_4_points", |b| {
-        b.iter(|| reversal.evaluate_batch(&points))
+        b.iter(|| reversal.evaluate_batch(points))
+    });
+    group.bench_function("reversal/batch_8_points", |b| {
+        b.iter(|| reversal.evaluate_batch(&all))
     });
 }
 
