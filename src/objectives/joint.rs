@@ -7,6 +7,7 @@ use std::sync::Mutex;
 
 use super::{sum_of_squares, Objective, ObjectiveError, ObjectiveKind, Smoothness};
 use crate::model::Params;
+use crate::sim::batch::by_point;
 
 /// One weighted part of a joint objective.
 pub struct Part {
@@ -121,21 +122,12 @@ impl Objective for Joint {
     }
 
     fn residuals_batch(&self, points: &[Params]) -> Vec<Result<Vec<f64>, ObjectiveError>> {
-        let mut each: Vec<Result<Vec<Vec<f64>>, ObjectiveError>> = points
+        let parts = self
+            .parts
             .iter()
-            .map(|_| Ok(Vec::with_capacity(self.parts.len())))
-            .collect();
-        for part in &self.parts {
-            for (acc, r) in each.iter_mut().zip(part.objective.residuals_batch(points)) {
-                if let Ok(parts) = acc {
-                    match r {
-                        Ok(r) => parts.push(r),
-                        Err(e) => *acc = Err(e),
-                    }
-                }
-            }
-        }
-        each.into_iter()
+            .map(|p| p.objective.residuals_batch(points));
+        by_point(points.len(), parts)
+            .into_iter()
             .zip(points)
             .map(|(parts, p)| Ok(self.stacked(p, parts?)))
             .collect()

@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use crate::model::{ParamError, Params};
-use crate::sim::batch::on_valid;
+use crate::sim::batch::{by_point, on_valid};
 use crate::sim::LANES;
 pub use cases::{Case, CaseError, Output, Test};
 pub use draws::{DrawSource, Draws};
@@ -196,19 +196,14 @@ impl Prediction {
 fn run_draws(s: &Setup, sets: &[Vec<f64>]) -> Vec<Result<Vec<Vec<Output>>, String>> {
     let params: Vec<Result<Params, String>> = sets.iter().map(|set| drawn(s, set)).collect();
     on_valid(params, |ps| {
-        let mut each: Vec<Result<Vec<Vec<Output>>, String>> =
-            ps.iter().map(|_| Ok(Vec::new())).collect();
-        for c in s.cases {
-            for (acc, r) in each.iter_mut().zip(c.run_batch(ps)) {
-                if let Ok(outputs) = acc {
-                    match r {
-                        Ok(r) => outputs.push(r),
-                        Err(e) => *acc = Err(format!("{}: {e}", c.label)),
-                    }
-                }
-            }
-        }
-        each
+        let cases = s.cases.iter().map(|c| {
+            let label = |e: CaseError| format!("{}: {e}", c.label);
+            c.run_batch(ps)
+                .into_iter()
+                .map(|r| r.map_err(label))
+                .collect()
+        });
+        by_point(ps.len(), cases)
     })
 }
 

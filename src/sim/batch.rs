@@ -99,6 +99,27 @@ pub fn on_valid<P, T, E>(
         .collect()
 }
 
+/// Each point's results from several tests' batches: `batches` yields, test after
+/// test, one result per point, and point `i` gets its results in test order — or the
+/// first test's error at it.
+pub fn by_point<T, E>(
+    points: usize,
+    batches: impl IntoIterator<Item = Vec<Result<T, E>>>,
+) -> Vec<Result<Vec<T>, E>> {
+    let mut each: Vec<Result<Vec<T>, E>> = (0..points).map(|_| Ok(Vec::new())).collect();
+    for batch in batches {
+        for (acc, r) in each.iter_mut().zip(batch) {
+            if let Ok(results) = acc {
+                match r {
+                    Ok(r) => results.push(r),
+                    Err(e) => *acc = Err(e),
+                }
+            }
+        }
+    }
+    each
+}
+
 /// The indices of `params` grouped by [`BatchKey`], in order of first appearance; a
 /// set whose key cannot be computed (invalid parameters) is a group of its own, so
 /// that its lone run gives its error.
@@ -129,6 +150,18 @@ fn batch_key(p: &Params) -> Option<BatchKey> {
 mod tests {
     use super::*;
     use crate::model::presets;
+
+    #[test]
+    fn each_point_gets_its_results_in_test_order_or_its_first_error() {
+        let batches: Vec<Vec<Result<i32, &str>>> = vec![
+            vec![Ok(1), Err("a at 1"), Ok(3)],
+            vec![Ok(10), Err("b at 1"), Err("b at 2")],
+        ];
+        assert_eq!(
+            by_point(3, batches),
+            vec![Ok(vec![1, 10]), Err("a at 1"), Err("b at 2")]
+        );
+    }
 
     #[test]
     fn sets_group_by_shape_and_step_in_order_and_invalid_ones_stand_alone() {
