@@ -31,6 +31,7 @@ use crate::experiments::fluctuation::{
 };
 use crate::io::experiment_file::{Direction, Experiment, Kind};
 use crate::model::Params;
+use crate::sim::batch::by_point;
 use crate::sim::SimError;
 
 /// The unbalance-step objective: closed-loop simulations (rough); determines the
@@ -231,18 +232,16 @@ impl Objective for UnbalanceStep {
             .par_iter()
             .map(|st| run_window_batch(points, &self.test, self.window(st)))
             .collect();
-        let mut per_step: Vec<_> = per_step.into_iter().map(Vec::into_iter).collect();
-        points
-            .iter()
-            .map(|p| {
-                let records: Vec<_> = per_step
-                    .iter_mut()
-                    .map(|r| r.next().expect("one record per point"))
+        by_point(points.len(), per_step)
+            .into_iter()
+            .zip(points)
+            .map(|(records, p)| {
+                let model: Vec<Option<f64>> = self
+                    .steps
+                    .iter()
+                    .zip(&records?)
+                    .map(|(st, record)| self.located(record, p, st))
                     .collect();
-                let mut model = Vec::with_capacity(self.steps.len());
-                for (st, record) in self.steps.iter().zip(records) {
-                    model.push(self.located(&record?, p, st));
-                }
                 Ok(self.scaled(&model))
             })
             .collect()
