@@ -3,6 +3,7 @@
 
 pub mod atomic;
 pub mod compensation_file;
+pub mod drive_settings;
 pub mod experiment_file;
 pub mod formats;
 pub mod import;
