@@ -312,17 +312,26 @@ fn the_report_puts_the_prediction_beside_the_records() {
 /// `--tests servo` predicts `rtid tune`'s own check: its value at the fit is the
 /// check of the tuned identified model, the interval around it.
 #[test]
+#[cfg_attr(
+    not(feature = "slow-tests"),
+    ignore = "slow tier (about 40 s): --features slow-tests"
+)]
 fn the_servo_check_of_a_tuning_is_predicted() {
     let dir = tempfile::tempdir().unwrap();
     let fit = fit();
     let f = fit.to_str().unwrap();
-    let tune = |extra: &[&str]| {
-        let mut args = vec!["tune", f, "--preset", "worm-gear"];
-        args.extend_from_slice(extra);
-        ok(&rtid(&args, dir.path()))
-    };
-    tune(&["-o", "tuned.json"]);
-    let checked: serde_json::Value = serde_json::from_str(&tune(&["--json"])).unwrap();
+    let checked = json(&rtid(
+        &[
+            "tune",
+            f,
+            "--preset",
+            "worm-gear",
+            "-o",
+            "tuned.json",
+            "--json",
+        ],
+        dir.path(),
+    ));
     let p = json(&rtid(
         &[
             "predict",
@@ -345,14 +354,97 @@ fn the_servo_check_of_a_tuning_is_predicted() {
         "step_overshoot_percent",
     ] {
         let (at_fit, lo, hi) = predicted(&p, "after", name);
-        let want = checked["verification"]["after"][name].as_f64().unwrap();
+        let want = checked["check"]["after"]["servo"][name].as_f64().unwrap();
         assert!(
             (at_fit - want).abs() < 1e-9,
             "{name}: {at_fit} against {want}"
         );
         assert!(lo <= hi, "{name}: [{lo} … {hi}]");
     }
+    // The tuned position gain is higher than the preset's: the following error v/Kpp
+    // falls by their ratio.
     let (before, _, _) = predicted(&p, "before", "following_error");
     let (after, _, _) = predicted(&p, "after", "following_error");
-    assert!(after < before / 3.0, "{before} → {after}″");
+    let ratio =
+        checked["before"]["Kpp"].as_f64().unwrap() / checked["after"]["Kpp"].as_f64().unwrap();
+    assert!(
+        (after / before / ratio - 1.0).abs() < 0.05,
+        "{before} → {after}″"
+    );
+}
+
+/// Issue 51's chain on the worm gear's fixtures: identify → tune → compensate for the
+/// tuned gains → predict `--tune` with that compensation. The predicted A after is at
+/// most A before (the preset's gains, uncompensated), and within 1.1 times what the
+/// preset's gains give with a compensation built for them.
+#[test]
+#[cfg_attr(
+    not(feature = "slow-tests"),
+    ignore = "slow tier (about a minute): --features slow-tests"
+)]
+fn identify_tune_and_predict_a_tuning_in_a_chain() {
+    let dir = tempfile::tempdir().unwrap();
+    let frf = root().join("fixtures/worm-gear/frequency_response.json");
+    ok(&rtid(
+        &[
+            "identify",
+            frf.to_str().unwrap(),
+            "--preset",
+            "worm-gear",
+            "--fit",
+            "Kw,Kg,Cig",
+            "--out",
+            "fit.json",
+            "--quiet",
+        ],
+        dir.path(),
+    ));
+    let base = ["--preset", "worm-gear"];
+    let run = |args: &[&str]| {
+        let mut all = args.to_vec();
+        all.extend_from_slice(&base);
+        ok(&rtid(&all, dir.path()))
+    };
+    run(&["tune", "fit.json", "-o", "tuned.json", "--quiet"]);
+    run(&[
+        "compensate",
+        "--fit",
+        "fit.json",
+        "--tune",
+        "tuned.json",
+        "-o",
+        "c-tuned.json",
+        "--quiet",
+    ]);
+    run(&[
+        "compensate",
+        "--fit",
+        "fit.json",
+        "-o",
+        "c-today.json",
+        "--quiet",
+    ]);
+    let predict = |extra: &[&str]| {
+        let mut args = vec![
+            "predict",
+            "fit.json",
+            "--tests",
+            "positioning",
+            "--draws",
+            "10",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        serde_json::from_str::<serde_json::Value>(&run(&args)).unwrap()
+    };
+    let tuned = predict(&["--tune", "tuned.json", "--compensation", "c-tuned.json"]);
+    let today = predict(&["--compensation", "c-today.json"]);
+    let (before, _, _) = predicted(&tuned, "before", "A");
+    let (after, _, _) = predicted(&tuned, "after", "A");
+    let (today_after, _, _) = predicted(&today, "after", "A");
+    assert!(after <= before, "A {before} → {after}″");
+    assert!(
+        after <= 1.1 * today_after,
+        "A {after}″ against today's {today_after}″"
+    );
 }

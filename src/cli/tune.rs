@@ -3,43 +3,58 @@
 
 use std::path::{Path, PathBuf};
 
+use anyhow::Context;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::common::inputs::refuse_overwrite;
 use crate::cli::common::plot::Plot;
 use crate::cli::ModelArgs;
 use rtid::io::params_file;
-use rtid::tuning::{self, bode, verify, Setting, Targets, Tuned};
+use rtid::model::params::LoopMode;
+use rtid::model::Axis;
+use rtid::tuning::{
+    self, bode, objective, verify, Criterion, Limits, LoopMargins, Objective, Options, Setting,
+    Targets, TuneWarning, Tuned,
+};
 
 pub const LONG_ABOUT: &str = "\
-Tune the cascade from the model (docs/tuning.md): notch filters (−20 dB) at the resonances \
-of the motor's compliance below 0.8·Nyquist, then the velocity PI (its corner Kvi/Kvp at a \
-quarter of the crossover) with the highest velocity-loop crossover that keeps the target \
-phase margin and the gain-margin floor, then the position gain Kpp = ω_c/4 (critically \
-damped on a velocity loop read as a first-order lag).
+Tune the cascade on the nonlinear model, in the loop it runs (docs/tuning.md): notch filters \
+at the resonances of the motor's compliance below 0.8·Nyquist; then velocity PIs (corner \
+Kvi/Kvp at a quarter of the crossover) at crossovers from the highest whose velocity loop \
+keeps the targets down to a tenth of it, each with position gains Kpp from ω_c/4 down to \
+ω_c/32; of these, the settings whose cascade as it runs keeps the targets — phase margin, \
+gain margins both ways, no conditional window, exact on the sampled loop: the drive held \
+over a control period, the controller sample by sample, the position loop closed on the \
+motor encoder (semi-closed) or the table encoder (full-closed) — are weighed on the \
+nonlinear model (backlash, friction with stick, quantised encoders, the torque limit) \
+against today's settings:
 
-The margins are those of the velocity loop's open-loop response on the sampled loop: the \
-controller's discrete PI and filters, the drive's exact linear compliance (no backlash, \
-no friction), the zero-order hold, the backward-difference speed, the encoder dead time \
-and the output delay; aliasing neglected. The table shows them for the current settings \
-and the tuned ones. With -o the tuned parameter file is written (atomically, never over \
-the --params input). With --plot the velocity loop's open loop before and after tuning is \
-drawn as a Bode plot (SVG: gain in dB over phase in degrees on a log frequency axis from \
-0.1 Hz to 0.99·Nyquist), each phase margin and gain margin marked where it is read and \
-named with its value in the legend.
+  the ISO 230-2 cycle at the table, A and R after the compensation built for the setting;
+  a 1° (1 mm) step: overshoot and settling within 20″ (20 µm) at the table;
+  the table's motion at rest after it (a limit cycle refuses the setting);
+  the following error at 10°/s (10 mm/s) and the reversal spike;
+  the peak torque of the move (--torque-reserve of the limit kept free).
 
-Then both settings run on the nonlinear model (backlash, friction, quantised encoders, \
-the torque limit, which the margins leave out): a 1° step (1 mm on a linear axis) — \
-overshoot, time to settle within 20″ (20 µm), peak torque — and a move 5° out and back \
-at 10°/s — the following error at constant speed and the reversal spike beyond it.
+The weighting is --objective's (positioning, the default: A, then R, then the settling; \
+following: the following error and the reversal spike; settling: the step at the table). \
+The settings are screened on a short cycle (every 90°, two runs), candidates side by side in \
+the kernel's lanes; the best are checked on the standard cycle with their compensation run \
+in the controller. Today's settings are a candidate: if none beats them, tune says so and \
+proposes nothing new; a proposed setting that makes any criterion worse than today's \
+carries a warning naming it and by how much.
+
+The table shows each setting's gains with their units (Tn = Kvp/Kvi; Kv in 1/s and in the \
+CNC's (rev/min)/rev or (m/min)/mm), the margins of the velocity loop alone and of the \
+cascade as it runs, and the check before and after. With -o the tuned parameter file is \
+written (atomically, never over an input). With --plot the velocity loop's open loop before \
+and after is drawn as a Bode plot with its margins marked.
 
 Examples:
   rtid tune --preset worm-gear
+  rtid tune --preset worm-gear --loop full_closed -o worm-full-closed.json
   rtid tune fit.json --preset worm-gear -o worm-tuned.json     (the identified model)
-  rtid tune --preset two-mass --phase-margin-deg 60 --gain-margin-db 10 -o two-mass-tuned.json
-  rtid tune --params fit-params.json --set encoder_delay=1e-4 --json
-  rtid tune --preset two-mass --plot two-mass-loop.svg
-  rtid simulate --params two-mass-tuned.json --input move:target_deg=1 --duration-s 1 --out step.csv
+  rtid tune --preset two-mass --objective following --max-kpp 60 --json
+  rtid tune --preset two-mass --phase-margin-deg 60 --gain-margin-db 10 --plot loop.svg
 
 The tuned file's setpoint filters are the notches only: filters of the input (a \
 low-pass, say) are in the \"before\" column and not carried over.";
@@ -53,13 +68,38 @@ pub struct Args {
     pub fit: Option<PathBuf>,
     #[command(flatten)]
     pub model: ModelArgs,
-    /// Target phase margin of the velocity loop, degrees.
+    /// Target phase margin of the cascade as it runs, degrees.
     #[arg(long, value_name = "DEG", default_value_t = 50.0)]
     pub phase_margin_deg: f64,
-    /// Smallest gain margin of the velocity loop, dB.
+    /// Smallest gain margin of the cascade, up and down, dB.
     #[arg(long, value_name = "DB", default_value_t = 6.0)]
     pub gain_margin_db: f64,
-    /// Print JSON (targets, resonances, before, after) instead of a table.
+    /// What the settings are weighed by: positioning (ISO 230-2 A and R after
+    /// compensation, then settling), following (following error, reversal spike) or
+    /// settling (the step at the table).
+    #[arg(long, value_name = "KIND", default_value = "positioning")]
+    pub objective: Objective,
+    /// The loop to tune (semi_closed or full_closed); default the parameter file's
+    /// `controller.loop`. Overriding it is said on stderr.
+    #[arg(long = "loop", value_name = "LOOP")]
+    pub loop_mode: Option<LoopMode>,
+    /// The highest position gain Kpp (Kv) allowed, 1/s.
+    #[arg(long, value_name = "1/s")]
+    pub max_kpp: Option<f64>,
+    /// The highest velocity-loop crossover allowed, Hz.
+    #[arg(long, value_name = "HZ")]
+    pub max_bandwidth_hz: Option<f64>,
+    /// The notches' depth at their centre, dB (−60 to −1).
+    #[arg(long, value_name = "DB", default_value_t = -20.0, allow_negative_numbers = true)]
+    pub notch_depth_db: f64,
+    /// The narrowest notch, as a fraction of its centre frequency (0.01 to 1).
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.2)]
+    pub notch_min_width: f64,
+    /// The fraction of the torque limit the move at speed must leave free (0 to 0.9).
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.2)]
+    pub torque_reserve: f64,
+    /// Print JSON (targets, resonances, before, after, search, check, warnings)
+    /// instead of tables.
     #[arg(long)]
     pub json: bool,
     /// Write the tuned parameter file.
@@ -69,7 +109,24 @@ pub struct Args {
     /// the margins marked (SVG; never over an input or the -o file).
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
-    /// No notes on stderr (accepted like every command's `--quiet`).
+    /// Write the tuned settings as a commented SINAMICS parameter list: p1460
+    /// (speed controller gain, N·m·s/rad), p1462 (integral time, ms), the current
+    /// setpoint filters p1656-p1676 (docs/drive-settings.md).
+    #[arg(long, value_name = "FILE")]
+    pub sinamics: Option<PathBuf>,
+    /// Write the tuned settings as SINUMERIK machine data: MD32200 Kv in
+    /// (m/min)/mm, the gear MD31050/MD31060, the speed feed-forward MD32620/32610/32810
+    /// (needs --axis-number; docs/drive-settings.md).
+    #[arg(long, value_name = "FILE", requires = "axis_number")]
+    pub sinumerik: Option<PathBuf>,
+    /// The machine axis of the SINUMERIK data: AX<N>.
+    #[arg(long, value_name = "N")]
+    pub axis_number: Option<u32>,
+    /// The gear as the CNC counts it, MOTOR:LOAD revolutions (e.g. 90:1), where rtid's
+    /// Rg·Rw is not a ratio of whole numbers up to 100000.
+    #[arg(long, value_name = "MOTOR:LOAD", value_parser = gear_ratio)]
+    pub gear_ratio: Option<(u64, u64)>,
+    /// No progress bar or notes on stderr.
     #[arg(long)]
     pub quiet: bool,
 }
@@ -82,8 +139,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .chain(&a.fit)
         .map(PathBuf::as_path)
         .collect();
-    if let Some(out) = &a.out {
-        refuse_overwrite("-o", out, &read)?;
+    let mut written: Vec<&Path> = Vec::new();
+    for (option, path) in [
+        ("-o", &a.out),
+        ("--sinamics", &a.sinamics),
+        ("--sinumerik", &a.sinumerik),
+    ] {
+        if let Some(path) = path {
+            let mut others = read.clone();
+            others.extend(written.iter().copied());
+            refuse_overwrite(option, path, &others)?;
+            written.push(path);
+        }
     }
     let plot = match &a.plot {
         Some(path) => {
@@ -93,14 +160,43 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         None => Plot::none(),
     };
-    let p = crate::cli::common::model_args::fitted(&a.model, a.fit.as_deref(), None)?;
-    let targets = Targets {
-        phase_margin_deg: a.phase_margin_deg,
-        gain_margin_db: a.gain_margin_db,
+    let mut p = crate::cli::common::model_args::fitted(&a.model, a.fit.as_deref(), None)?;
+    if let Some(mode) = a.loop_mode {
+        if mode != p.controller.loop_mode && !a.quiet {
+            eprintln!(
+                "note: --loop {mode} overrides the parameter set's controller.loop ({})",
+                p.controller.loop_mode
+            );
+        }
+        p.controller.loop_mode = mode;
+    }
+    let options = Options {
+        targets: Targets {
+            phase_margin_deg: a.phase_margin_deg,
+            gain_margin_db: a.gain_margin_db,
+        },
+        objective: a.objective,
+        limits: Limits {
+            max_kpp: a.max_kpp,
+            max_bandwidth_hz: a.max_bandwidth_hz,
+            notch_depth_db: a.notch_depth_db,
+            notch_min_width: a.notch_min_width,
+        },
+        torque_reserve: a.torque_reserve,
     };
-    let t = tuning::tune(&p, targets)?;
+    let bar = crate::cli::common::progress::bar(0, "weighing", a.quiet || a.json);
+    let t = tuning::tune(&p, &options, &|done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })?;
+    bar.finish_and_clear();
+    let forms = drive_forms(&a, &t.params)?;
     if let Some(out) = &a.out {
         params_file::write(out, &t.params)?;
+    }
+    for (path, text) in forms {
+        rtid::io::atomic::write(&path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
     }
     if a.plot.is_some() {
         let title = format!(
@@ -114,95 +210,253 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
         plot.write(&figure, "")?;
     }
-    let checked = [verify::responses(&p)?, verify::responses(&t.params)?];
     if a.json {
-        let mut v = rtid::io::json::value(&t)?;
-        v["verification"] = serde_json::json!({
-            "before": rtid::io::json::value(&checked[0])?,
-            "after": rtid::io::json::value(&checked[1])?,
-        });
-        println!("{}", rtid::io::json::pretty(&v)?);
+        println!("{}", rtid::io::json::pretty(&rtid::io::json::value(&t)?)?);
     } else {
-        print_table(&p.name, &t);
-        print_verification(&checked);
+        print_table(&p, &t);
+        print_check(&p, &t);
+        print_warnings(&p, &t);
     }
     Ok(())
 }
 
-/// The step and the out-and-back move on the nonlinear model, before and after.
-fn print_verification(r: &[verify::Responses; 2]) {
-    let u = r[0].unit;
-    println!(
-        "on the nonlinear model (backlash, friction, quantised encoders, torque limit), the motor encoder × the ratio: {}",
-        if u == "″" {
-            "a 1° step; 5° out and back at 10°/s"
-        } else {
-            "a 1 mm step; 5 mm out and back at 10 mm/s"
-        }
-    );
-    let mut table = Table::new();
-    table.load_preset(UTF8_FULL_CONDENSED);
-    table.set_header(vec!["", "before", "after"]);
-    let row =
-        |label: String, f: &dyn Fn(&verify::Responses) -> String| vec![label, f(&r[0]), f(&r[1])];
-    table.add_row(row("step overshoot".into(), &|x| {
-        format!("{:.1} %", x.step_overshoot_percent)
-    }));
-    let gap = if u == "″" { "" } else { " " };
-    table.add_row(row(
-        format!("step settled within {}{gap}{u}", verify::SETTLED),
-        &|x| {
-            x.step_settling_s
-                .map_or("not within 1 s".into(), |t| format!("{:.0} ms", t * 1e3))
-        },
-    ));
-    table.add_row(row(format!("following error, {u}"), &|x| {
-        format!("{:.1}", x.following_error)
-    }));
-    table.add_row(row(format!("reversal spike, {u}"), &|x| {
-        format!("{:.1}", x.reversal_spike)
-    }));
-    let effort = if u == "″" {
-        "peak torque, N·m"
-    } else {
-        "peak force, N"
-    };
-    table.add_row(row(effort.into(), &|x| format!("{:.2}", x.peak_effort)));
-    println!("{table}");
+/// `MOTOR:LOAD` as two whole numbers of revolutions.
+fn gear_ratio(s: &str) -> Result<(u64, u64), String> {
+    let parse = |x: &str| x.trim().parse::<u64>().ok().filter(|&n| n > 0);
+    match s.split_once(':').map(|(m, l)| (parse(m), parse(l))) {
+        Some((Some(m), Some(l))) => Ok((m, l)),
+        _ => Err(format!(
+            "{s:?}: give MOTOR:LOAD revolutions as whole numbers, e.g. 90:1"
+        )),
+    }
 }
 
-fn print_table(name: &str, t: &Tuned) {
+/// The drive forms asked for, as (path, text), made before anything is written so
+/// that a missing quantity writes nothing.
+fn drive_forms(a: &Args, p: &rtid::Params) -> anyhow::Result<Vec<(PathBuf, String)>> {
+    use rtid::io::drive_settings::{sinamics, sinumerik, ServoSettings};
+    let s = ServoSettings::from_params(p);
+    let mut out = Vec::new();
+    if let Some(path) = &a.sinamics {
+        let text = sinamics::program(&s, &sinamics::SinamicsContext::default())
+            .with_context(|| format!("--sinamics {}", path.display()))?;
+        out.push((path.clone(), text));
+    }
+    if let Some(path) = &a.sinumerik {
+        let ctx = sinumerik::SinumerikContext {
+            axis_number: a.axis_number,
+            gear: a.gear_ratio,
+            ..Default::default()
+        };
+        let text = sinumerik::program(&s, &ctx)
+            .with_context(|| format!("--sinumerik {}", path.display()))?;
+        out.push((path.clone(), text));
+    }
+    Ok(out)
+}
+
+/// The unit of a setting's gains: the output's per rad/s and per rad (N·m for a
+/// torque command, N on a linear axis, the drive's unit with a drive gain).
+fn gain_units(p: &rtid::Params) -> (&'static str, &'static str) {
+    match (p.controller.drive_gain == 1.0, p.axis) {
+        (true, Axis::Rotary) => ("N·m·s/rad", "N·m/rad"),
+        (true, Axis::Linear) => ("N·s/m", "N/m"),
+        (false, Axis::Rotary) => ("output·s/rad", "output/rad"),
+        (false, Axis::Linear) => ("output·s/m", "output/m"),
+    }
+}
+
+fn print_table(p: &rtid::Params, t: &Tuned) {
     println!(
-        "{name}: velocity-loop margins on the sampled loop; targets: phase margin ≥ {}°, gain margin ≥ {} dB",
-        t.targets.phase_margin_deg, t.targets.gain_margin_db
+        "{}: {} loop; targets on the cascade as it runs: phase margin ≥ {}°, gain margins ≥ {} dB up and down, no conditional window",
+        p.name, t.loop_mode, t.targets.phase_margin_deg, t.targets.gain_margin_db
     );
     let mut table = Table::new();
     table.load_preset(UTF8_FULL_CONDENSED);
-    table.set_header(vec!["", "before", "after"]);
+    let after = if t.proposes {
+        "after"
+    } else {
+        "after (today's kept)"
+    };
+    table.set_header(vec!["", "before", after]);
     let (b, a) = (&t.before, &t.after);
     let row = |label: &str, f: &dyn Fn(&Setting) -> String| vec![label.to_string(), f(b), f(a)];
-    table.add_row(row("Kvp", &|s| format!("{:.4e}", s.kvp)));
-    table.add_row(row("Kvi", &|s| format!("{:.4e}", s.kvi)));
-    table.add_row(row("Kvi/Kvp (1/s)", &|s| format!("{:.1}", s.kvi / s.kvp)));
-    table.add_row(row("Kpp (1/s)", &|s| format!("{:.1}", s.kpp)));
+    let (kvp_unit, kvi_unit) = gain_units(p);
+    table.add_row(row(&format!("Kvp ({kvp_unit})"), &|s| {
+        format!("{:.4e}", s.kvp)
+    }));
+    table.add_row(row(&format!("Kvi ({kvi_unit})"), &|s| {
+        format!("{:.4e}", s.kvi)
+    }));
+    table.add_row(row("Tn = Kvp/Kvi (ms)", &|s| {
+        if s.kvi > 0.0 {
+            format!("{:.2}", 1e3 * s.kvp / s.kvi)
+        } else {
+            "no integral action".into()
+        }
+    }));
+    table.add_row(row("Kpp = Kv (1/s)", &|s| format!("{:.2}", s.kpp)));
+    let (kv_unit, kv_per) = match p.axis {
+        Axis::Rotary => ("Kv ((rev/min)/rev)", 60.0),
+        Axis::Linear => ("Kv ((m/min)/mm)", 0.06),
+    };
+    table.add_row(row(kv_unit, &|s| format!("{:.3}", s.kpp * kv_per)));
     table.add_row(row("setpoint filters", &|s| filters(s)));
-    table.add_row(row("crossover", &|s| {
-        s.velocity_loop
+    let velocity = |s: &Setting| s.velocity_loop;
+    table.add_row(row("velocity loop alone: crossover", &|s| {
+        velocity(s)
             .crossover_hz
             .map_or("none".into(), |f| format!("{f:.1} Hz"))
     }));
-    table.add_row(row("phase margin", &|s| {
-        let m = &s.velocity_loop;
+    table.add_row(row("  phase margin", &|s| {
+        let m = velocity(s);
         at(m.phase_margin_deg.zip(m.phase_margin_hz), "°")
     }));
-    table.add_row(row("gain margin", &|s| {
-        let m = &s.velocity_loop;
+    table.add_row(row("  gain margin", &|s| {
+        let m = velocity(s);
         at(m.gain_margin_db.zip(m.gain_margin_hz), " dB")
+    }));
+    table.add_row(row("cascade as it runs: stability", &|s| {
+        stability(&s.cascade)
+    }));
+    table.add_row(row("  crossover", &|s| {
+        s.cascade
+            .margins
+            .crossover_hz
+            .map_or("none".into(), |f| format!("{f:.1} Hz"))
+    }));
+    table.add_row(row("  phase margin", &|s| {
+        let m = &s.cascade.margins;
+        at(m.phase_margin_deg.zip(m.phase_margin_hz), "°")
+    }));
+    table.add_row(row("  gain margin (increase)", &|s| {
+        let m = &s.cascade.margins;
+        at(m.gain_margin_db.zip(m.gain_margin_hz), " dB")
+    }));
+    table.add_row(row("  gain margin (reduction)", &|s| {
+        let m = &s.cascade.stability;
+        at(
+            m.gain_reduction_margin_db.zip(m.gain_reduction_margin_hz),
+            " dB",
+        )
     }));
     table.add_row(row("position loop: peak", &|s| {
         format!("{:.2} dB", s.position_peak_db)
     }));
     println!("{table}");
+    let s = &t.search;
+    println!(
+        "search ({}): {} settings tried on the cascade, {} within the targets; {} weighed on the nonlinear model (today's among them; {} refused: a limit cycle or the torque reserve), {} checked on the standard cycle; {:.1} s",
+        t.objective, s.tried, s.within_margins, s.screened, s.refused, s.checked, s.wall_s
+    );
+}
+
+/// `stable`, `UNSTABLE`, or the conditional window.
+fn stability(m: &LoopMargins) -> String {
+    let s = &m.stability;
+    match (s.stable, s.conditional_window_db) {
+        (false, _) => format!("UNSTABLE (pole at |z| = {:.4})", s.spectral_radius),
+        (true, Some([from, to])) => {
+            format!("conditionally stable: unstable from +{from:.1} to +{to:.1} dB")
+        }
+        (true, None) => "stable".into(),
+    }
+}
+
+/// Both settings on the standard cycle and the servo's responses.
+fn print_check(p: &rtid::Params, t: &Tuned) {
+    let (before, after) = (&t.check.before, &t.check.after);
+    let u = before.servo.unit;
+    let effort = if p.axis == Axis::Rotary { "N·m" } else { "N" };
+    println!(
+        "on the nonlinear model (backlash, friction, quantised encoders, torque limit), {} loop: the ISO 230-2 cycle ({} targets, {} runs) with the compensation built for each setting run in the controller; a {} step and a move {} out and back",
+        t.loop_mode,
+        before.positioning.targets,
+        before.positioning.runs,
+        if u == "″" { "1°" } else { "1 mm" },
+        if u == "″" { "5° at 10°/s" } else { "5 mm at 10 mm/s" },
+    );
+    let mut table = Table::new();
+    table.load_preset(UTF8_FULL_CONDENSED);
+    table.set_header(vec!["", "before", "after"]);
+    let fmt = |x: f64| format!("{x:.2}");
+    table.add_row(vec![
+        format!("ISO 230-2 A uncompensated ({u})"),
+        fmt(before.positioning.a_uncompensated),
+        fmt(after.positioning.a_uncompensated),
+    ]);
+    table.add_row(vec![
+        format!("ISO 230-2 B̄ uncompensated ({u})"),
+        fmt(before.positioning.b_mean_uncompensated),
+        fmt(after.positioning.b_mean_uncompensated),
+    ]);
+    table.add_row(vec![
+        format!("ISO 230-2 B̄ after compensation ({u})"),
+        fmt(before.positioning.b_mean),
+        fmt(after.positioning.b_mean),
+    ]);
+    for k in objective::ALL {
+        let unit = k.unit(u, effort);
+        let show = |c: &tuning::Criteria| match (k, c.servo.table_settling_s) {
+            (Criterion::TableSettling, None) => "not within 1 s".to_string(),
+            (Criterion::TableSettling, Some(s)) => format!("{:.0} ms", s * 1e3),
+            _ => fmt(k.value(c)),
+        };
+        let label = if k == Criterion::TableSettling {
+            format!("{} within {}{u}", k.label(), verify::SETTLED)
+        } else {
+            format!("{} ({unit})", k.label())
+        };
+        table.add_row(vec![label, show(before), show(after)]);
+    }
+    table.add_row(vec![
+        format!("step overshoot, motor × ratio (%)"),
+        fmt(before.servo.step_overshoot_percent),
+        fmt(after.servo.step_overshoot_percent),
+    ]);
+    table.add_row(vec![
+        format!("peak torque, step command ({effort})"),
+        fmt(before.servo.peak_effort),
+        fmt(after.servo.peak_effort),
+    ]);
+    println!("{table}");
+}
+
+fn print_warnings(p: &rtid::Params, t: &Tuned) {
+    let u = t.check.before.servo.unit;
+    let effort = if p.axis == Axis::Rotary { "N·m" } else { "N" };
+    for w in &t.warnings {
+        println!("warning: {}", warning_text(w, t.objective, u, effort));
+    }
+}
+
+/// A warning as the table prints it.
+fn warning_text(
+    w: &TuneWarning,
+    objective: Objective,
+    u: &'static str,
+    effort: &'static str,
+) -> String {
+    match w {
+        TuneWarning::Worse(w) => {
+            let unit = w.criterion.unit(u, effort);
+            format!(
+                "{} worse than today's: {:.2} → {:.2} {unit} (+{:.2} {unit})",
+                w.criterion.label(),
+                w.before,
+                w.after,
+                w.after - w.before
+            )
+        }
+        TuneWarning::NothingBetter { best_check_score } => format!(
+            "no setting within the targets beats today's on the {} objective{}: today's settings are kept",
+            objective,
+            best_check_score.map_or(String::new(), |s| format!(" (the best checked scores {s:.3} against today's 1)"))
+        ),
+        TuneWarning::TodayOutsideTargets => {
+            "today's cascade does not keep the targets (see its margins)".into()
+        }
+    }
 }
 
 /// `62.0° at 119.4 Hz`, or `none`.

@@ -55,6 +55,11 @@ impl Biquad {
         }
     }
 
+    /// The coefficients: numerator b0, b1, b2 and denominator a1, a2 (a0 = 1).
+    pub fn coefficients(&self) -> ([f64; 3], [f64; 2]) {
+        (self.b, self.a)
+    }
+
     /// The gain at DC, Σb/(1 + Σa).
     fn dc_gain(&self) -> f64 {
         (self.b[0] + self.b[1] + self.b[2]) / (1.0 + self.a[0] + self.a[1])

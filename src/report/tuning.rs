@@ -69,20 +69,21 @@ fn hz(f: f64) -> String {
 mod tests {
     use super::*;
     use crate::model::presets;
-    use crate::tuning::{bode::bode, tune, Targets};
+    use crate::tuning::{bode::bode, rule, Setting, Targets};
 
     #[test]
     fn the_plot_shows_both_loops_and_the_margins() {
         let p = presets::load("two-mass").unwrap();
-        let t = tune(&p, Targets::default()).unwrap();
-        let (b, a) = (bode(&p, &t.before).unwrap(), bode(&p, &t.after).unwrap());
+        let before = Setting::of(&p, &p.controller).unwrap();
+        let after = Setting::of(&p, &rule(&p, Targets::default()).unwrap()).unwrap();
+        let (b, a) = (bode(&p, &before).unwrap(), bode(&p, &after).unwrap());
         let svg = open_loop(&b, &a, "two-mass: velocity loop")
             .render()
             .unwrap();
         for s in ["L, before tuning", "L, after tuning", "after: phase margin"] {
             assert!(svg.contains(s), "{s}");
         }
-        let pm = t.after.velocity_loop.phase_margin_deg.unwrap();
+        let pm = after.velocity_loop.phase_margin_deg.unwrap();
         assert!(svg.contains(&degrees(pm)), "{pm}");
         assert_eq!(hz(119.44), "119");
         assert_eq!(hz(8.4321), "8.43");

@@ -80,17 +80,17 @@ fn interpolate(curve: &[(f64, f64)], x: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::model::presets;
-    use crate::tuning::{tune, Targets};
+    use crate::tuning::{rule, Setting, Targets};
 
     /// The tuned worm-gear loop: its gain is 0 dB and its phase −180° + the phase
     /// margin where the margin is read; the gain margin's point lies at −180°.
     #[test]
     fn the_margins_points_lie_on_the_curves() {
         let p = presets::load("worm-gear").unwrap();
-        let t = tune(&p, Targets::default()).unwrap();
-        let b = bode(&p, &t.after).unwrap();
+        let after = Setting::of(&p, &rule(&p, Targets::default()).unwrap()).unwrap();
+        let b = bode(&p, &after).unwrap();
         let (f, phase, pm) = b.phase_margin.unwrap();
-        assert_eq!(Some(pm), t.after.velocity_loop.phase_margin_deg);
+        assert_eq!(Some(pm), after.velocity_loop.phase_margin_deg);
         assert!((180.0 - phase.abs() - pm).abs() < 0.5, "{phase} vs {pm}");
         assert!(interpolate(&b.gain_db, f).abs() < 0.1);
         if let Some((_, db, phase)) = b.gain_margin {

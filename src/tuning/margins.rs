@@ -63,6 +63,28 @@ pub fn margins_on(
     grid: &[(f64, Complex<f64>)],
     l: impl Fn(f64) -> Option<Complex<f64>>,
 ) -> Margins {
+    margins_with(grid, l, Phase::Unwrapped)
+}
+
+/// How the phase margin is read at a gain crossover.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// 180° − |φ|, φ unwrapped along the grid from its principal value at the first
+    /// point (negative past −180°).
+    Unwrapped,
+    /// The angle between L and −1, 180° − |φ| with φ wrapped into (−180°, 180°]:
+    /// never negative; whether the loop is stable is decided by its poles
+    /// ([`super::stability`]). For loops whose low-frequency phase is not that of
+    /// the first branch (a cascade's three integrators: −270°).
+    ToMinusOne,
+}
+
+/// [`margins_on`] with the phase margin read as `phase` says.
+pub fn margins_with(
+    grid: &[(f64, Complex<f64>)],
+    l: impl Fn(f64) -> Option<Complex<f64>>,
+    rule: Phase,
+) -> Margins {
     let mut m = Margins::default();
     let phase = unwrapped_deg(grid);
     for (i, pair) in grid.windows(2).enumerate() {
@@ -70,7 +92,10 @@ pub fn margins_on(
         if (l0.norm() - 1.0) * (l1.norm() - 1.0) <= 0.0 && l0.norm() != l1.norm() {
             let f = bisect(f0, f1, |f| l(f).map(|v| v.norm() - 1.0));
             let v = l(f).unwrap_or(l0);
-            let phi = phase[i] + wrap_deg(v.arg().to_degrees() - phase[i]);
+            let phi = match rule {
+                Phase::Unwrapped => phase[i] + wrap_deg(v.arg().to_degrees() - phase[i]),
+                Phase::ToMinusOne => v.arg().to_degrees(),
+            };
             let pm = 180.0 - phi.abs();
             m.crossover_hz.get_or_insert(f);
             if m.phase_margin_deg.map_or(true, |old| pm < old) {
@@ -107,7 +132,7 @@ pub(crate) fn unwrapped_deg(grid: &[(f64, Complex<f64>)]) -> Vec<f64> {
 
 /// The root of `g` between `a` and `b` (signs differ), bisected on log f; stops where
 /// `g` is undefined.
-fn bisect(mut a: f64, mut b: f64, g: impl Fn(f64) -> Option<f64>) -> f64 {
+pub(crate) fn bisect(mut a: f64, mut b: f64, g: impl Fn(f64) -> Option<f64>) -> f64 {
     let Some(mut ga) = g(a) else { return a };
     for _ in 0..BISECTIONS {
         let mid = (a * b).sqrt();

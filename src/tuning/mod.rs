@@ -9,25 +9,39 @@
 //! the controller's discretised filters), below `experiments` and the command line.
 
 pub mod bode;
+pub mod candidates;
+pub mod criteria;
 pub mod margins;
 pub mod notches;
+pub mod objective;
 pub mod open_loop;
 pub mod position;
+pub mod sampled;
 pub mod search;
+pub mod stability;
 pub mod verify;
 
+use std::time::Instant;
+
+use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::model::params::{ControllerParams, LoopMode};
 use crate::model::{ParamError, Params, SetpointFilter};
+use crate::sim::LANES;
+pub use candidates::{Candidate, Limits};
+pub use criteria::{Criteria, CriteriaError};
 pub use margins::Margins;
+pub use objective::{Criterion, Objective, Worse};
 pub use open_loop::{VelocityLoop, VelocityPi};
+pub use stability::{LoopMargins, Stability};
 
-/// What the tuned velocity loop must keep.
+/// What the tuned cascade must keep.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Targets {
     /// Phase margin, deg (default 50).
     pub phase_margin_deg: f64,
-    /// Gain margin floor, dB (default 6).
+    /// Gain margin floor, both ways, dB (default 6).
     pub gain_margin_db: f64,
 }
 
@@ -38,6 +52,16 @@ impl Default for Targets {
             gain_margin_db: 6.0,
         }
     }
+}
+
+/// How to tune.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Options {
+    pub targets: Targets,
+    pub objective: Objective,
+    pub limits: Limits,
+    /// The fraction of the torque limit the move must leave free (0 to 1).
+    pub torque_reserve: f64,
 }
 
 /// Why a drive could not be tuned.
@@ -54,11 +78,26 @@ pub enum TuneError {
         best_crossover_hz: Option<f64>,
         best_gain_margin_db: Option<f64>,
     },
+    #[error("no cascade of the {tried} tried keeps a phase margin of {phase_margin_deg}° and gain margins of {gain_margin_db} dB both ways without a conditional window; {}", best.map_or("none of them is stable".to_string(), |b| format!("the closest: {b}")))]
+    CascadeUnreachable {
+        phase_margin_deg: f64,
+        gain_margin_db: f64,
+        tried: usize,
+        best: Option<candidates::BestTried>,
+    },
     #[error("targets must be finite with a phase margin in (0°, 180°) and a gain margin ≥ 0 dB: got {phase_margin_deg}° and {gain_margin_db} dB")]
     Targets {
         phase_margin_deg: f64,
         gain_margin_db: f64,
     },
+    #[error("{option} must be {expected}: got {value}")]
+    Option {
+        option: &'static str,
+        expected: &'static str,
+        value: f64,
+    },
+    #[error("the check of today's settings on the nonlinear model failed: {0}")]
+    Today(#[source] CriteriaError),
 }
 
 fn unreachable_message(
@@ -81,7 +120,7 @@ fn unreachable_message(
     )
 }
 
-/// One setting of the cascade and its velocity loop's margins.
+/// One setting of the cascade and its loops' margins.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Setting {
     #[serde(rename = "Kvp")]
@@ -91,72 +130,352 @@ pub struct Setting {
     #[serde(rename = "Kpp")]
     pub kpp: f64,
     pub filters: Vec<SetpointFilter>,
+    /// The velocity loop alone, the position loop open (quasi-continuous,
+    /// [`open_loop`]).
     pub velocity_loop: Margins,
+    /// The cascade as it runs: the position loop closed in the configured loop
+    /// type, exact on the sampled loop, with its stability ([`stability`]).
+    pub cascade: LoopMargins,
     /// The closed position loop's largest gain, dB ([`position::peak_db`]).
     pub position_peak_db: f64,
+}
+
+impl Setting {
+    /// The margins of `c` on `p`'s drive.
+    pub fn of(p: &Params, c: &ControllerParams) -> Result<Setting, ParamError> {
+        let lp = VelocityLoop::new(p, &c.filters)?;
+        let pi = VelocityPi {
+            kvp: c.kvp,
+            kvi: c.kvi,
+        };
+        let plant = sampled::DiscretePlant::new(p)?;
+        let cascade = sampled::SampledLoop::new(&plant, c, sampled::Closure::Cascade);
+        Ok(Setting {
+            kvp: c.kvp,
+            kvi: c.kvi,
+            kpp: c.kpp,
+            filters: c.filters.clone(),
+            velocity_loop: search::Grid::new(&lp).margins(pi),
+            cascade: stability::analyse(&cascade),
+            position_peak_db: position::peak_db(&lp, pi, c.kpp),
+        })
+    }
+}
+
+/// What the search did.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SearchSummary {
+    /// Settings tried on the linear cascade, and those that kept the targets.
+    pub tried: usize,
+    pub within_margins: usize,
+    /// Settings weighed on the nonlinear model (today's among them) and those
+    /// refused there (a limit cycle, the torque reserve).
+    pub screened: usize,
+    pub refused: usize,
+    /// Settings checked on the standard cycle.
+    pub checked: usize,
+    /// The chosen setting's score on the screening and on the check (today's: 1).
+    pub screen_score: f64,
+    pub check_score: f64,
+    /// Wall time of the search, s.
+    pub wall_s: f64,
+}
+
+/// Why a setting is flagged.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum TuneWarning {
+    /// The proposed setting makes a criterion worse than today's.
+    Worse(Worse),
+    /// No setting beats today's on the objective: nothing new is proposed.
+    NothingBetter { best_check_score: Option<f64> },
+    /// Today's cascade does not keep the targets.
+    TodayOutsideTargets,
 }
 
 /// The drive's settings before and after tuning, and the tuned parameter set.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Tuned {
     pub targets: Targets,
+    pub objective: Objective,
+    #[serde(rename = "loop")]
+    pub loop_mode: LoopMode,
     /// The resonances the notches sit at.
     pub resonances: Vec<notches::Resonance>,
     pub before: Setting,
     pub after: Setting,
+    /// Whether `after` is a new setting (false: today's is kept).
+    pub proposes: bool,
+    pub search: SearchSummary,
+    /// Both settings on the standard cycle, compensated in the controller.
+    pub check: Check,
+    pub warnings: Vec<TuneWarning>,
     #[serde(skip)]
     pub params: Params,
 }
 
-/// Tunes `p`'s velocity and position loops for `targets` (`p` validated).
-pub fn tune(p: &Params, targets: Targets) -> Result<Tuned, TuneError> {
-    let (pm, gm) = (targets.phase_margin_deg, targets.gain_margin_db);
+/// Today's and the proposed setting on the nonlinear model.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Check {
+    pub before: Criteria,
+    pub after: Criteria,
+}
+
+/// How many of the best screened settings are checked on the standard cycle, at
+/// most, until one beats today's.
+const CHECKED: usize = 3;
+
+/// Tunes `p`'s cascade (`p` validated) in its configured loop: candidates that keep
+/// the targets on the cascade, weighed on the nonlinear model against today's
+/// setting by `options.objective`; `progress(done, total)` after each batch.
+pub fn tune(
+    p: &Params,
+    options: &Options,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Tuned, TuneError> {
+    let started = Instant::now();
+    check_options(options)?;
+    let targets = options.targets;
+    let nyquist = 0.5 / p.controller.tc;
+    let resonances = notches::resonances(p, notches::MAX_RELATIVE_CENTRE * nyquist)?;
+    let filters = notches::notches_with(p, &options.limits)?;
+    let (found, tried) = candidates::generate(p, &filters, targets, &options.limits)?;
+    let mut sets = vec![p.clone()];
+    sets.extend(
+        found
+            .iter()
+            .map(|c| with_controller(p, c.controller(&p.controller, &filters))),
+    );
+    let mut screened = screen(&sets, progress);
+    let today = std::mem::replace(&mut screened[0], Err(CriteriaError::Unscreened))
+        .map_err(TuneError::Today)?;
+    let ranked = rank(p, options, &sets, &screened, &today);
+    let refused = sets.len() - 1 - ranked.len();
+    let before_check = criteria::check(p).map_err(TuneError::Today)?;
+    let chosen = choose(options.objective, &sets, &ranked, &before_check);
+    let before = Setting::of(p, &p.controller)?;
+    let mut warnings = Vec::new();
+    if !before
+        .cascade
+        .meets(targets.phase_margin_deg, targets.gain_margin_db)
+    {
+        warnings.push(TuneWarning::TodayOutsideTargets);
+    }
+    let (params, after_check, screen_score, check_score, proposes) = match chosen.best {
+        Some((i, check, score)) => (
+            sets[i].clone(),
+            check,
+            ranked_score(&ranked, i),
+            score,
+            true,
+        ),
+        None => {
+            warnings.push(TuneWarning::NothingBetter {
+                best_check_score: chosen.best_failed,
+            });
+            (p.clone(), before_check.clone(), 1.0, 1.0, false)
+        }
+    };
+    warnings.extend(
+        objective::worse(&after_check, &before_check)
+            .into_iter()
+            .map(TuneWarning::Worse),
+    );
+    let after = Setting::of(&params, &params.controller)?;
+    Ok(Tuned {
+        targets,
+        objective: options.objective,
+        loop_mode: p.controller.loop_mode,
+        resonances,
+        before,
+        after,
+        proposes,
+        search: SearchSummary {
+            tried,
+            within_margins: found.len(),
+            screened: sets.len(),
+            refused,
+            checked: chosen.checked,
+            screen_score,
+            check_score,
+            wall_s: started.elapsed().as_secs_f64(),
+        },
+        check: Check {
+            before: before_check,
+            after: after_check,
+        },
+        warnings,
+        params,
+    })
+}
+
+/// The linear rule of rtid's first tuning, one of the search's candidates: notches
+/// at the resonances, the velocity PI at the highest crossover whose velocity loop
+/// alone keeps `targets`, Kpp = ω_c/4 (docs/tuning.md, "The rule alone").
+pub fn rule(p: &Params, targets: Targets) -> Result<ControllerParams, TuneError> {
+    let filters = notches::notches(p)?;
+    let lp = VelocityLoop::new(p, &filters)?;
+    let v = search::velocity(&search::Grid::new(&lp), targets)?;
+    Ok(ControllerParams {
+        kvp: v.pi.kvp,
+        kvi: v.pi.kvi,
+        kpp: search::position_gain(v.margins.crossover_hz.unwrap_or(0.0)),
+        filters,
+        ..p.controller.clone()
+    })
+}
+
+/// Refuses targets and limits out of range.
+fn check_options(o: &Options) -> Result<(), TuneError> {
+    let (pm, gm) = (o.targets.phase_margin_deg, o.targets.gain_margin_db);
     if !(pm.is_finite() && pm > 0.0 && pm < 180.0 && gm.is_finite() && gm >= 0.0) {
         return Err(TuneError::Targets {
             phase_margin_deg: pm,
             gain_margin_db: gm,
         });
     }
-    let c = &p.controller;
-    let before_loop = VelocityLoop::new(p, &c.filters)?;
-    let current = VelocityPi {
-        kvp: c.kvp,
-        kvi: c.kvi,
+    let l = &o.limits;
+    let positive = |option, v: Option<f64>| match v {
+        Some(v) if !(v.is_finite() && v > 0.0) => Err(TuneError::Option {
+            option,
+            expected: "finite and positive",
+            value: v,
+        }),
+        _ => Ok(()),
     };
-    let before = Setting {
-        kvp: c.kvp,
-        kvi: c.kvi,
-        kpp: c.kpp,
-        filters: c.filters.clone(),
-        velocity_loop: search::Grid::new(&before_loop).margins(current),
-        position_peak_db: position::peak_db(&before_loop, current, c.kpp),
+    positive("--max-kpp", l.max_kpp)?;
+    positive("--max-bandwidth-hz", l.max_bandwidth_hz)?;
+    let within = |option, v: f64, lo: f64, hi: f64, expected| {
+        if v.is_finite() && v >= lo && v <= hi {
+            Ok(())
+        } else {
+            Err(TuneError::Option {
+                option,
+                expected,
+                value: v,
+            })
+        }
     };
-    let nyquist = 0.5 / c.tc;
-    let resonances = notches::resonances(p, notches::MAX_RELATIVE_CENTRE * nyquist)?;
-    let filters = notches::notches(p)?;
-    let lp = VelocityLoop::new(p, &filters)?;
-    let v = search::velocity(&search::Grid::new(&lp), targets)?;
-    let kpp = search::position_gain(v.margins.crossover_hz.unwrap_or(0.0));
-    let mut params = p.clone();
-    params.controller.kvp = v.pi.kvp;
-    params.controller.kvi = v.pi.kvi;
-    params.controller.kpp = kpp;
-    params.controller.filters = filters.clone();
-    params.validate()?;
-    Ok(Tuned {
-        targets,
-        resonances,
-        before,
-        after: Setting {
-            kvp: v.pi.kvp,
-            kvi: v.pi.kvi,
-            kpp,
-            filters,
-            velocity_loop: v.margins,
-            position_peak_db: position::peak_db(&lp, v.pi, kpp),
-        },
-        params,
-    })
+    within(
+        "--notch-depth-db",
+        l.notch_depth_db,
+        -60.0,
+        -1.0,
+        "between -60 and -1 dB",
+    )?;
+    within(
+        "--notch-min-width",
+        l.notch_min_width,
+        0.01,
+        1.0,
+        "between 0.01 and 1 (of the centre)",
+    )?;
+    within(
+        "--torque-reserve",
+        o.torque_reserve,
+        0.0,
+        0.9,
+        "between 0 and 0.9",
+    )
+}
+
+/// `p` with the controller `c`.
+fn with_controller(p: &Params, c: ControllerParams) -> Params {
+    Params {
+        controller: c,
+        ..p.clone()
+    }
+}
+
+/// Every set's figures on the short cycle, in lane batches run in parallel.
+fn screen(
+    sets: &[Params],
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Vec<Result<Criteria, CriteriaError>> {
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    sets.par_chunks(LANES)
+        .flat_map_iter(|chunk| {
+            let out = criteria::screen(chunk);
+            let n = done.fetch_add(chunk.len(), std::sync::atomic::Ordering::Relaxed) + chunk.len();
+            progress(n, sets.len());
+            out
+        })
+        .collect()
+}
+
+/// The candidates (indices into the sets, today's excluded) the nonlinear model
+/// admits — no limit cycle, the torque reserve kept —, best score first.
+fn rank(
+    p: &Params,
+    o: &Options,
+    sets: &[Params],
+    screened: &[Result<Criteria, CriteriaError>],
+    today: &Criteria,
+) -> Vec<(usize, f64)> {
+    let effort_cap = (1.0 - o.torque_reserve) * p.controller.torque_limit * p.controller.drive_gain;
+    let rest_cap = limit_cycle_threshold(p).max(2.0 * today.servo.table_motion_at_rest);
+    let mut out: Vec<(usize, f64)> = screened
+        .iter()
+        .enumerate()
+        .skip(1)
+        .filter_map(|(i, c)| {
+            let c = c.as_ref().ok()?;
+            let admitted = c.servo.table_motion_at_rest <= rest_cap
+                && c.servo.move_peak_effort <= effort_cap.max(today.servo.move_peak_effort);
+            admitted.then(|| (i, o.objective.score(c, today)))
+        })
+        .collect();
+    out.sort_by(|a, b| a.1.total_cmp(&b.1));
+    debug_assert!(out.iter().all(|(i, _)| *i < sets.len()));
+    out
+}
+
+/// The table's motion at rest that counts as a limit cycle: three table-encoder
+/// counts, and at least 1 report unit (1″, 1 µm).
+pub fn limit_cycle_threshold(p: &Params) -> f64 {
+    let k = crate::experiments::positioning::iso230::ReportUnits::of(p.axis).deviation_per_si;
+    (3.0 * p.controller.table_encoder_resolution * k).max(1.0)
+}
+
+fn ranked_score(ranked: &[(usize, f64)], i: usize) -> f64 {
+    ranked.iter().find(|r| r.0 == i).map_or(1.0, |r| r.1)
+}
+
+/// The outcome of checking the best screened settings.
+struct Chosen {
+    /// The first that beats today's on the check: index, figures, score.
+    best: Option<(usize, Criteria, f64)>,
+    /// The lowest check score of those that did not.
+    best_failed: Option<f64>,
+    checked: usize,
+}
+
+/// Checks the best screened settings that beat today's (score < 1) on the standard
+/// cycle, in order, until one beats today's there too.
+fn choose(
+    objective: Objective,
+    sets: &[Params],
+    ranked: &[(usize, f64)],
+    today: &Criteria,
+) -> Chosen {
+    let mut chosen = Chosen {
+        best: None,
+        best_failed: None,
+        checked: 0,
+    };
+    for &(i, _) in ranked.iter().filter(|r| r.1 < 1.0).take(CHECKED) {
+        chosen.checked += 1;
+        let Ok(c) = criteria::check(&sets[i]) else {
+            continue;
+        };
+        let score = objective.score(&c, today);
+        if score < 1.0 {
+            chosen.best = Some((i, c, score));
+            break;
+        }
+        chosen.best_failed = Some(chosen.best_failed.map_or(score, |b: f64| b.min(score)));
+    }
+    chosen
 }
 
 #[cfg(test)]
@@ -164,16 +483,21 @@ mod tests {
     use super::*;
     use crate::model::presets;
 
+    fn quiet(_: usize, _: usize) {}
+
     #[test]
     fn an_unreachable_phase_margin_is_a_typed_error_with_the_best() {
         // The PI with its corner at a quarter of the crossover lags 14° there, the
         // plant at least its viscous lag: no crossover has 170° left.
         let p = presets::load("worm-gear").unwrap();
-        let targets = Targets {
-            phase_margin_deg: 170.0,
-            gain_margin_db: 6.0,
+        let options = Options {
+            targets: Targets {
+                phase_margin_deg: 170.0,
+                gain_margin_db: 6.0,
+            },
+            ..Options::default()
         };
-        let err = tune(&p, targets).unwrap_err();
+        let err = tune(&p, &options, &quiet).unwrap_err();
         let TuneError::Unreachable {
             best_phase_margin_deg: Some(best),
             ..
@@ -186,32 +510,28 @@ mod tests {
     }
 
     #[test]
-    fn the_tuned_position_loop_has_no_peak_and_a_higher_gain_would() {
-        // Kpp = ω_c/4 keeps the closed position loop at or below 0 dB; 0.7·ω_c
-        // (about 1.8 times the largest gain that does) peaks above it.
-        for name in ["worm-gear", "two-mass"] {
-            let p = presets::load(name).unwrap();
-            let t = tune(&p, Targets::default()).unwrap();
-            assert!(t.after.position_peak_db <= 1e-6, "{name}: {t:?}");
-            let lp = VelocityLoop::new(&p, &t.after.filters).unwrap();
-            let pi = VelocityPi {
-                kvp: t.after.kvp,
-                kvi: t.after.kvi,
-            };
-            let high = position::peak_db(&lp, pi, 0.7 * 4.0 * t.after.kpp);
-            assert!(high > 0.5, "{name}: {high} dB");
-        }
-    }
-
-    #[test]
-    fn targets_out_of_range_are_refused() {
+    fn targets_and_limits_out_of_range_are_refused() {
         let p = presets::load("worm-gear").unwrap();
         for (pm, gm) in [(0.0, 6.0), (190.0, 6.0), (50.0, -1.0), (f64::NAN, 6.0)] {
-            let t = Targets {
-                phase_margin_deg: pm,
-                gain_margin_db: gm,
+            let o = Options {
+                targets: Targets {
+                    phase_margin_deg: pm,
+                    gain_margin_db: gm,
+                },
+                ..Options::default()
             };
-            assert!(matches!(tune(&p, t), Err(TuneError::Targets { .. })));
+            assert!(matches!(
+                tune(&p, &o, &quiet),
+                Err(TuneError::Targets { .. })
+            ));
         }
+        let mut o = Options::default();
+        o.limits.max_kpp = Some(-1.0);
+        let err = tune(&p, &o, &quiet).unwrap_err();
+        assert!(err.to_string().contains("--max-kpp"), "{err}");
+        let mut o = Options::default();
+        o.torque_reserve = 1.5;
+        let err = tune(&p, &o, &quiet).unwrap_err();
+        assert!(err.to_string().contains("--torque-reserve"), "{err}");
     }
 }

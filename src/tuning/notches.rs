@@ -59,20 +59,30 @@ pub fn resonances(p: &Params, max_hz: f64) -> Result<Vec<Resonance>, ParamError>
 /// A notch at each resonance below [`MAX_RELATIVE_CENTRE`]·Nyquist, the lowest
 /// [`MAX_FILTERS`].
 pub fn notches(p: &Params) -> Result<Vec<SetpointFilter>, ParamError> {
+    notches_with(p, &super::Limits::default())
+}
+
+/// [`notches`] with the depth and narrowest width of `limits`.
+pub fn notches_with(p: &Params, limits: &super::Limits) -> Result<Vec<SetpointFilter>, ParamError> {
     let nyquist = 0.5 / p.controller.tc;
     Ok(resonances(p, MAX_RELATIVE_CENTRE * nyquist)?
         .into_iter()
         .take(MAX_FILTERS)
-        .map(notch)
+        .map(|r| notch_with(r, limits.notch_depth_db, limits.notch_min_width))
         .collect())
 }
 
 /// The notch of one resonance.
 pub fn notch(r: Resonance) -> SetpointFilter {
+    notch_with(r, DEPTH_DB, MIN_RELATIVE_WIDTH)
+}
+
+/// The notch of one resonance with `depth_db` and at least `min_width` of its centre.
+fn notch_with(r: Resonance, depth_db: f64, min_width: f64) -> SetpointFilter {
     SetpointFilter::Notch {
         centre_hz: r.hz,
-        width_hz: (4.0 * r.damping * r.hz).max(MIN_RELATIVE_WIDTH * r.hz),
-        depth_db: Some(DEPTH_DB),
+        width_hz: (4.0 * r.damping * r.hz).max(min_width * r.hz),
+        depth_db: Some(depth_db),
     }
 }
 

@@ -1,29 +1,42 @@
 //! The settings checked on the nonlinear model — backlash, friction, quantised
 //! encoders, the torque limit, all of which the margins leave out: a step of the
-//! position command, and a constant-speed move out and back with its reversal.
-//! Positions are the motor encoder's times the ratio (what the semi-closed loop
-//! controls), in the axis's report unit (arc-seconds, µm).
+//! position command, and a constant-speed move out and back with its reversal. The
+//! step is read on the motor encoder times the ratio (what the semi-closed loop
+//! controls) and at the table (what the machine is judged by): its overshoot, when it
+//! settles, and the table's motion once it should be at rest (a limit cycle); in the
+//! axis's report unit (arc-seconds, µm). Parameter sets run side by side in the
+//! kernel's lanes (`sim::batch`), each with the result it gives alone.
 
 use serde::Serialize;
 
 use crate::controller::Compensation;
 use crate::experiments::positioning::iso230::ReportUnits;
 use crate::input::{Move, Trajectory};
-use crate::model::idx::THETA_M;
-use crate::model::{Axis, Params};
-use crate::recorder::Trace;
-use crate::sim::{SimError, Simulation};
+use crate::model::idx::{THETA_M, THETA_T};
+use crate::model::{Axis, Params, NSTATE};
+use crate::recorder::Recorder;
+use crate::sim::batch::{in_lanes, LaneRun};
+use crate::sim::{common_step, LaneSimulation, SimError};
 
 /// The responses of one setting.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Responses {
     /// The step's size (1° or 1 mm), in the report's target unit.
     pub step: f64,
-    /// The step's largest excursion beyond the target, % of the step.
+    /// The step's largest excursion beyond the target on the motor encoder × the
+    /// ratio, % of the step.
     pub step_overshoot_percent: f64,
-    /// When the step stays within [`SETTLED`] report units of the target, s; `None`
-    /// when it has not by the end (1 s).
+    /// When the motor encoder × the ratio stays within [`SETTLED`] report units of
+    /// the target, s; `None` when it has not by the end (1 s).
     pub step_settling_s: Option<f64>,
+    /// The step's largest excursion beyond the target at the table, % of the step.
+    pub table_overshoot_percent: f64,
+    /// When the table stays within [`SETTLED`] report units of the target, s;
+    /// `None` when it has not by the end.
+    pub table_settling_s: Option<f64>,
+    /// The table's peak-to-peak motion over the step's last [`REST_WINDOW_S`], in
+    /// report units: what a limit cycle leaves.
+    pub table_motion_at_rest: f64,
     /// The following error on the move's constant-speed part (its second half), the
     /// largest magnitude.
     pub following_error: f64,
@@ -32,12 +45,19 @@ pub struct Responses {
     pub reversal_spike: f64,
     /// The largest motor torque (force) of the step and the move, N·m (N).
     pub peak_effort: f64,
+    /// The largest motor torque (force) of the move alone (a ramp, not a step
+    /// command), N·m (N).
+    pub move_peak_effort: f64,
     /// The unit of the excursions (`″`, `µm`).
     pub unit: &'static str,
 }
 
 /// Within this many report units (20″, 20 µm) the step has settled.
 pub const SETTLED: f64 = 20.0;
+/// The step's length, s.
+pub const STEP_S: f64 = 1.0;
+/// The end of the step over which the table's motion at rest is measured, s.
+pub const REST_WINDOW_S: f64 = 0.25;
 
 /// The step and the out-and-back move of `p` on the nonlinear model.
 pub fn responses(p: &Params) -> Result<Responses, SimError> {
@@ -46,84 +66,172 @@ pub fn responses(p: &Params) -> Result<Responses, SimError> {
 
 /// The same with the controller's compensations `c` on.
 pub fn responses_with(p: &Params, c: &Compensation) -> Result<Responses, SimError> {
-    let u = ReportUnits::of(p.axis);
-    let k = u.deviation_per_si;
-    let (step, speed) = match p.axis {
-        Axis::Rotary => (1f64.to_radians(), 10f64.to_radians()),
-        Axis::Linear => (1e-3, 10e-3),
-    };
-    let samples = run(p, c, &[(0.0, step, None, 1.0)])?;
-    let peak_step = samples.iter().map(|s| s.1).fold(f64::MIN, f64::max);
-    let settled = samples
-        .iter()
-        .rev()
-        .find(|s| (s.1 - step).abs() * k > SETTLED)
-        .map(|s| s.0);
-    let leg = 5.0 * step / speed;
-    let out_and_back = run(
-        p,
-        c,
-        &[
-            (0.0, 5.0 * step, Some(speed), leg),
-            (5.0 * step, 0.0, Some(speed), leg),
-        ],
-    )?;
-    let (following, spike) = following_errors(&out_and_back, leg);
-    let peak = samples
-        .iter()
-        .chain(&out_and_back)
-        .map(|s| s.3.abs())
-        .fold(0.0, f64::max);
-    Ok(Responses {
-        step: step * u.target_per_si,
-        step_overshoot_percent: ((peak_step / step - 1.0) * 100.0).max(0.0),
-        step_settling_s: match settled {
-            Some(t) if t >= 1.0 - 1e-9 => None,
-            Some(t) => Some(t),
-            None => Some(0.0),
-        },
-        following_error: following * k,
-        reversal_spike: spike * k,
-        peak_effort: peak,
-        unit: u.deviation,
-    })
+    responses_batch(std::slice::from_ref(p), c)
+        .pop()
+        .expect("one set, one result")
 }
 
-/// (t, position, reference, effort) every step.
-type Sample = (f64, f64, f64, f64);
+/// [`responses_with`] for each of `sets` (of one axis kind), in the kernel's lanes.
+pub fn responses_batch(sets: &[Params], c: &Compensation) -> Vec<Result<Responses, SimError>> {
+    in_lanes(sets, &Runs(c))
+}
 
-/// Runs the moves (from, to, speed, duration) one after the other from rest.
-fn run(
-    p: &Params,
+/// The step and the move, for `sim::batch`.
+struct Runs<'a>(&'a Compensation);
+
+impl LaneRun for Runs<'_> {
+    type Out = Responses;
+
+    fn lone(&self, p: &Params) -> Result<Responses, SimError> {
+        let [one] = self.lanes(&[p.clone()])?;
+        one
+    }
+
+    fn lanes<const L: usize>(
+        &self,
+        params: &[Params; L],
+    ) -> Result<[Result<Responses, SimError>; L], SimError> {
+        let axis = params[0].axis;
+        if params.iter().any(|p| p.axis != axis) {
+            return Ok(params.each_ref().map(|p| self.lone(p)));
+        }
+        let (step, speed) = match axis {
+            Axis::Rotary => (1f64.to_radians(), 10f64.to_radians()),
+            Axis::Linear => (1e-3, 10e-3),
+        };
+        let steps = run(params, self.0, &[(0.0, step, None, STEP_S)])?;
+        let leg = 5.0 * step / speed;
+        let moves = run(
+            params,
+            self.0,
+            &[
+                (0.0, 5.0 * step, Some(speed), leg),
+                (5.0 * step, 0.0, Some(speed), leg),
+            ],
+        )?;
+        let mut moves = moves.into_iter();
+        Ok(steps.map(|s| {
+            let m = moves.next().expect("one per lane");
+            Ok(figures(&s?, &m?, step, leg, ReportUnits::of(axis)))
+        }))
+    }
+}
+
+/// The figures of one set's step and move samples.
+fn figures(steps: &[Sample], moves: &[Sample], step: f64, leg: f64, u: ReportUnits) -> Responses {
+    let k = u.deviation_per_si;
+    let motor = |s: &Sample| s.1;
+    let table = |s: &Sample| s.2;
+    let (following, spike) = following_errors(moves, leg);
+    let effort = |samples: &[Sample]| samples.iter().map(|s| s.4.abs()).fold(0.0, f64::max);
+    Responses {
+        step: step * u.target_per_si,
+        step_overshoot_percent: overshoot(steps, step, motor),
+        step_settling_s: settling(steps, step, k, motor),
+        table_overshoot_percent: overshoot(steps, step, table),
+        table_settling_s: settling(steps, step, k, table),
+        table_motion_at_rest: motion_after(steps, STEP_S - REST_WINDOW_S, table) * k,
+        following_error: following * k,
+        reversal_spike: spike * k,
+        peak_effort: effort(steps).max(effort(moves)),
+        move_peak_effort: effort(moves),
+        unit: u.deviation,
+    }
+}
+
+/// The largest excursion of `at` beyond `step`, % of it.
+fn overshoot(samples: &[Sample], step: f64, at: impl Fn(&Sample) -> f64) -> f64 {
+    let peak = samples.iter().map(at).fold(f64::MIN, f64::max);
+    ((peak / step - 1.0) * 100.0).max(0.0)
+}
+
+/// When `at` stays within [`SETTLED`] report units (`k` per SI unit) of `step`.
+fn settling(samples: &[Sample], step: f64, k: f64, at: impl Fn(&Sample) -> f64) -> Option<f64> {
+    let last_out = samples
+        .iter()
+        .rev()
+        .find(|s| (at(s) - step).abs() * k > SETTLED)
+        .map(|s| s.0);
+    match last_out {
+        Some(t) if t >= STEP_S - 1e-9 => None,
+        Some(t) => Some(t),
+        None => Some(0.0),
+    }
+}
+
+/// The peak-to-peak of `at` from time `from` on.
+fn motion_after(samples: &[Sample], from: f64, at: impl Fn(&Sample) -> f64) -> f64 {
+    let (lo, hi) = samples
+        .iter()
+        .filter(|s| s.0 >= from)
+        .map(at)
+        .fold((f64::MAX, f64::MIN), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    (hi - lo).max(0.0)
+}
+
+/// (t, motor × ratio, table, reference, effort) every step.
+type Sample = (f64, f64, f64, f64, f64);
+
+/// A lane's samples of one move (the reference filled in afterwards).
+struct Positions {
+    ratio: f64,
+    samples: Vec<Sample>,
+}
+
+impl Recorder for Positions {
+    fn record(&mut self, t: f64, y: &[f64; NSTATE], effort: f64) {
+        self.samples
+            .push((t, y[THETA_M] * self.ratio, y[THETA_T], 0.0, effort));
+    }
+}
+
+/// Runs the moves (from, to, speed, duration) one after the other from rest, every
+/// set in a lane: each lane's samples, or its error.
+fn run<const L: usize>(
+    params: &[Params; L],
     c: &Compensation,
     moves: &[(f64, f64, Option<f64>, f64)],
-) -> Result<Vec<Sample>, SimError> {
-    let mut sim = Simulation::with_default_step(p)?;
-    let mut controller = sim.controller(p)?;
-    controller.set_compensation(c.clone());
-    let mut out = Vec::new();
+) -> Result<[Result<Vec<Sample>, SimError>; L], SimError> {
+    let mut sim = LaneSimulation::<L>::of(params, common_step(params)?)?;
+    let mut controllers = sim.controllers(params)?;
+    for controller in &mut controllers {
+        controller.set_compensation(c.clone());
+    }
+    let mut out: [Vec<Sample>; L] = std::array::from_fn(|_| Vec::new());
+    let mut failed: [Option<SimError>; L] = std::array::from_fn(|_| None);
     for &(from, to, speed, duration) in moves {
         let m = Move { from, to, speed };
-        let t0 = sim.time();
+        let t0 = sim.time(0);
         let reference = |t: f64| m.angle(t - t0);
-        let mut trace = Trace::every(1);
-        sim.run_closed_loop(&mut controller, &reference, duration, &mut trace)?;
-        out.extend(trace.samples.iter().map(|s| {
-            (
-                s.t,
-                s.y[THETA_M] * p.ratio(),
-                reference(s.t),
-                s.motor_torque,
-            )
-        }));
+        let mut recorders = params.each_ref().map(|p| Positions {
+            ratio: p.ratio(),
+            samples: Vec::new(),
+        });
+        sim.run_closed_loop(
+            (&mut controllers, &mut recorders),
+            &reference,
+            duration,
+            &mut failed,
+        )?;
+        for (o, r) in out.iter_mut().zip(recorders) {
+            o.extend(
+                r.samples
+                    .into_iter()
+                    .map(|s| (s.0, s.1, s.2, reference(s.0), s.4)),
+            );
+        }
     }
-    Ok(out)
+    let mut out = out.into_iter();
+    Ok(failed.map(|f| {
+        let samples = out.next().expect("one per lane");
+        f.map_or(Ok(samples), Err)
+    }))
 }
 
 /// The largest following error on the second half of the first leg, and the spike:
 /// the largest error on the second leg less its own second half's largest.
 fn following_errors(samples: &[Sample], leg: f64) -> (f64, f64) {
-    let error = |s: &Sample| (s.2 - s.1).abs();
+    let error = |s: &Sample| (s.3 - s.1).abs();
     let largest = |from: f64, to: f64| {
         samples
             .iter()
