@@ -210,8 +210,33 @@ pub struct Tuned {
     /// Both settings on the standard cycle, compensated in the controller.
     pub check: Check,
     pub warnings: Vec<TuneWarning>,
+    /// Every candidate within the targets as the screening weighed it.
+    pub candidates: Vec<Screened>,
     #[serde(skip)]
     pub params: Params,
+}
+
+/// A candidate as the screening weighed it (report units; `score` against today's,
+/// `None` where refused, with the reason).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Screened {
+    #[serde(rename = "Kvp")]
+    pub kvp: f64,
+    #[serde(rename = "Kvi")]
+    pub kvi: f64,
+    #[serde(rename = "Kpp")]
+    pub kpp: f64,
+    pub crossover_hz: f64,
+    pub phase_margin_deg: Option<f64>,
+    #[serde(rename = "A")]
+    pub a: Option<f64>,
+    #[serde(rename = "R")]
+    pub r: Option<f64>,
+    pub table_settling_s: Option<f64>,
+    pub following_error: Option<f64>,
+    pub table_motion_at_rest: Option<f64>,
+    pub score: Option<f64>,
+    pub refused: Option<String>,
 }
 
 /// Today's and the proposed setting on the nonlinear model.
@@ -221,8 +246,7 @@ pub struct Check {
     pub after: Criteria,
 }
 
-/// How many of the best screened settings are checked on the standard cycle, at
-/// most, until one beats today's.
+/// How many of the best screened settings are checked on the standard cycle.
 const CHECKED: usize = 3;
 
 /// Tunes `p`'s cascade (`p` validated) in its configured loop: candidates that keep
@@ -249,7 +273,8 @@ pub fn tune(
     let mut screened = screen(&sets, progress);
     let today = std::mem::replace(&mut screened[0], Err(CriteriaError::Unscreened))
         .map_err(TuneError::Today)?;
-    let ranked = rank(p, options, &sets, &screened, &today);
+    let ranked = rank(p, options, &screened, &today);
+    let table = screened_table(&found, &screened, &ranked);
     let refused = sets.len() - 1 - ranked.len();
     let before_check = criteria::check(p).map_err(TuneError::Today)?;
     let chosen = choose(options.objective, &sets, &ranked, &before_check);
@@ -305,8 +330,45 @@ pub fn tune(
             after: after_check,
         },
         warnings,
+        candidates: table,
         params,
     })
+}
+
+/// The candidates (`found`, screened from index 1 on) as the JSON lists them.
+fn screened_table(
+    found: &[Candidate],
+    screened: &[Result<Criteria, CriteriaError>],
+    ranked: &[(usize, f64)],
+) -> Vec<Screened> {
+    found
+        .iter()
+        .zip(&screened[1..])
+        .enumerate()
+        .map(|(i, (c, r))| {
+            let ok = r.as_ref().ok();
+            let score = ranked.iter().find(|x| x.0 == i + 1).map(|x| x.1);
+            let refused = match (r, score) {
+                (Err(e), _) => Some(e.to_string()),
+                (Ok(_), None) => Some("a limit cycle or the torque reserve".to_string()),
+                _ => None,
+            };
+            Screened {
+                kvp: c.pi.0,
+                kvi: c.pi.1,
+                kpp: c.kpp,
+                crossover_hz: c.crossover_hz,
+                phase_margin_deg: c.cascade.margins.phase_margin_deg,
+                a: ok.map(|c| c.positioning.a),
+                r: ok.map(|c| c.positioning.r),
+                table_settling_s: ok.and_then(|c| c.servo.table_settling_s),
+                following_error: ok.map(|c| c.servo.following_error),
+                table_motion_at_rest: ok.map(|c| c.servo.table_motion_at_rest),
+                score,
+                refused,
+            }
+        })
+        .collect()
 }
 
 /// The linear rule of rtid's first tuning, one of the search's candidates: notches
@@ -404,17 +466,18 @@ fn screen(
 }
 
 /// The candidates (indices into the sets, today's excluded) the nonlinear model
-/// admits — no limit cycle, the torque reserve kept —, best score first.
+/// admits — no limit cycle, the torque reserve kept —, with their scores: first those
+/// that keep every criterion the objective lists ([`Objective::keeps`]), best score
+/// first, then the others.
 fn rank(
     p: &Params,
     o: &Options,
-    sets: &[Params],
     screened: &[Result<Criteria, CriteriaError>],
     today: &Criteria,
 ) -> Vec<(usize, f64)> {
     let effort_cap = (1.0 - o.torque_reserve) * p.controller.torque_limit * p.controller.drive_gain;
     let rest_cap = limit_cycle_threshold(p).max(2.0 * today.servo.table_motion_at_rest);
-    let mut out: Vec<(usize, f64)> = screened
+    let mut out: Vec<(usize, f64, bool)> = screened
         .iter()
         .enumerate()
         .skip(1)
@@ -422,12 +485,12 @@ fn rank(
             let c = c.as_ref().ok()?;
             let admitted = c.servo.table_motion_at_rest <= rest_cap
                 && c.servo.move_peak_effort <= effort_cap.max(today.servo.move_peak_effort);
-            admitted.then(|| (i, o.objective.score(c, today)))
+            let keeps = o.objective.keeps(c, today);
+            admitted.then(|| (i, o.objective.score(c, today), keeps))
         })
         .collect();
-    out.sort_by(|a, b| a.1.total_cmp(&b.1));
-    debug_assert!(out.iter().all(|(i, _)| *i < sets.len()));
-    out
+    out.sort_by(|a, b| b.2.cmp(&a.2).then(a.1.total_cmp(&b.1)));
+    out.into_iter().map(|(i, score, _)| (i, score)).collect()
 }
 
 /// The table's motion at rest that counts as a limit cycle: three table-encoder
@@ -443,39 +506,55 @@ fn ranked_score(ranked: &[(usize, f64)], i: usize) -> f64 {
 
 /// The outcome of checking the best screened settings.
 struct Chosen {
-    /// The first that beats today's on the check: index, figures, score.
+    /// The one that beats today's most on the check: index, figures, score.
     best: Option<(usize, Criteria, f64)>,
-    /// The lowest check score of those that did not.
+    /// The lowest check score when none beats today's.
     best_failed: Option<f64>,
     checked: usize,
 }
 
-/// Checks the best screened settings that beat today's (score < 1) on the standard
-/// cycle, in order, until one beats today's there too.
+/// Checks the best [`CHECKED`] screened settings that beat today's (score < 1) on
+/// the standard cycle, and takes the one that beats today's most there among those
+/// that keep every criterion the objective lists, else among all.
 fn choose(
     objective: Objective,
     sets: &[Params],
     ranked: &[(usize, f64)],
     today: &Criteria,
 ) -> Chosen {
-    let mut chosen = Chosen {
-        best: None,
-        best_failed: None,
-        checked: 0,
+    let picked: Vec<usize> = ranked
+        .iter()
+        .filter(|r| r.1 < 1.0)
+        .take(CHECKED)
+        .map(|r| r.0)
+        .collect();
+    let checked: Vec<(usize, Criteria, f64)> = picked
+        .par_iter()
+        .filter_map(|&i| {
+            let c = criteria::check(&sets[i]).ok()?;
+            let score = objective.score(&c, today);
+            Some((i, c, score))
+        })
+        .collect();
+    let better = |c: &&(usize, Criteria, f64)| c.2 < 1.0;
+    let lowest = |keeping: bool| {
+        checked
+            .iter()
+            .filter(better)
+            .filter(|c| !keeping || objective.keeps(&c.1, today))
+            .min_by(|a, b| a.2.total_cmp(&b.2))
+            .cloned()
     };
-    for &(i, _) in ranked.iter().filter(|r| r.1 < 1.0).take(CHECKED) {
-        chosen.checked += 1;
-        let Ok(c) = criteria::check(&sets[i]) else {
-            continue;
-        };
-        let score = objective.score(&c, today);
-        if score < 1.0 {
-            chosen.best = Some((i, c, score));
-            break;
-        }
-        chosen.best_failed = Some(chosen.best_failed.map_or(score, |b: f64| b.min(score)));
+    let best = lowest(true).or_else(|| lowest(false));
+    let best_failed = match best {
+        Some(_) => None,
+        None => checked.iter().map(|c| c.2).min_by(f64::total_cmp),
+    };
+    Chosen {
+        best,
+        best_failed,
+        checked: picked.len(),
     }
-    chosen
 }
 
 #[cfg(test)]

@@ -135,8 +135,12 @@ impl Criterion {
     }
 }
 
+/// The weight of each criterion an objective does not list: enough that a setting
+/// which makes one of them several times worse pays for it.
+pub const OTHERS: f64 = 0.05;
+
 impl Objective {
-    /// The criteria and their weights.
+    /// The criteria and their weights; every other criterion weighs [`OTHERS`].
     pub fn weights(self) -> &'static [(Criterion, f64)] {
         use Criterion::*;
         match self {
@@ -162,18 +166,36 @@ impl Objective {
         }
     }
 
-    /// The weighted mean ratio of `c`'s criteria to `today`'s: 1 for today's
-    /// setting, below 1 for a better one.
+    /// The weighted mean ratio of `c`'s criteria to `today`'s, over every criterion:
+    /// 1 for today's setting, below 1 for a better one.
     pub fn score(self, c: &Criteria, today: &Criteria) -> f64 {
-        let (sum, weight) = self
-            .weights()
+        let listed = self.weights();
+        let others = ALL
             .iter()
-            .fold((0.0, 0.0), |(sum, weight), &(k, w)| {
-                let t = k.value(today);
-                let floor = k.floor(t);
-                (sum + w * (k.value(c) + floor) / (t + floor), weight + w)
-            });
+            .filter(|k| !listed.iter().any(|(l, _)| l == *k))
+            .map(|&k| (k, OTHERS));
+        let (sum, weight) =
+            listed
+                .iter()
+                .copied()
+                .chain(others)
+                .fold((0.0, 0.0), |(sum, weight), (k, w)| {
+                    let t = k.value(today);
+                    let floor = k.floor(t);
+                    (sum + w * (k.value(c) + floor) / (t + floor), weight + w)
+                });
         sum / weight
+    }
+}
+
+impl Objective {
+    /// Whether `c` is no worse than `today` on any criterion the objective lists
+    /// (as [`worse`] judges): such a setting is preferred to a better-scoring one
+    /// that trades one of them away.
+    pub fn keeps(self, c: &Criteria, today: &Criteria) -> bool {
+        worse(c, today)
+            .iter()
+            .all(|w| !self.weights().iter().any(|(k, _)| *k == w.criterion))
     }
 }
 
