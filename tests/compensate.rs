@@ -252,14 +252,11 @@ fn the_sinumerik_program_holds_the_table_modulo_360() {
     assert_eq!(rows.len(), 14, "{csv}");
 }
 
-/// The record with a warm-up drift added: runs shifted progressively, more at larger
-/// angles (3″ per run across the turn). The table of runs 1–3 does not repeat on runs
-/// 4–5, and the output says so.
-#[test]
-fn a_drifting_axis_gets_a_warning() {
-    let dir = tempfile::tempdir().unwrap();
+/// The fixture's record in `dir`, each reading (arc-seconds) changed by
+/// `change(target_deg, run, reading)`.
+fn changed_record(dir: &Path, change: impl Fn(f64, f64, f64) -> f64) {
     let csv = std::fs::read_to_string(fixture().join("positioning.csv")).unwrap();
-    let mut drifted = String::new();
+    let mut changed = String::new();
     for line in csv.lines() {
         let cells: Vec<&str> = line.split(',').collect();
         match (
@@ -268,19 +265,29 @@ fn a_drifting_axis_gets_a_warning() {
         ) {
             (4, Some(target)) => {
                 let run: f64 = cells[2].parse().unwrap();
-                let x: f64 = cells[3].parse().unwrap();
-                let x = x + (run - 3.0) * 3.0 * target / 360.0;
-                drifted.push_str(&format!("{},{},{},{x}\n", cells[0], cells[1], cells[2]));
+                let x = change(target, run, cells[3].parse().unwrap());
+                changed.push_str(&format!("{},{},{},{x}\n", cells[0], cells[1], cells[2]));
             }
-            _ => drifted.push_str(&format!("{line}\n")),
+            _ => changed.push_str(&format!("{line}\n")),
         }
     }
-    std::fs::write(dir.path().join("positioning.csv"), drifted).unwrap();
+    std::fs::write(dir.join("positioning.csv"), changed).unwrap();
     std::fs::copy(
         fixture().join("positioning.json"),
-        dir.path().join("positioning.json"),
+        dir.join("positioning.json"),
     )
     .unwrap();
+}
+
+/// The record with a warm-up drift added: runs shifted progressively, more at larger
+/// angles (3″ per run across the turn). The table of runs 1–3 does not repeat on runs
+/// 4–5, and the output says so.
+#[test]
+fn a_drifting_axis_gets_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    changed_record(dir.path(), |target, run, x| {
+        x + (run - 3.0) * 3.0 * target / 360.0
+    });
     let out = rtid(
         &["compensate", "positioning.json", "--runs", "1-3"],
         dir.path(),
@@ -298,6 +305,42 @@ fn a_drifting_axis_gets_a_warning() {
     // Built from every run, it is not checked, and says that instead.
     let text = ok(&rtid(&["compensate", "positioning.json"], dir.path()));
     assert!(text.contains("warning: built from every run"), "{text}");
+}
+
+/// Runs 4–5 without their reversal at 90° (both directions read −17.28″ ± 2″): the
+/// backlash of runs 1–3 leaves 35″ of reversal there, R of runs 4–5 grows, and the
+/// table and the JSON say by how much.
+#[test]
+fn a_repeatability_made_worse_gets_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    changed_record(dir.path(), |target, run, x| {
+        match (target.round() as i32, run as i32) {
+            (90, 4) => -15.28,
+            (90, 5) => -19.28,
+            _ => x,
+        }
+    });
+    let args = ["compensate", "positioning.json", "--runs", "1-3"];
+    let text = ok(&rtid(&args, dir.path()));
+    assert!(
+        text.contains("warning: the compensation makes the repeatability R of the runs it was not built from worse by"),
+        "{text}"
+    );
+    let got = json(&rtid(&[&args[..], &["--json"]].concat(), dir.path()));
+    let warning = got["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|w| w["code"] == "repeatability_worse")
+        .unwrap_or_else(|| panic!("{got}"));
+    let (before, after) = (
+        got["check"]["before"]["R"].as_f64().unwrap(),
+        got["check"]["after"]["R"].as_f64().unwrap(),
+    );
+    assert!(after > before, "{got}");
+    let message = warning["message"].as_str().unwrap();
+    let by = format!("worse by {:.2}″: {before:.2}″ without it", after - before);
+    assert!(message.contains(&by), "{by}: {message}");
 }
 
 #[test]

@@ -34,7 +34,8 @@ With --runs the compensation is built from those runs and checked on the others:
 ISO 230-2 values before and after are printed for both, and a warning says so when it \
 does not lower the systematic deviation E of the runs it was not built from (an axis that \
 drifts between runs, warming up): a table that only fits the runs it came from is no \
-compensation. Without --runs every run builds it, and nothing checks it.
+compensation. Warnings also say when it makes their accuracy A or repeatability R worse. \
+Without --runs every run builds it, and nothing checks it.
 
 Outputs, each only when asked and never over an input, written atomically:
   -o compensation.json   positions and values in degrees (mm on a linear axis)
