@@ -197,12 +197,26 @@ fn evaluate_with_the_compensation_halves_e_on_the_runs_it_was_not_built_from() {
     );
 }
 
+/// The `name[…]=value` assignments of a SINUMERIK program: index and value.
+fn assigned(lines: &[&str], name: &str) -> Vec<(String, f64)> {
+    lines
+        .iter()
+        .filter_map(|l| l.strip_prefix(name))
+        .map(|rest| {
+            let (index, value) = rest.split_once("]=").unwrap();
+            (index.to_string(), value.trim().parse::<f64>().unwrap())
+        })
+        .collect()
+}
+
 /// The SINUMERIK program parsed back holds the table's values with SINUMERIK's sign
-/// (the axis's error, −table) to its printed precision, every 30° modulo 360°.
+/// (the axis's error, −table) to its printed precision, every 30° modulo 360°, less
+/// their value at the reference point (by default the first, 0°), which its comment
+/// and the command's JSON state.
 #[test]
 fn the_sinumerik_program_holds_the_table_modulo_360() {
     let dir = tempfile::tempdir().unwrap();
-    compensate_into(dir.path());
+    let got = compensate_into(dir.path());
     let text = std::fs::read_to_string(dir.path().join("AX4_EEC.SPF")).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines[0], "%_N_AX_EEC_INI");
@@ -219,29 +233,41 @@ fn the_sinumerik_program_holds_the_table_modulo_360() {
         b_mean < 0.0 && (value + b_mean).abs() < 1e-9,
         "{value} against B̄ {b_mean}°"
     );
-    let assigned = |name: &str| -> Vec<(String, f64)> {
-        lines
-            .iter()
-            .filter_map(|l| l.strip_prefix(name))
-            .map(|rest| {
-                let (index, value) = rest.split_once("]=").unwrap();
-                (index.to_string(), value.trim().parse::<f64>().unwrap())
-            })
-            .collect()
-    };
-    let values = assigned("$AA_ENC_COMP[0,");
+    let values = assigned(&lines, "$AA_ENC_COMP[0,");
     let want = numbers(&expected()["sinumerik_deg"]);
     assert_eq!(values.len(), want.len());
+    assert_eq!(values[0].1, 0.0, "zero at the reference point 0°");
     for (i, ((index, v), w)) in values.iter().zip(&want).enumerate() {
         assert_eq!(index, &format!("{i},AX4"));
-        assert!((v - w).abs() <= 0.5e-9 + 1e-15, "point {i}: {v} vs {w}");
+        let w = w - want[0];
+        assert!((v - w).abs() <= 1e-9 + 1e-15, "point {i}: {v} vs {w}");
     }
     assert_eq!(
         values[0].1,
         values[values.len() - 1].1,
         "0° and 360° one value"
     );
-    let one = |name: &str| assigned(name)[0].1;
+    // The shift is the table's value at 0° (−x̄↑ there): in the program's comment in
+    // degrees and in the JSON in arc-seconds.
+    let shift = -want[0];
+    let stated = format!("each value is -(table - {shift:.9}), rtid's table less its value there");
+    assert!(text.contains(&stated), "{stated}:\n{text}");
+    assert!(
+        text.contains("; zero at the reference point 0.000000 deg"),
+        "{text}"
+    );
+    assert!(
+        text.contains("MD32700 $MA_ENC_COMP_ENABLE[0,AX4] = 0")
+            && text.contains("then set MD32700 $MA_ENC_COMP_ENABLE[0,AX4] = 1"),
+        "{text}"
+    );
+    assert_eq!(got["sinumerik"]["reference_deg"], 0.0, "{got}");
+    same(
+        got["sinumerik"]["shift"].as_f64().unwrap(),
+        shift * 3600.0,
+        "the shift",
+    );
+    let one = |name: &str| assigned(&lines, name)[0].1;
     assert_eq!(one("$AA_ENC_COMP_STEP[0,"), 30.0);
     assert_eq!(one("$AA_ENC_COMP_MIN[0,"), 0.0);
     assert_eq!(one("$AA_ENC_COMP_MAX[0,"), 360.0);
@@ -252,14 +278,73 @@ fn the_sinumerik_program_holds_the_table_modulo_360() {
     assert_eq!(rows.len(), 14, "{csv}");
 }
 
-/// The record with a warm-up drift added: runs shifted progressively, more at larger
-/// angles (3″ per run across the turn). The table of runs 1–3 does not repeat on runs
-/// 4–5, and the output says so.
+/// `--reference-deg 90`: the program is zero at 90° (its fourth point), every value
+/// shifted by the table's value there, which the output states; a reference outside
+/// the table, or in the other axis's unit, is refused naming the option.
 #[test]
-fn a_drifting_axis_gets_a_warning() {
+fn the_sinumerik_program_is_zero_at_the_reference_given() {
     let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let record = fixture().join("positioning.json");
+    let record = record.to_str().unwrap();
+    let args = [
+        "compensate",
+        record,
+        "--runs",
+        "1-3",
+        "--sinumerik",
+        "AX4_EEC.SPF",
+        "--axis-number",
+        "4",
+        "--reference-deg",
+        "90",
+    ];
+    let got = json(&rtid(&[&args[..], &["--json"]].concat(), d));
+    let text = std::fs::read_to_string(d.join("AX4_EEC.SPF")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let values = assigned(&lines, "$AA_ENC_COMP[0,");
+    assert_eq!(values[3], ("3,AX4".to_string(), 0.0), "{text}");
+    let want = numbers(&expected()["sinumerik_deg"]);
+    for (i, ((_, v), w)) in values.iter().zip(&want).enumerate() {
+        assert!((v - (w - want[3])).abs() <= 1e-9 + 1e-15, "point {i}: {v}");
+    }
+    let table_at_90 = got["targets"][3]["table"].as_f64().unwrap();
+    assert_eq!(got["sinumerik"]["reference_deg"], 90.0);
+    same(
+        got["sinumerik"]["shift"].as_f64().unwrap(),
+        table_at_90,
+        "the shift",
+    );
+    assert!(
+        text.contains("; zero at the reference point 90.000000 deg"),
+        "{text}"
+    );
+    let printed = ok(&rtid(&args, d));
+    let line = format!(
+        "SINUMERIK program: zero at the reference point 90.00°, rtid's table less its value there, {table_at_90:.2}″"
+    );
+    assert!(printed.contains(&line), "{line}:\n{printed}");
+    let refused = |extra: [&str; 2], expect: &str| {
+        let args = [&args[..8], &extra[..]].concat();
+        let e = err(&rtid(&args, d));
+        assert!(e.contains(expect), "{extra:?}: {e}");
+    };
+    refused(
+        ["--reference-deg", "400"],
+        "--reference-deg 400: outside the SINUMERIK table, which runs from 0.000 to 360.000 deg",
+    );
+    refused(["--reference-deg", "-1"], "--reference-deg -1: outside");
+    refused(
+        ["--reference-mm", "5"],
+        "--reference-mm is for a linear axis",
+    );
+}
+
+/// The fixture's record in `dir`, each reading (arc-seconds) changed by
+/// `change(target_deg, run, reading)`.
+fn changed_record(dir: &Path, change: impl Fn(f64, f64, f64) -> f64) {
     let csv = std::fs::read_to_string(fixture().join("positioning.csv")).unwrap();
-    let mut drifted = String::new();
+    let mut changed = String::new();
     for line in csv.lines() {
         let cells: Vec<&str> = line.split(',').collect();
         match (
@@ -268,19 +353,29 @@ fn a_drifting_axis_gets_a_warning() {
         ) {
             (4, Some(target)) => {
                 let run: f64 = cells[2].parse().unwrap();
-                let x: f64 = cells[3].parse().unwrap();
-                let x = x + (run - 3.0) * 3.0 * target / 360.0;
-                drifted.push_str(&format!("{},{},{},{x}\n", cells[0], cells[1], cells[2]));
+                let x = change(target, run, cells[3].parse().unwrap());
+                changed.push_str(&format!("{},{},{},{x}\n", cells[0], cells[1], cells[2]));
             }
-            _ => drifted.push_str(&format!("{line}\n")),
+            _ => changed.push_str(&format!("{line}\n")),
         }
     }
-    std::fs::write(dir.path().join("positioning.csv"), drifted).unwrap();
+    std::fs::write(dir.join("positioning.csv"), changed).unwrap();
     std::fs::copy(
         fixture().join("positioning.json"),
-        dir.path().join("positioning.json"),
+        dir.join("positioning.json"),
     )
     .unwrap();
+}
+
+/// The record with a warm-up drift added: runs shifted progressively, more at larger
+/// angles (3″ per run across the turn). The table of runs 1–3 does not repeat on runs
+/// 4–5, and the output says so.
+#[test]
+fn a_drifting_axis_gets_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    changed_record(dir.path(), |target, run, x| {
+        x + (run - 3.0) * 3.0 * target / 360.0
+    });
     let out = rtid(
         &["compensate", "positioning.json", "--runs", "1-3"],
         dir.path(),
@@ -298,6 +393,42 @@ fn a_drifting_axis_gets_a_warning() {
     // Built from every run, it is not checked, and says that instead.
     let text = ok(&rtid(&["compensate", "positioning.json"], dir.path()));
     assert!(text.contains("warning: built from every run"), "{text}");
+}
+
+/// Runs 4–5 without their reversal at 90° (both directions read −17.28″ ± 2″): the
+/// backlash of runs 1–3 leaves 35″ of reversal there, R of runs 4–5 grows, and the
+/// table and the JSON say by how much.
+#[test]
+fn a_repeatability_made_worse_gets_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    changed_record(dir.path(), |target, run, x| {
+        match (target.round() as i32, run as i32) {
+            (90, 4) => -15.28,
+            (90, 5) => -19.28,
+            _ => x,
+        }
+    });
+    let args = ["compensate", "positioning.json", "--runs", "1-3"];
+    let text = ok(&rtid(&args, dir.path()));
+    assert!(
+        text.contains("warning: the compensation makes the repeatability R of the runs it was not built from worse by"),
+        "{text}"
+    );
+    let got = json(&rtid(&[&args[..], &["--json"]].concat(), dir.path()));
+    let warning = got["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|w| w["code"] == "repeatability_worse")
+        .unwrap_or_else(|| panic!("{got}"));
+    let (before, after) = (
+        got["check"]["before"]["R"].as_f64().unwrap(),
+        got["check"]["after"]["R"].as_f64().unwrap(),
+    );
+    assert!(after > before, "{got}");
+    let message = warning["message"].as_str().unwrap();
+    let by = format!("worse by {:.2}″: {before:.2}″ without it", after - before);
+    assert!(message.contains(&by), "{by}: {message}");
 }
 
 #[test]

@@ -13,8 +13,9 @@ use rtid::model::{presets, Params};
 /// Which parameter set to use, and overrides.
 #[derive(Debug, Clone, Args)]
 pub struct ModelArgs {
-    /// Shipped parameter set: worm-gear or roller-gear-cam (IMECE2008-66108 Table 1).
-    #[arg(long, value_name = "NAME", conflicts_with = "params")]
+    // Shipped parameter set; the help names every preset of the registry
+    // (`presets::names`), so that a new preset cannot be left out of it.
+    #[arg(long, value_name = "NAME", conflicts_with = "params", help = preset_help())]
     pub preset: Option<String>,
     /// Parameter file (JSON, SI units), e.g. one written by `rtid params --out`.
     #[arg(long, value_name = "FILE.json")]
@@ -22,6 +23,14 @@ pub struct ModelArgs {
     /// Override one parameter, SI units; repeatable: --set Kw=3.5e5 --set theta_bw=5e-5.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
+}
+
+/// The help of `--preset`: every shipped parameter set, by name.
+fn preset_help() -> String {
+    format!(
+        "Shipped parameter set: {} (worm-gear and roller-gear-cam: IMECE2008-66108 Table 1)",
+        presets::names().collect::<Vec<_>>().join(", ")
+    )
 }
 
 impl ModelArgs {
@@ -124,6 +133,25 @@ mod tests {
             preset: Some(preset.into()),
             params: None,
             set: set.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    /// `--help` of a command that flattens the model arguments names every preset.
+    #[test]
+    fn the_preset_help_names_every_preset() {
+        use clap::CommandFactory;
+        #[derive(clap::Parser)]
+        struct Cli {
+            #[command(flatten)]
+            model: ModelArgs,
+        }
+        for help in [
+            Cli::command().render_help().to_string(),
+            Cli::command().render_long_help().to_string(),
+        ] {
+            for name in presets::names() {
+                assert!(help.contains(name), "`{name}` missing from:\n{help}");
+            }
         }
     }
 

@@ -4,6 +4,7 @@
 //! and a CSV.
 
 mod model;
+mod sinumerik;
 
 use std::path::{Path, PathBuf};
 
@@ -18,7 +19,7 @@ use rtid::experiments::friction_map;
 use rtid::experiments::positioning::compensate::{self, BeforeAfter, Computed, Runs};
 use rtid::experiments::positioning::iso230::{AxisStats, ReportUnits};
 use rtid::experiments::positioning::{self};
-use rtid::io::compensation_file::{self, sinumerik, table_csv, CompensationFile, Source};
+use rtid::io::compensation_file::{self, table_csv, CompensationFile, Source};
 use rtid::io::experiment_file::{self, Data, Experiment};
 use rtid::model::Axis;
 
@@ -34,13 +35,16 @@ With --runs the compensation is built from those runs and checked on the others:
 ISO 230-2 values before and after are printed for both, and a warning says so when it \
 does not lower the systematic deviation E of the runs it was not built from (an axis that \
 drifts between runs, warming up): a table that only fits the runs it came from is no \
-compensation. Without --runs every run builds it, and nothing checks it.
+compensation. Warnings also say when it makes their accuracy A or repeatability R worse. \
+Without --runs every run builds it, and nothing checks it.
 
 Outputs, each only when asked and never over an input, written atomically:
   -o compensation.json   positions and values in degrees (mm on a linear axis)
   --sinumerik FILE --axis-number N   a SINUMERIK EEC program ($AA_ENC_COMP…, values the \
 axis's error: the opposite sign), resampled onto equidistant points, modulo 360° on a \
-rotary table; the backlash for MD32450 in a comment
+rotary table, shifted to be zero at the reference point (--reference-deg or \
+--reference-mm; default the table's first point: the shift is printed); the backlash \
+for MD32450 in a comment
   --csv FILE             position_deg,value_arcsec (position_mm,value_um)
 
 Examples:
@@ -98,6 +102,25 @@ pub struct Args {
     /// The machine axis of the SINUMERIK program: AX<N>.
     #[arg(long, value_name = "N")]
     pub axis_number: Option<u32>,
+    /// Rotary axis: the reference point of the SINUMERIK program, degrees; its table
+    /// is shifted to be zero there [default: the table's first point].
+    #[arg(
+        long,
+        value_name = "DEG",
+        requires = "sinumerik",
+        conflicts_with = "reference_mm",
+        allow_negative_numbers = true
+    )]
+    pub reference_deg: Option<f64>,
+    /// Linear axis: the reference point of the SINUMERIK program, mm; its table is
+    /// shifted to be zero there [default: the table's first point].
+    #[arg(
+        long,
+        value_name = "MM",
+        requires = "sinumerik",
+        allow_negative_numbers = true
+    )]
+    pub reference_mm: Option<f64>,
     /// Write the table as CSV.
     #[arg(long, value_name = "FILE.csv")]
     pub csv: Option<PathBuf>,
@@ -125,17 +148,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(p) = origin.model.as_ref().filter(|_| a.friction) {
         computed.compensation.friction = Some(model::friction(p, &origin.name)?);
     }
-    write_outputs(&a, &origin, &computed, &outputs)?;
+    let zeroed = sinumerik::table(&a, &computed)?;
+    write_outputs(&a, &origin, &computed, zeroed.as_ref(), &outputs)?;
     if a.json {
-        print_json(&origin, &computed)
+        print_json(&origin, &computed, zeroed.as_ref())
     } else {
-        print_tables(&origin, &computed);
+        print_tables(&origin, &computed, zeroed.as_ref());
         Ok(())
     }
 }
 
 /// Where the readings come from: a record, or the model's virtual test.
-struct Origin {
+pub(crate) struct Origin {
     /// The record, or the model, in messages and the file's source.
     name: String,
     /// The files read (no output may overwrite them).
@@ -256,14 +280,16 @@ fn write_outputs(
     a: &Args,
     o: &Origin,
     c: &Computed,
+    zeroed: Option<&sinumerik::Zeroed>,
     outputs: &[(&'static str, PathBuf)],
 ) -> anyhow::Result<()> {
     for (option, path) in outputs {
-        match *option {
-            "-o" => compensation_file::write(path, &file_of(a, o, c))?,
-            "--sinumerik" => {
-                let text = sinumerik_program(a, o, c)?;
-                sinumerik::write(path, &text)?;
+        match (*option, zeroed) {
+            ("-o", _) => compensation_file::write(path, &file_of(a, o, c))?,
+            ("--sinumerik", z) => {
+                let z = z.context("the SINUMERIK table was not computed")?;
+                let text = sinumerik::program(a, o, c, z)?;
+                compensation_file::sinumerik::write(path, &text)?;
             }
             _ => {
                 let table = table_of(c)?;
@@ -278,33 +304,11 @@ fn write_outputs(
     Ok(())
 }
 
-fn table_of(c: &Computed) -> anyhow::Result<&rtid::controller::ErrorTable> {
+pub(crate) fn table_of(c: &Computed) -> anyhow::Result<&rtid::controller::ErrorTable> {
     c.compensation
         .table
         .as_ref()
         .context("the compensation has no table")
-}
-
-fn sinumerik_program(a: &Args, o: &Origin, c: &Computed) -> anyhow::Result<String> {
-    let Some(n) = a.axis_number else {
-        bail!("--sinumerik needs --axis-number N (the machine axis AX<N>)");
-    };
-    let grid = sinumerik::Grid::of(table_of(c)?)?;
-    let note = format!(
-        "rtid {} compensate {}{}",
-        rtid::VERSION,
-        o.name,
-        a.runs
-            .as_ref()
-            .map_or(String::new(), |r| format!(" --runs {r}"))
-    );
-    Ok(sinumerik::program(
-        &grid,
-        c.axis,
-        n,
-        c.compensation.backlash,
-        &note,
-    ))
 }
 
 fn file_of(a: &Args, o: &Origin, c: &Computed) -> CompensationFile {
@@ -329,7 +333,7 @@ fn file_of(a: &Args, o: &Origin, c: &Computed) -> CompensationFile {
 const MODEL_SOURCE: &str =
     "the virtual positioning test (ISO 230-2 standard cycle) of the identified model";
 
-fn print_json(o: &Origin, c: &Computed) -> anyhow::Result<()> {
+fn print_json(o: &Origin, c: &Computed, zeroed: Option<&sinumerik::Zeroed>) -> anyhow::Result<()> {
     let u = ReportUnits::of(c.axis);
     let k = u.deviation_per_si;
     // Every number through the finite check: `json!` would write a NaN as null.
@@ -373,6 +377,7 @@ fn print_json(o: &Origin, c: &Computed) -> anyhow::Result<()> {
         "build": scaled(&c.build)?,
         "check": c.check.as_ref().map(scaled).transpose()?,
         "warnings": warnings,
+        "sinumerik": zeroed.map(|z| sinumerik::json(z, c.axis)).transpose()?,
     });
     println!("{}", rtid::io::json::pretty(&value)?);
     Ok(())
@@ -410,7 +415,7 @@ fn friction_text(f: &FrictionCompensation, axis: Axis) -> String {
     )
 }
 
-fn print_tables(o: &Origin, c: &Computed) {
+fn print_tables(o: &Origin, c: &Computed, zeroed: Option<&sinumerik::Zeroed>) {
     let u = ReportUnits::of(c.axis);
     let (k, d) = (u.deviation_per_si, u.deviation);
     println!(
@@ -455,6 +460,9 @@ fn print_tables(o: &Origin, c: &Computed) {
     if let Some(check) = &c.check {
         let title = format!("runs {} (check)", runs_text(&c.check_runs));
         println!("{}", before_after_table(check, &title, k, d));
+    }
+    if let Some(z) = zeroed {
+        println!("{}", sinumerik::summary(z, c.axis));
     }
     for w in &c.warnings {
         println!("warning: {}", w.message(k, d));

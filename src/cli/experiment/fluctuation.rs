@@ -15,8 +15,8 @@ use rtid::model::{LoopMode, Params};
 use rtid::report;
 
 pub const LONG_ABOUT: &str = "\
-Rotational fluctuation (paper §4.4, Figs. 11 and 12): the servo, in semi-closed loop by \
-default, turns the table at a constant 180°/min through one revolution counter-clockwise \
+Rotational fluctuation (paper §4.4, Figs. 11 and 12): the servo, in the parameter set's \
+loop (controller.loop; semi-closed in the presets) unless --loop overrides it, turns the table at a constant 180°/min through one revolution counter-clockwise \
 (up) and one clockwise (down), with 10° of run-in at both ends of each pass so the speed \
 is steady. Both encoders are recorded (every 4 ms, quantised to their resolutions).
 
@@ -47,13 +47,9 @@ pub struct Args {
 /// The run settings fluctuation and unbalance share.
 #[derive(Debug, clap::Args)]
 pub struct RunArgs {
-    /// Feedback loop.
-    #[arg(
-        long = "loop",
-        value_name = "semi_closed|full_closed",
-        default_value = "semi_closed"
-    )]
-    pub loop_mode: LoopMode,
+    /// Feedback loop [default: the parameter set's controller.loop].
+    #[arg(long = "loop", value_name = "semi_closed|full_closed")]
+    pub loop_mode: Option<LoopMode>,
     /// Whole revolutions measured in each direction.
     #[arg(long, default_value_t = 1)]
     pub revolutions: u32,
@@ -120,6 +116,7 @@ pub fn run_test(
             p.name
         );
     }
+    let note = super::loop_override(run.loop_mode, p, common.quiet);
     let bar = progress::bar(test.duration().ceil() as u64, name, common.quiet);
     let mut record = fluctuation::run(p, test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
@@ -138,6 +135,7 @@ pub fn run_test(
             run.seed
         ));
     }
+    super::add_note(&mut manifest, note);
     common.write_and_report(
         name,
         manifest,

@@ -20,6 +20,7 @@ use anyhow::Context;
 
 use super::ModelArgs;
 use rtid::io::experiment_file::{self, Data, Experiment, Manifest};
+use rtid::model::LoopMode;
 
 pub const LONG_ABOUT: &str = "\
 Runs one of the paper's tests on the model and writes it as an experiment file — a JSON \
@@ -135,6 +136,29 @@ impl Common {
     pub fn create_out(&self) -> anyhow::Result<()> {
         std::fs::create_dir_all(&self.out)
             .with_context(|| format!("creating {}", self.out.display()))
+    }
+}
+
+/// `--loop` against the parameter set's `controller.loop`: where it overrides a
+/// different one, a note on stderr (unless `quiet`) and its text, for the manifest's
+/// notes; `None` where the test runs in the set's own loop.
+pub fn loop_override(given: Option<LoopMode>, p: &rtid::Params, quiet: bool) -> Option<String> {
+    let own = p.controller.loop_mode;
+    let mode = given.filter(|&m| m != own)?;
+    let note = format!("--loop {mode} overrides the parameter set's controller.loop ({own})");
+    if !quiet {
+        eprintln!("note: {note}");
+    }
+    Some(note)
+}
+
+/// `manifest` with `note` appended to its notes.
+pub fn add_note(manifest: &mut Manifest, note: Option<String>) {
+    if let Some(note) = note {
+        manifest.notes = Some(match manifest.notes.take() {
+            Some(notes) => format!("{notes}; {note}"),
+            None => note,
+        });
     }
 }
 

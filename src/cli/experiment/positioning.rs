@@ -17,8 +17,9 @@ use rtid::io::experiment_file::Experiment;
 use rtid::model::{Axis, LoopMode, Params};
 
 pub const LONG_ABOUT: &str = "\
-ISO 230-2 positioning accuracy and repeatability (paper §4.3): the servo, in semi-closed \
-loop by default, approaches targets every 30° from 0° to 360°, 5 times from each side, \
+ISO 230-2 positioning accuracy and repeatability (paper §4.3): the servo, in the \
+parameter set's loop (controller.loop; semi-closed in the presets) unless --loop \
+overrides it, approaches targets every 30° from 0° to 360°, 5 times from each side, \
 with 1 s dwell; the table encoder (0.0001°) reads each stop. Writes positioning.json/.csv \
 (deviation_arcsec per reading) and positioning.svg (the paper's Fig. 10), and prints the \
 ISO 230-2 statistics in arc-seconds.
@@ -44,13 +45,9 @@ compensation predicted on the model, not read off a record:
 pub struct Args {
     #[command(flatten)]
     pub common: Common,
-    /// Feedback loop.
-    #[arg(
-        long = "loop",
-        value_name = "semi_closed|full_closed",
-        default_value = "semi_closed"
-    )]
-    pub loop_mode: LoopMode,
+    /// Feedback loop [default: the parameter set's controller.loop].
+    #[arg(long = "loop", value_name = "semi_closed|full_closed")]
+    pub loop_mode: Option<LoopMode>,
     /// Approaches of each target from each side.
     #[arg(long, default_value_t = 5)]
     pub runs: u32,
@@ -96,8 +93,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "simulated seconds",
         "--runs, --target-step-deg/mm, --travel-mm, --speed-*, --dwell-s",
     )?;
+    let note = super::loop_override(a.loop_mode, &p, a.common.quiet);
     a.common.create_out()?;
-    run_positioning(&a, &p, test)
+    run_positioning(&a, &p, test, note)
 }
 
 /// The test the flags describe on `axis`, checked before anything runs.
@@ -202,13 +200,21 @@ fn linear(a: &Args) -> anyhow::Result<(Vec<f64>, f64, f64)> {
     ))
 }
 
-fn run_positioning(a: &Args, p: &Params, test: positioning::PositioningTest) -> anyhow::Result<()> {
+/// Runs `test` on `p` and writes it, `note` (the loop's override) in its manifest.
+fn run_positioning(
+    a: &Args,
+    p: &Params,
+    test: positioning::PositioningTest,
+    note: Option<String>,
+) -> anyhow::Result<()> {
     let bar = progress::bar(test.readings() as u64, "positioning", a.common.quiet);
     let readings = positioning::run(p, &test, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
+    let mut manifest = positioning::manifest(p, &test);
+    super::add_note(&mut manifest, note);
     a.common.write_and_report(
         "positioning",
-        positioning::manifest(p, &test),
+        manifest,
         &positioning::to_data(&readings, p.axis),
         report,
     )

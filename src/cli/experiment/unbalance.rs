@@ -8,8 +8,8 @@ use rtid::experiments::fluctuation::{FluctuationTest, DEFAULT_UNBALANCE};
 pub const LONG_ABOUT: &str = "\
 Influence of an unbalance mass (paper §4.5, Fig. 14): the table is mounted vertically \
 with a mass offset from its axis (gravity torque −m·g·e·sin(θt + ψ)); the servo, in \
-semi-closed loop, turns it at a constant 360°/min through one revolution each way, as in \
-the fluctuation test. The mass and radius are the parameters' unbalance_mass and \
+the parameter set's loop (semi-closed in the presets; --loop overrides it), turns it at \
+a constant 360°/min through one revolution each way, as in the fluctuation test. The mass and radius are the parameters' unbalance_mass and \
 unbalance_radius when set, else 10 kg at 0.1 m, or --mass-kg/--radius-m.
 
 Outputs, in --out DIR: unbalance.json/.csv, unbalance.svg (deviation θt − θm·Rg·Rw over \

@@ -39,7 +39,7 @@ use std::f64::consts::TAU;
 use std::path::PathBuf;
 
 use crate::io::experiment_file::{Experiment, Kind};
-use crate::model::params::LoopMode;
+use crate::model::params::{LoopMode, Params};
 
 /// A pass ends where the table angle turns back by more than this from its extreme,
 /// rad (0.05°: far above encoder noise, far below any travel).
@@ -77,8 +77,9 @@ pub struct FluctuationTest {
     pub sample_period: f64,
     /// Standstill before each pass, s (default 0.5).
     pub dwell: f64,
-    /// Feedback arrangement (default semi-closed, as in the paper).
-    pub loop_mode: LoopMode,
+    /// Feedback arrangement; `None` (the default): the parameter set's own
+    /// (`controller.loop`; semi-closed in the presets, as in the paper).
+    pub loop_mode: Option<LoopMode>,
     /// Unbalance mass (kg) and radius (m) on a vertical table; `None` for the
     /// fluctuation test (the parameters' own unbalance, if any, is removed).
     pub unbalance: Option<(f64, f64)>,
@@ -92,7 +93,7 @@ impl Default for FluctuationTest {
             run_in: 10f64.to_radians(),
             sample_period: 4e-3,
             dwell: 0.5,
-            loop_mode: LoopMode::SemiClosed,
+            loop_mode: None,
             unbalance: None,
         }
     }
@@ -144,9 +145,14 @@ impl FluctuationTest {
             test.speed = v.to_radians() / 60.0;
         }
         if let Some(l) = c.loop_mode {
-            test.loop_mode = l;
+            test.loop_mode = Some(l);
         }
         Ok(test)
+    }
+
+    /// The feedback arrangement the test runs `params` in: its own, or the test's.
+    pub fn loop_on(&self, params: &Params) -> LoopMode {
+        self.loop_mode.unwrap_or(params.controller.loop_mode)
     }
 
     /// Which experiment this is.

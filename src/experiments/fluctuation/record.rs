@@ -56,7 +56,7 @@ pub fn from_data(data: &Data) -> Option<Record> {
 pub fn manifest(params: &Params, test: &FluctuationTest) -> Manifest {
     let mut m = Manifest::new(test.kind());
     m.mechanism = Some(params.name.clone());
-    m.conditions.loop_mode = Some(test.loop_mode);
+    m.conditions.loop_mode = Some(test.loop_on(params));
     m.conditions.speed_deg_per_min = Some(test.speed.to_degrees() * 60.0);
     m.conditions.ratio = Some(params.ratio());
     if let Some((mass, radius)) = test.unbalance {

@@ -63,7 +63,7 @@ pub struct Record {
 /// The parameters the test runs with: loop mode and unbalance set.
 pub(crate) fn test_params(params: &Params, test: &FluctuationTest) -> Params {
     let mut p = params.clone();
-    p.controller.loop_mode = test.loop_mode;
+    p.controller.loop_mode = test.loop_on(params);
     let (mass, radius) = test.unbalance.unwrap_or((0.0, 0.0));
     p.unbalance_mass = mass;
     p.unbalance_radius = radius;

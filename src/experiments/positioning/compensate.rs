@@ -114,6 +114,14 @@ pub enum CompensateWarning {
     /// Every run was used to build the compensation (or fewer than two are left): the
     /// values after compensation are those of the runs it was fitted to, not a check.
     Unchecked { check_runs: usize },
+    /// The compensation makes the bidirectional accuracy A of the other runs larger
+    /// (rad or m): it moves their mean deviations towards the targets where they
+    /// scatter most, or their error does not repeat that of the build runs.
+    AccuracyWorse { a_before: f64, a_after: f64 },
+    /// The compensation makes the bidirectional repeatability R of the other runs
+    /// larger (rad or m): their reversal differs from the build runs' mean B̄ at some
+    /// target, so the backlash leaves it larger there than it was.
+    RepeatabilityWorse { r_before: f64, r_after: f64 },
 }
 
 impl CompensateWarning {
@@ -138,6 +146,23 @@ impl CompensateWarning {
                  larger than the table): load the backlash alone",
                 v(e_backlash_only),
                 v(e_after)
+            ),
+            CompensateWarning::AccuracyWorse { a_before, a_after } => format!(
+                "the compensation makes the accuracy A of the runs it was not built from \
+                 worse by {}: {} without it, {} with it; their error does not repeat that of \
+                 the build runs, or scatters most where the table moves it: check it on more \
+                 runs before loading it",
+                v(&(a_after - a_before)),
+                v(a_before),
+                v(a_after)
+            ),
+            CompensateWarning::RepeatabilityWorse { r_before, r_after } => format!(
+                "the compensation makes the repeatability R of the runs it was not built \
+                 from worse by {}: {} without it, {} with it; their reversal differs from the \
+                 build runs' mean B̄ at some target, where the backlash leaves it larger",
+                v(&(r_after - r_before)),
+                v(r_before),
+                v(r_after)
             ),
             CompensateWarning::Unchecked { check_runs } => format!(
                 "built from {}: the values after compensation are those of the runs it was \
@@ -295,21 +320,55 @@ pub fn compute(
     })
 }
 
-/// The warnings of a compensation checked (or not) on the other runs.
+/// The warnings of a compensation checked (or not) on the other runs: on E first,
+/// then on A and R.
 fn warnings(check: Option<&BeforeAfter>, check_runs: usize) -> Vec<CompensateWarning> {
-    match check {
-        Some(c) if c.after.e >= c.before.e => vec![CompensateWarning::NoImprovement {
+    let Some(c) = check else {
+        return vec![CompensateWarning::Unchecked { check_runs }];
+    };
+    e_warning(c).into_iter().chain(worse(c)).collect()
+}
+
+/// The warning on the systematic deviation E of the check runs, if any.
+fn e_warning(c: &BeforeAfter) -> Option<CompensateWarning> {
+    if c.after.e >= c.before.e {
+        Some(CompensateWarning::NoImprovement {
             e_before: c.before.e,
             e_after: c.after.e,
-        }],
-        Some(c) if c.after.e >= c.backlash_only.e => vec![CompensateWarning::TableDoesNotHelp {
+        })
+    } else if c.after.e >= c.backlash_only.e {
+        Some(CompensateWarning::TableDoesNotHelp {
             e_backlash_only: c.backlash_only.e,
             e_after: c.after.e,
-        }],
-        Some(_) => Vec::new(),
-        None => vec![CompensateWarning::Unchecked { check_runs }],
+        })
+    } else {
+        None
     }
 }
+
+/// The warnings on A and R of the check runs: each where the compensation makes it
+/// larger than without, beyond the rounding of the two computations.
+fn worse(c: &BeforeAfter) -> Vec<CompensateWarning> {
+    let larger = |before: f64, after: f64| after - before > WORSE_TOLERANCE * before.abs();
+    let mut w = Vec::new();
+    if larger(c.before.a, c.after.a) {
+        w.push(CompensateWarning::AccuracyWorse {
+            a_before: c.before.a,
+            a_after: c.after.a,
+        });
+    }
+    if larger(c.before.r, c.after.r) {
+        w.push(CompensateWarning::RepeatabilityWorse {
+            r_before: c.before.r,
+            r_after: c.after.r,
+        });
+    }
+    w
+}
+
+/// The relative growth of A or R below which it is rounding, not a worse axis: the
+/// scatter terms are computed anew from shifted readings.
+const WORSE_TOLERANCE: f64 = 1e-9;
 
 /// The build runs' targets with the table's value at each.
 fn rows(targets: &[iso230::TargetStats], compensation: &Compensation) -> Vec<TargetRow> {
@@ -552,11 +611,90 @@ mod tests {
             (3.0 - run as f64) * (profile(t) + half(d))
         });
         let c = compute(&reversed, Axis::Rotary, Some(&Runs(1..=3))).unwrap();
+        // Everything worse on runs 4–5: E, and A and R with it.
         assert!(
-            matches!(c.warnings[..], [CompensateWarning::NoImprovement { e_before, e_after }] if e_after >= e_before),
+            matches!(c.warnings[..], [
+                CompensateWarning::NoImprovement { e_before, e_after },
+                CompensateWarning::AccuracyWorse { .. },
+                CompensateWarning::RepeatabilityWorse { .. },
+            ] if e_after >= e_before),
             "{:?}",
             c.warnings
         );
+    }
+
+    /// Runs 4–5 scatter by s = 2″ at 0°, where their mean lies inside the others'
+    /// range; the table of runs 1–3 lowers their E from 10″ to 8″ but moves 0° to
+    /// the edge: A grows from 10″ to 12″, and the warning says so.
+    #[test]
+    fn an_accuracy_made_worse_is_warned_about() {
+        let spread = std::f64::consts::SQRT_2;
+        let m = record(&[0.0, 90.0, 180.0], 5, |t, _, run| match (t as i32, run) {
+            (0, 1..=3) => 13.0,
+            (0, 4) => 5.0 + spread,
+            (0, _) => 5.0 - spread,
+            (90, _) => 10.0,
+            _ => 0.0,
+        });
+        let c = compute(&m, Axis::Rotary, Some(&Runs(1..=3))).unwrap();
+        let check = c.check.unwrap();
+        let arcsec = |x: f64| x * ARCSEC_PER_RAD;
+        assert!(
+            arcsec(check.after.e) < arcsec(check.before.e) - 1.9,
+            "{check:?}"
+        );
+        let [CompensateWarning::AccuracyWorse { a_before, a_after }] = c.warnings[..] else {
+            panic!("{:?}", c.warnings);
+        };
+        assert!((arcsec(a_before) - 10.0).abs() < 1e-6, "{a_before}");
+        assert!((arcsec(a_after) - 12.0).abs() < 1e-6, "{a_after}");
+        let text = c.warnings[0].message(ARCSEC_PER_RAD, "″");
+        for part in [
+            "accuracy A",
+            "worse by 2.00″",
+            "10.00″ without it",
+            "12.00″ with it",
+        ] {
+            assert!(text.contains(part), "{part}: {text}");
+        }
+    }
+
+    /// Runs 4–5 have no reversal at 0° (and scatter there) where runs 1–3 had −30″:
+    /// the backlash corrects the other targets and leaves 30″ of reversal at 0°, so R
+    /// grows from 30″ to 38″ while E falls from 50″ to 30″.
+    #[test]
+    fn a_repeatability_made_worse_is_warned_about() {
+        let spread = std::f64::consts::SQRT_2;
+        let profile = |t: f64| if t > 100.0 { 20.0 } else { 0.0 };
+        let m = record(&[0.0, 90.0, 180.0], 5, |t, d, run| {
+            let half = if d == Up { -15.0 } else { 15.0 };
+            match (t as i32, run) {
+                (0, 4) => spread,
+                (0, 5) => -spread,
+                _ => profile(t) + half,
+            }
+        });
+        let c = compute(&m, Axis::Rotary, Some(&Runs(1..=3))).unwrap();
+        let check = c.check.unwrap();
+        let arcsec = |x: f64| x * ARCSEC_PER_RAD;
+        assert!((arcsec(check.before.e) - 50.0).abs() < 1e-6, "{check:?}");
+        assert!((arcsec(check.after.e) - 30.0).abs() < 1e-6, "{check:?}");
+        let [CompensateWarning::RepeatabilityWorse { r_before, r_after }] = c.warnings[..] else {
+            panic!("{:?}", c.warnings);
+        };
+        assert!((arcsec(r_before) - 30.0).abs() < 1e-6, "{r_before}");
+        assert!((arcsec(r_after) - 38.0).abs() < 1e-6, "{r_after}");
+        let text = c.warnings[0].message(ARCSEC_PER_RAD, "″");
+        assert!(
+            text.contains("repeatability R") && text.contains("worse by 8.00″"),
+            "{text}"
+        );
+        // In µm on a linear axis: the unit is the caller's.
+        let w = CompensateWarning::RepeatabilityWorse {
+            r_before: 3e-6,
+            r_after: 4.5e-6,
+        };
+        assert!(w.message(1e6, "µm").contains("worse by 1.50µm"));
     }
 
     #[test]

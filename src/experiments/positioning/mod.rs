@@ -42,8 +42,9 @@ pub struct PositioningTest {
     pub noise: f64,
     /// Seed of the noise generator.
     pub seed: u64,
-    /// Feedback arrangement (default semi-closed, as in the paper).
-    pub loop_mode: LoopMode,
+    /// Feedback arrangement; `None` (the default): the parameter set's own
+    /// (`controller.loop`; semi-closed in the presets, as in the paper).
+    pub loop_mode: Option<LoopMode>,
     /// The controller's compensations (default none).
     pub compensation: Compensation,
 }
@@ -58,7 +59,7 @@ impl Default for PositioningTest {
             overrun: 5f64.to_radians(),
             noise: 0.0,
             seed: 0,
-            loop_mode: LoopMode::SemiClosed,
+            loop_mode: None,
             compensation: Compensation::default(),
         }
     }
@@ -116,6 +117,11 @@ impl PositioningTest {
     pub fn readings(&self) -> usize {
         2 * self.targets.len() * self.runs as usize
     }
+
+    /// The feedback arrangement the test runs `params` in: its own, or the test's.
+    pub fn loop_on(&self, params: &Params) -> LoopMode {
+        self.loop_mode.unwrap_or(params.controller.loop_mode)
+    }
 }
 
 /// Runs the cycle on the model. `progress(done, total)` is called after each reading.
@@ -159,7 +165,7 @@ impl LaneRun for Cycle<'_> {
 /// `params` with the test's feedback arrangement.
 fn test_params(params: &Params, test: &PositioningTest) -> Params {
     let mut p = params.clone();
-    p.controller.loop_mode = test.loop_mode;
+    p.controller.loop_mode = test.loop_on(params);
     p
 }
 
@@ -299,7 +305,7 @@ pub fn from_data(data: &Data) -> Option<Vec<Measurement>> {
 pub fn manifest(params: &Params, test: &PositioningTest) -> Manifest {
     let mut m = Manifest::new(Kind::Positioning);
     m.mechanism = Some(params.name.clone());
-    m.conditions.loop_mode = Some(test.loop_mode);
+    m.conditions.loop_mode = Some(test.loop_on(params));
     m.conditions.dwell_s = Some(test.dwell);
     let resolution = params.controller.table_encoder_resolution;
     let (encoder, noise) = match params.axis {
