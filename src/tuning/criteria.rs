@@ -4,12 +4,11 @@
 //! error, the reversal spike, the peak torque) and the ISO 230-2 positioning cycle
 //! at the table after the compensation built for this setting (A, R, B̄).
 //!
-//! Two depths. [`screen`] weighs many candidates: a short cycle (every 90° or 125 mm,
-//! two runs per direction) whose compensation is built from its own readings and
-//! applied to them (as `rtid evaluate --compensation` does), the candidates in the
-//! kernel's lanes. [`check`] weighs the setting proposed and today's: the standard
-//! cycle (`rtid experiment positioning`'s), its compensation built from it and then run
-//! in the controller for a second cycle (as the machine would run it).
+//! Two depths, each with the compensation built from a first cycle and then run in
+//! the controller for a second (as the machine would run it). [`screen`] weighs many
+//! candidates on a short cycle (every 90° or 125 mm, two runs per direction), in the
+//! kernel's lanes; [`check`] weighs the setting proposed and today's on the standard
+//! cycle (`rtid experiment positioning`'s).
 
 use serde::Serialize;
 
@@ -47,8 +46,7 @@ pub struct Positioning {
     /// Targets per direction and runs of the cycle.
     pub targets: usize,
     pub runs: u32,
-    /// Where the compensation acted: `controller` (run in the servo) or `readings`
-    /// (added to the readings).
+    /// Where the compensation acted: `controller` (run in the servo).
     pub compensated_in: &'static str,
 }
 
@@ -67,7 +65,7 @@ pub enum CriteriaError {
     Unscreened,
 }
 
-/// The short cycle of the screening, on `p`'s axis and in its loop.
+/// The short cycle of the screening, on `p`'s axis (in the set's own loop).
 pub fn short_cycle(p: &Params) -> PositioningTest {
     let standard = PositioningTest::standard(p.axis);
     let (span, step) = match p.axis {
@@ -79,37 +77,54 @@ pub fn short_cycle(p: &Params) -> PositioningTest {
             .map(|i| i as f64 * step)
             .collect(),
         runs: 2,
-        loop_mode: p.controller.loop_mode,
         ..standard
     }
 }
 
-/// The standard cycle on `p`'s axis and in its loop.
+/// The standard cycle on `p`'s axis (in the set's own loop).
 pub fn standard_cycle(p: &Params) -> PositioningTest {
-    PositioningTest {
-        loop_mode: p.controller.loop_mode,
-        ..PositioningTest::standard(p.axis)
-    }
+    PositioningTest::standard(p.axis)
 }
 
-/// The figures of each of `sets` (one axis kind and loop) on the short cycle, the
-/// compensation applied to the readings; in the kernel's lanes.
+/// The figures of each of `sets` (one axis kind) on the short cycle, its
+/// compensation built from a first cycle and run in the controller for a second;
+/// in the kernel's lanes.
 pub fn screen(sets: &[Params]) -> Vec<Result<Criteria, CriteriaError>> {
     let Some(first) = sets.first() else {
         return Vec::new();
     };
     let test = short_cycle(first);
     let servo = verify::responses_batch(sets, &Compensation::default());
-    let cycles = positioning::run_batch(sets, &test);
+    let built: Vec<Result<(AxisStats, Compensation), CriteriaError>> =
+        positioning::run_batch(sets, &test)
+            .into_iter()
+            .map(|readings| {
+                let readings = readings?;
+                let before = iso230::evaluate(&readings)?.axis;
+                Ok((
+                    before,
+                    compensate::compute(&readings, first.axis, None)?.compensation,
+                ))
+            })
+            .collect();
+    let compensations: Vec<Compensation> = built
+        .iter()
+        .map(|b| {
+            b.as_ref()
+                .map_or_else(|_| Compensation::default(), |b| b.1.clone())
+        })
+        .collect();
+    let second = positioning::run_batch_compensated(sets, &test, &compensations);
     servo
         .into_iter()
-        .zip(cycles)
-        .map(|(servo, readings)| {
-            let computed = compensate::compute(&readings?, first.axis, None)?;
-            let b = &computed.build;
+        .zip(built)
+        .zip(second)
+        .map(|((servo, built), readings)| {
+            let (before, _) = built?;
+            let after = iso230::evaluate(&readings?)?.axis;
             Ok(Criteria {
                 servo: servo?,
-                positioning: figures(&b.before, &b.after, &test, first.axis, "readings"),
+                positioning: figures(&before, &after, &test, first.axis, "controller"),
             })
         })
         .collect()

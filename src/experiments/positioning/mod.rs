@@ -130,7 +130,8 @@ pub fn run(
     test: &PositioningTest,
     progress: impl FnMut(usize, usize),
 ) -> Result<Vec<Measurement>, SimError> {
-    let [one] = run_lanes(&[test_params(params, test)], test, progress)?;
+    let compensation = [test.compensation.clone()];
+    let [one] = run_lanes(&[test_params(params, test)], test, compensation, progress)?;
     one
 }
 
@@ -142,6 +143,61 @@ pub fn run_batch(
 ) -> Vec<Result<Vec<Measurement>, SimError>> {
     let sets: Vec<Params> = params.iter().map(|p| test_params(p, test)).collect();
     crate::sim::batch::in_lanes(&sets, &Cycle(test))
+}
+
+/// [`run_batch`] with each set's own compensation in the controller
+/// (`compensations[i]` for `params[i]`) in place of the test's: the second cycle of
+/// settings whose compensation was built from their first (`rtid tune`).
+pub fn run_batch_compensated(
+    params: &[Params],
+    test: &PositioningTest,
+    compensations: &[Compensation],
+) -> Vec<Result<Vec<Measurement>, SimError>> {
+    let sets: Vec<Params> = params.iter().map(|p| test_params(p, test)).collect();
+    let each = Compensated {
+        test,
+        sets: &sets,
+        compensations,
+    };
+    crate::sim::batch::in_lanes(&sets, &each)
+}
+
+/// The cycle with each set's compensation, for `sim::batch`: a lane's set is found
+/// among `sets` by equality (equal sets have equal cycles, hence equal compensations).
+struct Compensated<'a> {
+    test: &'a PositioningTest,
+    sets: &'a [Params],
+    compensations: &'a [Compensation],
+}
+
+impl Compensated<'_> {
+    fn of(&self, p: &Params) -> Compensation {
+        self.sets
+            .iter()
+            .position(|s| s == p)
+            .map_or_else(Compensation::default, |i| self.compensations[i].clone())
+    }
+}
+
+impl LaneRun for Compensated<'_> {
+    type Out = Vec<Measurement>;
+
+    fn lone(&self, p: &Params) -> Result<Vec<Measurement>, SimError> {
+        let [one] = run_lanes(&[p.clone()], self.test, [self.of(p)], |_, _| {})?;
+        one
+    }
+
+    fn lanes<const L: usize>(
+        &self,
+        params: &[Params; L],
+    ) -> Result<[Result<Vec<Measurement>, SimError>; L], SimError> {
+        run_lanes(
+            params,
+            self.test,
+            params.each_ref().map(|p| self.of(p)),
+            |_, _| {},
+        )
+    }
 }
 
 /// The test's cycle, for `sim::batch`.
@@ -158,7 +214,8 @@ impl LaneRun for Cycle<'_> {
         &self,
         params: &[Params; L],
     ) -> Result<[Result<Vec<Measurement>, SimError>; L], SimError> {
-        run_lanes(params, self.0, |_, _| {})
+        let compensations = std::array::from_fn(|_| self.0.compensation.clone());
+        run_lanes(params, self.0, compensations, |_, _| {})
     }
 }
 
@@ -170,11 +227,12 @@ fn test_params(params: &Params, test: &PositioningTest) -> Params {
 }
 
 /// The cycle on `L` parameter sets at once (already [`test_params`]), lane by lane
-/// as a lone run computes it: one result per set (a set that diverges fails alone).
-/// `progress` counts the readings of the cycle.
+/// as a lone run computes it, each with its compensation: one result per set (a set
+/// that diverges fails alone). `progress` counts the readings of the cycle.
 fn run_lanes<const L: usize>(
     params: &[Params; L],
     test: &PositioningTest,
+    compensations: [Compensation; L],
     mut progress: impl FnMut(usize, usize),
 ) -> Result<[Result<Vec<Measurement>, SimError>; L], SimError> {
     let mut sim = LaneSimulation::<L>::of(params, crate::sim::common_step(params)?)?;
@@ -184,8 +242,8 @@ fn run_lanes<const L: usize>(
         sim.start(l, rest_state(p, stops[0].0, Preload::None), 0.0);
     }
     let mut controllers = sim.controllers(params)?;
-    for c in &mut controllers {
-        c.set_compensation(test.compensation.clone());
+    for (c, compensation) in controllers.iter_mut().zip(compensations) {
+        c.set_compensation(compensation);
     }
     let mut readings = Readings::<L>::new(params, test);
     let mut failed: [Option<SimError>; L] = std::array::from_fn(|_| None);
