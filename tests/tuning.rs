@@ -295,9 +295,16 @@ fn the_command_writes_the_tuned_file_and_keeps_todays_when_nothing_beats_it() {
     }
     assert_eq!(v["after"]["cascade"]["stable"], true);
     let svg = std::fs::read_to_string(dir.path().join("loop.svg")).unwrap();
-    for s in ["L, before tuning", "L, after tuning", "after: phase margin"] {
+    for s in [
+        "velocity loop alone, before",
+        "cascade as it runs, after",
+        "cascade as it runs, after: phase margin",
+        "cascade as it runs, after: gain margin",
+    ] {
         assert!(svg.contains(s), "{s}");
     }
+    let pm = v["after"]["cascade"]["phase_margin_deg"].as_f64().unwrap();
+    assert!(svg.contains(&format!("phase margin {pm:.1}°")), "{pm}");
 
     let again = ok(&rtid(&["tune", "--params", "tuned.json"], dir.path()));
     assert!(again.contains("after (today's kept)"), "{again}");

@@ -46,8 +46,9 @@ carries a warning naming it and by how much.
 The table shows each setting's gains with their units (Tn = Kvp/Kvi; Kv in 1/s and in the \
 CNC's (rev/min)/rev or (m/min)/mm), the margins of the velocity loop alone and of the \
 cascade as it runs, and the check before and after. With -o the tuned parameter file is \
-written (atomically, never over an input). With --plot the velocity loop's open loop before \
-and after is drawn as a Bode plot with its margins marked.
+written (atomically, never over an input). With --plot the open loops before and after — \
+the velocity loop alone and the cascade as it runs — are drawn as a Bode plot with their \
+margins marked.
 
 Examples:
   rtid tune --preset worm-gear
@@ -105,8 +106,9 @@ pub struct Args {
     /// Write the tuned parameter file.
     #[arg(short = 'o', long = "out", value_name = "tuned.json")]
     pub out: Option<PathBuf>,
-    /// Write the velocity loop's open-loop Bode plot, before and after tuning, with
-    /// the margins marked (SVG; never over an input or the -o file).
+    /// Write the open loops' Bode plot — the velocity loop alone and the cascade as
+    /// it runs, before and after tuning — with the margins marked (SVG; never over an
+    /// input or the -o file).
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
     /// Write the tuned settings as a commented SINAMICS parameter list: p1460
@@ -200,14 +202,23 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if a.plot.is_some() {
         let title = format!(
-            "{}: velocity loop, open loop L(jω) on the sampled loop",
-            p.name
+            "{}: open loops on the sampled loop, opened at the torque setpoint ({} loop)",
+            p.name, t.loop_mode
         );
-        let figure = rtid::report::tuning::open_loop(
-            &bode::bode(&p, &t.before)?,
-            &bode::bode(&t.params, &t.after)?,
-            &title,
-        );
+        let curves = [
+            ("velocity loop alone, before", bode::bode(&p, &t.before)?),
+            (
+                "velocity loop alone, after",
+                bode::bode(&t.params, &t.after)?,
+            ),
+            ("cascade as it runs, before", bode::cascade(&p, &t.before)?),
+            (
+                "cascade as it runs, after",
+                bode::cascade(&t.params, &t.after)?,
+            ),
+        ];
+        let named: Vec<(&str, &bode::Bode)> = curves.iter().map(|(n, b)| (*n, b)).collect();
+        let figure = rtid::report::tuning::open_loop(&named, &title);
         plot.write(&figure, "")?;
     }
     if a.json {

@@ -1,21 +1,21 @@
-//! The figure of `rtid tune --plot`: the velocity loop's open loop before and after
-//! tuning as a Bode plot (gain in dB over phase in degrees on one log frequency
-//! axis), each setting's margins marked where they are read and named in the
-//! legend with their values.
+//! The figure of `rtid tune --plot`: the open loops before and after tuning — the
+//! velocity loop alone and the cascade as it runs — as a Bode plot (gain in dB over
+//! phase in degrees on one log frequency axis), each loop's margins marked where they
+//! are read and named in the legend with their values.
 
 use super::figure::{Figure, Series, Style};
 use crate::tuning::bode::Bode;
 
-/// The Bode plot of `before` and `after` (named so in the legend), titled `title`.
-pub fn open_loop(before: &Bode, after: &Bode, title: &str) -> Figure {
+/// The Bode plot of `curves` (each named in the legend: `velocity loop alone,
+/// before`, …), titled `title`.
+pub fn open_loop(curves: &[(&str, &Bode)], title: &str) -> Figure {
     let mut gain = Figure::new(title, "frequency, Hz", "|L|, dB").log_x();
     let mut phase = Figure::new("", "", "arg L, degrees (unwrapped)");
-    for (who, b) in [("before", before), ("after", after)] {
-        let name = format!("L, {who} tuning");
-        gain = gain.with(Series::new(&name, b.gain_db.clone(), Style::Line));
-        phase = phase.with(Series::new(&name, b.phase_deg.clone(), Style::Line));
+    for (who, b) in curves {
+        gain = gain.with(Series::new(*who, b.gain_db.clone(), Style::Line));
+        phase = phase.with(Series::new(*who, b.phase_deg.clone(), Style::Line));
     }
-    for (who, b) in [("before", before), ("after", after)] {
+    for (who, b) in curves {
         if let Some((f, at, pm)) = b.phase_margin {
             let name = format!("{who}: phase margin {} at {} Hz", degrees(pm), hz(f));
             gain = gain.with(Series::new(&name, vec![(f, 0.0)], Style::Markers));
@@ -27,7 +27,7 @@ pub fn open_loop(before: &Bode, after: &Bode, title: &str) -> Figure {
             phase = phase.with(Series::new(&name, vec![(f, at)], Style::Markers));
         }
     }
-    let (lo, hi) = span(before, after);
+    let (lo, hi) = span(curves);
     let reference = "0 dB and −180°";
     gain = gain.with(Series::new(
         reference,
@@ -42,12 +42,11 @@ pub fn open_loop(before: &Bode, after: &Bode, title: &str) -> Figure {
     gain.above(phase)
 }
 
-/// The frequencies both curves span, Hz.
-fn span(before: &Bode, after: &Bode) -> (f64, f64) {
-    before
-        .gain_db
+/// The frequencies the curves span, Hz.
+fn span(curves: &[(&str, &Bode)]) -> (f64, f64) {
+    curves
         .iter()
-        .chain(&after.gain_db)
+        .flat_map(|(_, b)| &b.gain_db)
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
             (a.min(p.0), b.max(p.0))
         })
@@ -77,10 +76,10 @@ mod tests {
         let before = Setting::of(&p, &p.controller).unwrap();
         let after = Setting::of(&p, &rule(&p, Targets::default()).unwrap()).unwrap();
         let (b, a) = (bode(&p, &before).unwrap(), bode(&p, &after).unwrap());
-        let svg = open_loop(&b, &a, "two-mass: velocity loop")
+        let svg = open_loop(&[("before", &b), ("after", &a)], "two-mass: velocity loop")
             .render()
             .unwrap();
-        for s in ["L, before tuning", "L, after tuning", "after: phase margin"] {
+        for s in ["before", "after", "after: phase margin"] {
             assert!(svg.contains(s), "{s}");
         }
         let pm = after.velocity_loop.phase_margin_deg.unwrap();

@@ -1,7 +1,7 @@
-//! The velocity loop's open-loop frequency response of a [`Setting`] as a Bode plot
-//! draws it: gain in dB and phase in degrees (unwrapped from its principal value at
-//! the lowest frequency, as [`super::margins`] reads it) on a log grid from
-//! [`LOWEST_HZ`] to 0.99·Nyquist, with the points where the margins are read.
+//! A [`Setting`]'s open loops as a Bode plot draws them — the velocity loop alone
+//! ([`bode`]) and the cascade as it runs ([`cascade`]): gain in dB and phase in
+//! degrees (unwrapped along the grid) on a log grid from [`LOWEST_HZ`] to
+//! 0.99·Nyquist, with the points where the margins are read.
 
 use super::margins::{log_grid, unwrapped_deg};
 use super::open_loop::{VelocityLoop, VelocityPi};
@@ -45,6 +45,50 @@ pub fn bode(p: &Params, s: &Setting) -> Result<Bode, ParamError> {
         .map(|(f, v)| (*f, 20.0 * v.norm().log10()))
         .collect();
     let m = &s.velocity_loop;
+    let phase_margin = m
+        .phase_margin_hz
+        .zip(m.phase_margin_deg)
+        .map(|(f, pm)| (f, interpolate(&phase_deg, f), pm));
+    let gain_margin = m
+        .gain_margin_hz
+        .zip(m.gain_margin_db)
+        .map(|(f, gm)| (f, -gm, interpolate(&phase_deg, f)));
+    Ok(Bode {
+        gain_db,
+        phase_deg,
+        phase_margin,
+        gain_margin,
+    })
+}
+
+/// The cascade as it runs of `s` on the drive `p` (`s.filters` and gains in `p`'s
+/// controller, its loop type), exact on the sampled loop ([`super::sampled`]), on the
+/// same grid, its phase unwrapped from the branch of its low-frequency asymptote
+/// (−270°: three integrators), the margins of `s.cascade` marked.
+pub fn cascade(p: &Params, s: &Setting) -> Result<Bode, ParamError> {
+    let plant = super::sampled::DiscretePlant::new(p)?;
+    let c = crate::model::params::ControllerParams {
+        kvp: s.kvp,
+        kvi: s.kvi,
+        kpp: s.kpp,
+        filters: s.filters.clone(),
+        ..p.controller.clone()
+    };
+    let l = super::sampled::SampledLoop::new(&plant, &c, super::sampled::Closure::Cascade);
+    let values: Vec<_> = log_grid(LOWEST_HZ, 0.99 * l.nyquist_hz(), POINTS)
+        .into_iter()
+        .filter_map(|f| l.at(f).map(|v| (f, v)))
+        .collect();
+    let mut phase = unwrapped_deg(&values);
+    if phase.first().is_some_and(|&a| a > 0.0) {
+        phase.iter_mut().for_each(|a| *a -= 360.0);
+    }
+    let phase_deg: Vec<(f64, f64)> = values.iter().map(|v| v.0).zip(phase).collect();
+    let gain_db = values
+        .iter()
+        .map(|(f, v)| (*f, 20.0 * v.norm().log10()))
+        .collect();
+    let m = &s.cascade.margins;
     let phase_margin = m
         .phase_margin_hz
         .zip(m.phase_margin_deg)

@@ -427,7 +427,8 @@ mod tests {
             p.controller.kvp *= 1.0 - 0.1 * l as f64;
             test_params(&p, &test)
         });
-        let lanes = run_lanes(&sets, &test, |_, _| {}).unwrap();
+        let none = || std::array::from_fn(|_| Compensation::default());
+        let lanes = run_lanes(&sets, &test, none(), |_, _| {}).unwrap();
         for (l, p) in sets.iter().enumerate() {
             let alone = run(p, &test, |_, _| {}).unwrap();
             assert_eq!(lanes[l].as_ref().unwrap(), &alone, "lane {l}");
@@ -435,7 +436,40 @@ mod tests {
         assert_ne!(lanes[0], lanes[3], "the sets read differently");
         let mut stiffer = sets.clone();
         stiffer[2].kw *= 2.0;
-        let err = run_lanes(&stiffer, &test, |_, _| {}).unwrap_err();
+        let err = run_lanes(&stiffer, &test, none(), |_, _| {}).unwrap_err();
         assert!(err.to_string().contains("lane 2"), "{err}");
+    }
+
+    /// Each set's own compensation in the lanes: every set reads what it reads alone
+    /// with its compensation in the test.
+    #[test]
+    fn each_set_runs_its_own_compensation_in_the_lanes() {
+        let test = PositioningTest {
+            targets: vec![0.0, 90f64.to_radians()],
+            runs: 1,
+            dwell: 0.2,
+            ..PositioningTest::default()
+        };
+        let sets: Vec<Params> = (0..3)
+            .map(|l| {
+                let mut p = presets::load("worm-gear").unwrap();
+                p.controller.kpp *= 1.0 + 0.2 * l as f64;
+                p
+            })
+            .collect();
+        let compensations: Vec<Compensation> = (0..3)
+            .map(|l| Compensation {
+                backlash: Some(-1e-4 * (l + 1) as f64),
+                ..Compensation::default()
+            })
+            .collect();
+        let batch = run_batch_compensated(&sets, &test, &compensations);
+        for ((p, c), got) in sets.iter().zip(&compensations).zip(batch) {
+            let alone = PositioningTest {
+                compensation: c.clone(),
+                ..test.clone()
+            };
+            assert_eq!(got.unwrap(), run(p, &alone, |_, _| {}).unwrap());
+        }
     }
 }
