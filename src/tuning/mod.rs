@@ -608,8 +608,10 @@ mod tests {
         o.limits.max_kpp = Some(-1.0);
         let err = tune(&p, &o, &quiet).unwrap_err();
         assert!(err.to_string().contains("--max-kpp"), "{err}");
-        let mut o = Options::default();
-        o.torque_reserve = 1.5;
+        let o = Options {
+            torque_reserve: 1.5,
+            ..Options::default()
+        };
         let err = tune(&p, &o, &quiet).unwrap_err();
         assert!(err.to_string().contains("--torque-reserve"), "{err}");
     }

@@ -83,7 +83,7 @@ impl LaneRun for Runs<'_> {
     type Out = Responses;
 
     fn lone(&self, p: &Params) -> Result<Responses, SimError> {
-        let [one] = self.lanes(&[p.clone()])?;
+        let [one] = self.lanes(std::array::from_ref(p))?;
         one
     }
 

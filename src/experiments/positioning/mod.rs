@@ -183,7 +183,7 @@ impl LaneRun for Compensated<'_> {
     type Out = Vec<Measurement>;
 
     fn lone(&self, p: &Params) -> Result<Vec<Measurement>, SimError> {
-        let [one] = run_lanes(&[p.clone()], self.test, [self.of(p)], |_, _| {})?;
+        let [one] = run_lanes(std::array::from_ref(p), self.test, [self.of(p)], |_, _| {})?;
         one
     }
 
