@@ -34,31 +34,8 @@ pub fn bode(p: &Params, s: &Setting) -> Result<Bode, ParamError> {
         kvp: s.kvp,
         kvi: s.kvi,
     };
-    let values: Vec<_> = log_grid(LOWEST_HZ, 0.99 * lp.nyquist_hz(), POINTS)
-        .into_iter()
-        .filter_map(|f| lp.at(pi, f).map(|v| (f, v)))
-        .collect();
-    let phase = unwrapped_deg(&values);
-    let phase_deg: Vec<(f64, f64)> = values.iter().map(|v| v.0).zip(phase).collect();
-    let gain_db = values
-        .iter()
-        .map(|(f, v)| (*f, 20.0 * v.norm().log10()))
-        .collect();
-    let m = &s.velocity_loop;
-    let phase_margin = m
-        .phase_margin_hz
-        .zip(m.phase_margin_deg)
-        .map(|(f, pm)| (f, interpolate(&phase_deg, f), pm));
-    let gain_margin = m
-        .gain_margin_hz
-        .zip(m.gain_margin_db)
-        .map(|(f, gm)| (f, -gm, interpolate(&phase_deg, f)));
-    Ok(Bode {
-        gain_db,
-        phase_deg,
-        phase_margin,
-        gain_margin,
-    })
+    let values = on_grid(lp.nyquist_hz(), |f| lp.at(pi, f));
+    Ok(drawn(&values, unwrapped_deg(&values), &s.velocity_loop))
 }
 
 /// The cascade as it runs of `s` on the drive `p` (`s.filters` and gains in `p`'s
@@ -75,20 +52,33 @@ pub fn cascade(p: &Params, s: &Setting) -> Result<Bode, ParamError> {
         ..p.controller.clone()
     };
     let l = super::sampled::SampledLoop::new(&plant, &c, super::sampled::Closure::Cascade);
-    let values: Vec<_> = log_grid(LOWEST_HZ, 0.99 * l.nyquist_hz(), POINTS)
-        .into_iter()
-        .filter_map(|f| l.at(f).map(|v| (f, v)))
-        .collect();
+    let values = on_grid(l.nyquist_hz(), |f| l.at(f));
     let mut phase = unwrapped_deg(&values);
     if phase.first().is_some_and(|&a| a > 0.0) {
         phase.iter_mut().for_each(|a| *a -= 360.0);
     }
+    Ok(drawn(&values, phase, &s.cascade.margins))
+}
+
+/// A loop's values on the drawn grid up to 0.99·`nyquist_hz`.
+fn on_grid(
+    nyquist_hz: f64,
+    l: impl Fn(f64) -> Option<nalgebra::Complex<f64>>,
+) -> Vec<(f64, nalgebra::Complex<f64>)> {
+    log_grid(LOWEST_HZ, 0.99 * nyquist_hz, POINTS)
+        .into_iter()
+        .filter_map(|f| l(f).map(|v| (f, v)))
+        .collect()
+}
+
+/// The curves of `values` with their phase `phase` (deg, one per value), the margins
+/// `m` marked on them.
+fn drawn(values: &[(f64, nalgebra::Complex<f64>)], phase: Vec<f64>, m: &super::Margins) -> Bode {
     let phase_deg: Vec<(f64, f64)> = values.iter().map(|v| v.0).zip(phase).collect();
     let gain_db = values
         .iter()
         .map(|(f, v)| (*f, 20.0 * v.norm().log10()))
         .collect();
-    let m = &s.cascade.margins;
     let phase_margin = m
         .phase_margin_hz
         .zip(m.phase_margin_deg)
@@ -97,12 +87,12 @@ pub fn cascade(p: &Params, s: &Setting) -> Result<Bode, ParamError> {
         .gain_margin_hz
         .zip(m.gain_margin_db)
         .map(|(f, gm)| (f, -gm, interpolate(&phase_deg, f)));
-    Ok(Bode {
+    Bode {
         gain_db,
         phase_deg,
         phase_margin,
         gain_margin,
-    })
+    }
 }
 
 /// `curve` (ascending in x) at `x`, linear in log x between its points; its end
