@@ -376,7 +376,8 @@ fn the_servo_check_of_a_tuning_is_predicted() {
 /// Issue 51's chain on the worm gear's fixtures: identify → tune → compensate for the
 /// tuned gains → predict `--tune` with that compensation. The predicted A after is at
 /// most A before (the preset's gains, uncompensated), and within 1.1 times what the
-/// preset's gains give with a compensation built for them.
+/// preset's gains give with a compensation built for them; `--tests servo` predicts
+/// the tune's own check.
 #[test]
 #[cfg_attr(
     not(feature = "slow-tests"),
@@ -405,7 +406,8 @@ fn identify_tune_and_predict_a_tuning_in_a_chain() {
         all.extend_from_slice(&base);
         ok(&rtid(&all, dir.path()))
     };
-    run(&["tune", "fit.json", "-o", "tuned.json", "--quiet"]);
+    let checked: serde_json::Value =
+        serde_json::from_str(&run(&["tune", "fit.json", "-o", "tuned.json", "--json"])).unwrap();
     run(&[
         "compensate",
         "--fit",
@@ -425,20 +427,19 @@ fn identify_tune_and_predict_a_tuning_in_a_chain() {
         "--quiet",
     ]);
     let predict = |extra: &[&str]| {
-        let mut args = vec![
-            "predict",
-            "fit.json",
-            "--tests",
-            "positioning",
-            "--draws",
-            "10",
-            "--json",
-        ];
+        let mut args = vec!["predict", "fit.json", "--draws", "10", "--json"];
         args.extend_from_slice(extra);
         serde_json::from_str::<serde_json::Value>(&run(&args)).unwrap()
     };
-    let tuned = predict(&["--tune", "tuned.json", "--compensation", "c-tuned.json"]);
-    let today = predict(&["--compensation", "c-today.json"]);
+    let positioning = ["--tests", "positioning"];
+    let tuned = predict(
+        &[
+            &positioning[..],
+            &["--tune", "tuned.json", "--compensation", "c-tuned.json"],
+        ]
+        .concat(),
+    );
+    let today = predict(&[&positioning[..], &["--compensation", "c-today.json"]].concat());
     let (before, _, _) = predicted(&tuned, "before", "A");
     let (after, _, _) = predicted(&tuned, "after", "A");
     let (today_after, _, _) = predicted(&today, "after", "A");
@@ -446,5 +447,31 @@ fn identify_tune_and_predict_a_tuning_in_a_chain() {
     assert!(
         after <= 1.1 * today_after,
         "A {after}″ against today's {today_after}″"
+    );
+
+    // `--tests servo` predicts `rtid tune`'s own check: its value at the fit is the
+    // check of the tuned identified model, the interval around it; the following
+    // error v/Kpp falls by the ratio of the position gains.
+    let servo = predict(&["--tune", "tuned.json", "--tests", "servo"]);
+    for name in [
+        "following_error",
+        "reversal_spike",
+        "step_overshoot_percent",
+    ] {
+        let (at_fit, lo, hi) = predicted(&servo, "after", name);
+        let want = checked["check"]["after"]["servo"][name].as_f64().unwrap();
+        assert!(
+            (at_fit - want).abs() < 1e-9,
+            "{name}: {at_fit} against {want}"
+        );
+        assert!(lo <= hi, "{name}: [{lo} … {hi}]");
+    }
+    let (before, _, _) = predicted(&servo, "before", "following_error");
+    let (after, _, _) = predicted(&servo, "after", "following_error");
+    let kpp = |w: &str| checked[w]["Kpp"].as_f64().unwrap();
+    let ratio = kpp("before") / kpp("after");
+    assert!(
+        (after / before / ratio - 1.0).abs() < 0.05,
+        "{before} → {after}″"
     );
 }

@@ -414,7 +414,8 @@ fn print_check(p: &rtid::Params, t: &Tuned) {
             _ => fmt(k.value(c)),
         };
         let label = if k == Criterion::TableSettling {
-            format!("{} within {}{u}", k.label(), verify::SETTLED)
+            let gap = if u == "″" { "" } else { " " };
+            format!("{} within {}{gap}{u}", k.label(), verify::SETTLED)
         } else {
             format!("{} ({unit})", k.label())
         };
