@@ -78,6 +78,32 @@ pub fn filter(f: &SetpointFilter) -> SinamicsFilter {
 
 /// The parameter list's lines, in order.
 pub fn settings(s: &ServoSettings, ctx: &SinamicsContext) -> Result<Vec<Setting>, DriveFormError> {
+    check(s, ctx)?;
+    let d = ctx.data_set;
+    let mut out = speed_controller(s, d);
+    let mask = (0..s.filters.len()).fold(0i64, |m, i| m | 1 << i);
+    out.push(Setting::integer(
+        format!("p1656[{d}]"),
+        mask,
+        "",
+        format!(
+            "current setpoint filters active, bit i-1 for filter i: {}",
+            if s.filters.is_empty() {
+                "none".to_string()
+            } else {
+                format!("filters 1-{}", s.filters.len())
+            }
+        ),
+    ));
+    for (i, f) in s.filters.iter().enumerate() {
+        out.extend(filter_settings(i, f, d));
+    }
+    Ok(out)
+}
+
+/// Refuses a gain the integral time cannot be formed from and, with the current
+/// controller's sampling time given, a filter at or above its Nyquist frequency.
+fn check(s: &ServoSettings, ctx: &SinamicsContext) -> Result<(), DriveFormError> {
     s.check()?;
     if s.kvp <= 0.0 {
         return Err(DriveFormError::OutOfRange {
@@ -107,7 +133,11 @@ pub fn settings(s: &ServoSettings, ctx: &SinamicsContext) -> Result<Vec<Setting>
             }
         }
     }
-    let d = ctx.data_set;
+    Ok(())
+}
+
+/// p1460 and p1462 of data set `d`.
+fn speed_controller(s: &ServoSettings, d: usize) -> Vec<Setting> {
     let linear = s.axis == Axis::Linear;
     let (gain_unit, speed) = if linear {
         ("Ns/m", "m/s")
@@ -149,95 +179,87 @@ pub fn settings(s: &ServoSettings, ctx: &SinamicsContext) -> Result<Vec<Setting>
         )
     };
     out.push(Setting::real(format!("p1462[{d}]"), tn_ms, "ms", tn_from));
-    let mask = (0..s.filters.len()).fold(0i64, |m, i| m | 1 << i);
+    out
+}
+
+/// The parameters of filter `i` (from 0) of data set `d`: five, or three for a low-pass.
+fn filter_settings(i: usize, f: &SetpointFilter, d: usize) -> Vec<Setting> {
+    let mut out = Vec::new();
+    let base = 1657 + 5 * i;
+    let n = i + 1;
+    let g = filter(f);
+    let what = match *f {
+        SetpointFilter::LowPass {
+            frequency_hz,
+            damping,
+        } => format!(
+            "rtid low-pass {} Hz, damping {}",
+            super::number(frequency_hz),
+            super::number(damping)
+        ),
+        SetpointFilter::Notch {
+            centre_hz,
+            width_hz,
+            depth_db,
+        } => format!(
+            "rtid notch {} Hz, {} Hz wide, {}",
+            super::number(centre_hz),
+            super::number(width_hz),
+            depth_db.map_or("full depth".to_string(), |db| format!(
+                "depth {} dB",
+                super::number(db)
+            ))
+        ),
+    };
     out.push(Setting::integer(
-        format!("p1656[{d}]"),
-        mask,
+        format!("p{base}[{d}]"),
+        g.kind,
         "",
         format!(
-            "current setpoint filters active, bit i-1 for filter i: {}",
-            if s.filters.is_empty() {
-                "none".to_string()
+            "filter {n} type: {} ({what})",
+            if g.kind == 1 {
+                "PT2 low-pass"
             } else {
-                format!("filters 1-{}", s.filters.len())
+                "general second-order filter"
             }
         ),
     ));
-    for (i, f) in s.filters.iter().enumerate() {
-        let base = 1657 + 5 * i;
-        let n = i + 1;
-        let g = filter(f);
-        let what = match *f {
-            SetpointFilter::LowPass {
-                frequency_hz,
-                damping,
-            } => format!(
-                "rtid low-pass {} Hz, damping {}",
-                super::number(frequency_hz),
-                super::number(damping)
-            ),
-            SetpointFilter::Notch {
-                centre_hz,
-                width_hz,
-                depth_db,
-            } => format!(
-                "rtid notch {} Hz, {} Hz wide, {}",
-                super::number(centre_hz),
-                super::number(width_hz),
-                depth_db.map_or("full depth".to_string(), |db| format!(
-                    "depth {} dB",
-                    super::number(db)
-                ))
-            ),
-        };
-        out.push(Setting::integer(
-            format!("p{base}[{d}]"),
-            g.kind,
-            "",
-            format!(
-                "filter {n} type: {} ({what})",
-                if g.kind == 1 {
-                    "PT2 low-pass"
-                } else {
-                    "general second-order filter"
-                }
-            ),
-        ));
+    out.push(Setting::real(
+        format!("p{}[{d}]", base + 1),
+        g.denominator_hz,
+        "Hz",
+        format!("filter {n} denominator natural frequency"),
+    ));
+    out.push(Setting::real(
+        format!("p{}[{d}]", base + 2),
+        g.denominator_damping,
+        "",
+        format!(
+            "filter {n} denominator damping{}",
+            if g.kind == 2 {
+                " = width/(2·centre)"
+            } else {
+                ""
+            }
+        ),
+    ));
+    if let Some((fz, dz)) = g.numerator {
         out.push(Setting::real(
-            format!("p{}[{d}]", base + 1),
-            g.denominator_hz,
+            format!("p{}[{d}]", base + 3),
+            fz,
             "Hz",
-            format!("filter {n} denominator natural frequency"),
+            format!("filter {n} numerator natural frequency = centre"),
         ));
         out.push(Setting::real(
-            format!("p{}[{d}]", base + 2),
-            g.denominator_damping,
+            format!("p{}[{d}]", base + 4),
+            dz,
             "",
             format!(
-                "filter {n} denominator damping{}",
-                if g.kind == 2 {
-                    " = width/(2·centre)"
-                } else {
-                    ""
-                }
+                "filter {n} numerator damping = denominator damping·10^(depth/20) (0: full notch)"
             ),
         ));
-        if let Some((fz, dz)) = g.numerator {
-            out.push(Setting::real(
-                format!("p{}[{d}]", base + 3),
-                fz,
-                "Hz",
-                format!("filter {n} numerator natural frequency = centre"),
-            ));
-            out.push(Setting::real(
-                format!("p{}[{d}]", base + 4),
-                dz,
-                "",
-                format!("filter {n} numerator damping = denominator damping·10^(depth/20) (0: full notch)"),
-            ));
-        }
     }
-    Ok(out)
+    out
 }
 
 /// The commented parameter list: a header saying what it holds and what was not
