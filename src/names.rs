@@ -38,6 +38,55 @@ impl std::fmt::Display for Num {
     }
 }
 
+/// The known name `name` most likely misspells, if any: the same but for case, a
+/// missing unit suffix (`preload` for `preload_nm`), or an edit distance of at most one
+/// in five characters, a swap counted as one (`phase_degs` for `phase_deg`). A name far from every known one
+/// is no misspelling: files may carry names of their own (docs/experiment-files.md).
+pub fn misspelling_of<'a>(name: &str, known: &[&'a str]) -> Option<&'a str> {
+    let lower = name.to_ascii_lowercase();
+    let close = |k: &str| {
+        let k = k.to_ascii_lowercase();
+        let suffix_dropped = k
+            .strip_prefix(lower.as_str())
+            .is_some_and(|r| r.starts_with('_'));
+        suffix_dropped || strsim::osa_distance(&lower, &k) <= (k.len() / 5).max(1)
+    };
+    known
+        .iter()
+        .filter(|k| **k != name && close(k))
+        .min_by_key(|k| strsim::osa_distance(&lower, &k.to_ascii_lowercase()))
+        .copied()
+}
+
+#[cfg(test)]
+mod misspelling_tests {
+    use super::misspelling_of;
+
+    const KNOWN: [&str; 5] = ["preload_nm", "phase_deg", "ratio", "mass_kg", "period_s"];
+
+    #[test]
+    fn near_names_are_misspellings() {
+        assert_eq!(misspelling_of("preload", &KNOWN), Some("preload_nm"));
+        assert_eq!(misspelling_of("phase_degs", &KNOWN), Some("phase_deg"));
+        assert_eq!(misspelling_of("Ratio", &KNOWN), Some("ratio"));
+        assert_eq!(misspelling_of("mass_gk", &KNOWN), Some("mass_kg"));
+    }
+
+    #[test]
+    fn names_of_their_own_are_not() {
+        for name in [
+            "preload_nm",
+            "output_limit_v",
+            "velocity_gain_v_s_per_m",
+            "operator",
+            "loop_period_s",
+            "run_id",
+        ] {
+            assert_eq!(misspelling_of(name, &KNOWN), None, "{name}");
+        }
+    }
+}
+
 #[cfg(test)]
 mod num_tests {
     use super::Num;

@@ -310,26 +310,27 @@ fn an_interrupted_search_still_writes_a_valid_result() {
     assert_eq!(v["termination"]["code"], "interrupted", "{text}");
 }
 
-/// Interrupted after n evaluations, for 24 moments from the first start's first
-/// evaluations to its last start's last, then resumed from the checkpoint: the
-/// parameters and cost of the run never interrupted, bit for bit (issue 37: a start
-/// interrupted with its cost still null used to continue from its last point, and
-/// ended elsewhere).
+/// README's identification without `--fit` (Kw, Kg, Ciw and Cig from 40–60 % off,
+/// the linear search's starts then the nonlinear corrections) interrupted after n
+/// evaluations — 14 moments through the search's starts, 3 inside the corrections —
+/// then resumed from the checkpoint: the parameters and cost of the run never
+/// interrupted, bit for bit. Issue 37: a start interrupted with its cost still null
+/// continued from its last point. Issue 50: the search's result is its best
+/// evaluation, which may be a difference step's point rather than a start's result;
+/// a resume inside the starts lost it and ended at Ciw 0.32 against 0.15.
 #[test]
 fn a_resumed_identification_is_the_uninterrupted_one_from_every_moment() {
     let Fixture { spec, truth } = support::worm_frequency_response();
-    let base = off(&truth, &[("Kw", 1.4), ("Kg", 0.7), ("Ciw", 3.0)]);
-    let mut c = config(vec![spec], base, &["Kw", "Kg", "Ciw"]);
-    c.fidelity = FidelityChoice::Linear;
-    c.search.starts = Some(3);
+    let base = off(&truth, &[("Kw", 1.4), ("Kg", 1.4), ("Cig", 1.6)]);
+    let mut c = config(vec![spec], base, &["Kw", "Kg", "Ciw", "Cig"]);
     let whole = run(&c);
     let total = whole.result.evaluations;
-    assert!(total > 48, "{total} evaluations");
+    assert!(total > 1000, "{total} evaluations");
     let dir = tempfile::tempdir().unwrap();
     let checkpoint = dir.path().join("fit.ck.json");
     c.checkpoint = Some(checkpoint.clone());
-    for k in 1..=24 {
-        let n = k * (total - 1) / 25 + 1;
+    let search: Vec<usize> = (1..=14).map(|k| k * (total - 20) / 15).collect();
+    for n in search.into_iter().chain([total - 6, total - 3, total - 1]) {
         let _ = std::fs::remove_file(&checkpoint);
         c.resume = false;
         c.search.max_evaluations = Some(n);

@@ -140,7 +140,7 @@ fn report(a: &Args, exp: &experiment_file::Experiment, plot: &Plot) -> anyhow::R
             servo_trace::report(exp, plot, a.json, model, &a.idim)
         }
         Kind::FrequencyResponseTime => {
-            frequency_response_time::report_with(exp, plot, a.json, &a.estimate.options())
+            frequency_response_time::report_with(exp, plot, a.json, &a.estimate.options()?)
         }
         Kind::FrictionMap => friction_map::report(exp, plot, a.json),
         other => bail!(

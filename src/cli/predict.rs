@@ -28,8 +28,9 @@ on each, before (the model's own controller, no compensation) and after (with \
 interval of the draws: \"A after 3.6 [3.4 … 3.9]″\".
 
 The model is the base the fit started from (--preset or --params, as given to identify) \
-with the fit's values set. The interval carries the fitted parameters' uncertainty only: \
-every other parameter keeps its value, and the output names them. A fitted parameter \
+with the fit's values set. The interval carries the fitted parameters' uncertainty and \
+that of the held parameters given with --uncertain NAME=X% (drawn uniformly within \
+value·(1 ± X %)): every other parameter keeps its value, and the output names them. A fitted parameter \
 the data did not determine (no standard error) cannot be drawn: the command refuses \
 until it is held at its value (--hold NAME), and then says so.
 
@@ -72,6 +73,12 @@ pub struct Args {
     /// Hold a fitted parameter at its value instead of drawing it; repeatable.
     #[arg(long, value_name = "NAME")]
     pub hold: Vec<String>,
+    /// A parameter the fit held at an assumed value, with its uncertainty as a
+    /// relative half-range: drawn uniformly within value·(1 ± X %) beside the fit's
+    /// draws (e.g. --uncertain Kw=10% for a stiffness taken from a catalogue);
+    /// repeatable.
+    #[arg(long, value_name = "NAME=X%")]
+    pub uncertain: Vec<String>,
     /// Positioning test: runs per direction.
     #[arg(long, value_name = "N", default_value_t = 5)]
     pub runs: u32,
@@ -107,6 +114,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut params = a.model.load()?;
     model_args::apply_fit(&mut params, &fit, &a.fit)?;
     let (source, draws) = draws(&a, &fit)?;
+    let uncertain = uncertain(&a.uncertain, &params, &fit)?;
+    let draws = draws.with_uncertain(&uncertain, a.seed);
     let cases = cases(&a, &params)?;
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();
@@ -175,6 +184,45 @@ fn draws(a: &Args, fit: &IdentifyResult) -> anyhow::Result<(DrawSource, draws::D
     }
     let d = draws::from_covariance(fit, &a.hold, a.draws, a.seed).with_context(context)?;
     Ok((DrawSource::Covariance, d))
+}
+
+/// `--uncertain NAME=X%` each: a parameter of the model not fitted, its value, and X/100.
+fn uncertain(
+    specs: &[String],
+    params: &Params,
+    fit: &IdentifyResult,
+) -> anyhow::Result<Vec<(String, f64, f64)>> {
+    let mut out: Vec<(String, f64, f64)> = Vec::new();
+    for s in specs {
+        let form = || format!("--uncertain {s}: expected NAME=X%, e.g. Kw=10%");
+        let (name, range) = s.split_once('=').with_context(form)?;
+        let percent = range
+            .trim()
+            .trim_start_matches('±')
+            .strip_suffix('%')
+            .with_context(form)?;
+        let percent: f64 = percent.trim().parse().ok().with_context(form)?;
+        if !(percent > 0.0 && percent < 100.0) {
+            bail!("--uncertain {s}: the range must lie between 0 and 100 % of the value");
+        }
+        let spec =
+            rtid::model::spec(name.trim()).map_err(|e| anyhow::anyhow!("--uncertain {s}: {e}"))?;
+        if fit.parameters.contains_key(spec.name) {
+            bail!(
+                "--uncertain {s}: {} is fitted; its uncertainty is the fit's",
+                spec.name
+            );
+        }
+        if out.iter().any(|(n, ..)| n == spec.name) {
+            bail!("--uncertain: {} is given twice", spec.name);
+        }
+        let value = spec
+            .get(params)
+            .filter(|v| *v != 0.0)
+            .with_context(|| format!("--uncertain {s}: {} is zero or not a parameter of this model: a relative range needs a value", spec.name))?;
+        out.push((spec.name.to_string(), value, percent / 100.0));
+    }
+    Ok(out)
 }
 
 fn fitted(fit: &IdentifyResult) -> String {

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
+use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::common::inputs::refuse_overwrite;
@@ -12,6 +12,7 @@ use crate::cli::ModelArgs;
 use rtid::io::params_file;
 use rtid::model::params::LoopMode;
 use rtid::model::Axis;
+use rtid::names::Num;
 use rtid::tuning::{
     self, bode, objective, verify, Criterion, Limits, LoopMargins, Objective, Options, Setting,
     Targets, TuneWarning, Tuned,
@@ -171,6 +172,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             );
         }
         p.controller.loop_mode = mode;
+    }
+    if !(a.phase_margin_deg > 0.0 && a.phase_margin_deg < 180.0) {
+        bail!(
+            "--phase-margin-deg {}: a phase margin lies between 0° and 180°",
+            Num(a.phase_margin_deg)
+        );
+    }
+    if !(0.0..=60.0).contains(&a.gain_margin_db) {
+        bail!(
+            "--gain-margin-db {}: a gain margin target lies in 0..60 dB",
+            Num(a.gain_margin_db)
+        );
     }
     let options = Options {
         targets: Targets {

@@ -92,7 +92,7 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
     let params = space.params(&best.values).map_err(ObjectiveError::from)?;
     let mut warnings = start.warnings;
     warnings.extend(ran.warnings.iter().cloned());
-    if let Some((path, error)) = checkpoint.finish(monitor.evaluations()) {
+    if let Some((path, error)) = checkpoint.finish(monitor) {
         warnings.push(Warning::CheckpointNotWritten { path, error });
     }
     let assessment = assess(&plan, &space, &ran, &best, &params, monitor)?;

@@ -59,7 +59,7 @@ pub enum SpaceError {
     Twice { name: String },
     #[error("{name} does not apply to this mechanism (no spur-gear stage): it cannot be fitted")]
     NotApplicable { name: String },
-    #[error("bounds of {name}, {lo}..{hi}: {reason}")]
+    #[error("bounds of {name} (--bound {name}={lo}..{hi}): {reason}")]
     BadBound {
         name: String,
         lo: f64,
@@ -140,6 +140,11 @@ impl ParamSpace {
                     }
                     if b.lo >= b.hi {
                         return Err(bad("the lower bound must be below the upper"));
+                    }
+                    if let Some(fault) =
+                        crate::model::spec(name)?.constraint.range_fault(b.lo, b.hi)
+                    {
+                        return Err(bad(fault));
                     }
                     *b
                 }
@@ -316,6 +321,14 @@ mod tests {
             ),
             (space(&["Kw"], &[("Kw", 1.0, 2.0)]), "outside its bounds"),
             (space(&["fluct_phase"], &[]), "give it bounds"),
+            (
+                space(&["Kw"], &[("Kw", -1.0, 1e6)]),
+                "bounds of Kw (--bound Kw=-1..1000000): the parameter must be positive",
+            ),
+            (
+                space(&["theta_bw"], &[("theta_bw", -1e-5, 1e-4)]),
+                "must be ≥ 0",
+            ),
         ];
         for (r, want) in cases {
             let e = r.unwrap_err().to_string();

@@ -24,6 +24,27 @@ pub enum Constraint {
     ZeroOrOne,
 }
 
+impl Constraint {
+    /// Why a range `lo..hi` (lo < hi) of a parameter so constrained holds values it
+    /// cannot take, if it does: a stiffness through zero, a ratio through zero.
+    pub fn range_fault(self, lo: f64, hi: f64) -> Option<&'static str> {
+        match self {
+            // A range from 0 itself is a linear search's (the search never takes
+            // its ends); below 0 it holds values the model cannot take.
+            Constraint::Positive if lo < 0.0 => {
+                Some("the parameter must be positive: the range may not go below 0")
+            }
+            Constraint::NonNegative if lo < 0.0 => {
+                Some("the parameter must be ≥ 0: the range may not go below 0")
+            }
+            Constraint::NonZero if lo <= 0.0 && hi >= 0.0 => {
+                Some("the parameter must not be 0 (its sign is the direction): the range may not pass through 0")
+            }
+            _ => None,
+        }
+    }
+}
+
 /// Which topologies a parameter belongs to (docs/model.md §1, §11).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Applies {
@@ -232,9 +253,9 @@ pub fn spec(name: &str) -> Result<&'static ParamSpec, ParamError> {
 }
 
 fn suggest(name: &str) -> String {
-    let lower = name.to_ascii_lowercase();
-    match PARAMS.iter().find(|s| s.name.to_ascii_lowercase() == lower) {
-        Some(s) => format!(" (did you mean `{}`?)", s.name),
+    let names: Vec<&str> = PARAMS.iter().map(|s| s.name).collect();
+    match crate::names::misspelling_of(name, &names) {
+        Some(known) => format!(" (did you mean `{known}`?)"),
         None => String::new(),
     }
 }

@@ -97,6 +97,24 @@ pub fn from_bootstrap(fit: &IdentifyResult) -> Result<Draws, PredictError> {
     })
 }
 
+impl Draws {
+    /// The sets widened by parameters the fit held at assumed values: each of
+    /// `uncertain` (name, its value in `base`, relative half-width) drawn uniformly
+    /// within value·(1 ± half-width), independently of the fit — what a prediction
+    /// rests on besides the fit (a preset's stiffness, an inertia from a drawing).
+    pub fn with_uncertain(mut self, uncertain: &[(String, f64, f64)], seed: u64) -> Draws {
+        use rand::Rng;
+        let mut rng = StdRng::seed_from_u64(seed ^ 0x5eed_u64.rotate_left(32));
+        for set in &mut self.sets {
+            for (_, value, half) in uncertain {
+                set.push(value * (1.0 + half * rng.random_range(-1.0..=1.0)));
+            }
+        }
+        self.names.extend(uncertain.iter().map(|(n, ..)| n.clone()));
+        self
+    }
+}
+
 /// One parameter's normal marginal: in log space when its bounds are positive (a
 /// stiffness, a friction level: the draw stays positive, the standard error read as
 /// relative), else linear.
@@ -206,6 +224,24 @@ mod tests {
         assert!(err.to_string().contains("`c`"), "{err}");
         let held = from_covariance(&fit, &["c".to_string()], 10, 1).unwrap();
         assert_eq!(held.names, ["Kw"]);
+    }
+
+    #[test]
+    fn uncertain_parameters_are_drawn_within_their_range() {
+        let fit: IdentifyResult =
+            serde_json::from_str(include_str!("tests/two_parameter_fit.json")).unwrap();
+        let draws = from_covariance(&fit, &[], 2000, 1)
+            .unwrap()
+            .with_uncertain(&[("Jt".into(), 0.1, 0.05)], 1);
+        assert_eq!(draws.names, ["Kw", "c", "Jt"]);
+        let jt: Vec<f64> = draws.sets.iter().map(|s| s[2]).collect();
+        let (lo, hi) = jt
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+        assert!(
+            lo >= 0.095 && hi <= 0.105 && lo < 0.0951 && hi > 0.1049,
+            "{lo} {hi}"
+        );
     }
 
     #[test]

@@ -163,6 +163,7 @@ pub fn predict(
     let done: Vec<Vec<Vec<Output>>> = done.into_iter().filter_map(Result::ok).collect();
     let mut notes = Vec::new();
     note_missing(&mut notes, failures.len(), skipped.into_inner(), done.len());
+    note_assumed(&mut notes, s.params, &s.draws.names);
     let cases = summarise(s, &nominal, &done);
     note_rough(&mut notes, &cases);
     Ok(Prediction {
@@ -229,6 +230,30 @@ fn note_missing(notes: &mut Vec<String>, failed: usize, skipped: usize, done: us
     if done < MIN_DRAWS {
         notes.push(format!(
             "{done} draws completed, fewer than {MIN_DRAWS}: no interval"
+        ));
+    }
+}
+
+/// Names the parameters the base's notes mark uncertain or assumed (a preset's
+/// values not printed in its source, or read ambiguously) that are not drawn: the
+/// intervals take them as exact, which they are not.
+fn note_assumed(notes: &mut Vec<String>, params: &Params, drawn: &[String]) {
+    let assumed: Vec<&str> = params
+        .notes
+        .iter()
+        .filter(|(name, text)| {
+            let t = text.to_ascii_lowercase();
+            (t.contains("uncertain") || t.contains("assumed"))
+                && params.get(name).is_ok_and(|v| v.is_some())
+                && !drawn.contains(name)
+        })
+        .map(|(name, _)| name.as_str())
+        .collect();
+    if !assumed.is_empty() {
+        notes.push(format!(
+            "the intervals take as exact {}, which the parameter set's notes mark uncertain or \
+             assumed: --uncertain NAME=X% carries a parameter's uncertainty into them",
+            assumed.join(", ")
         ));
     }
 }

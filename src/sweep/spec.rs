@@ -162,20 +162,30 @@ pub fn parse(spec: &str, base: &Params) -> Result<Factor, SpecError> {
             .map_err(|_| syntax(&format!("{what} `{}` is not a number", s.trim())))
     };
     let (low, high) = (number(low, "LOW")?, number(high, "HIGH")?);
-    let (mut scale, mut levels) = (Scale::Lin, DEFAULT_LEVELS);
+    let (mut scale, mut levels) = (None, None);
     for option in parts {
-        match option.trim() {
-            "log" => scale = Scale::Log,
-            "lin" => scale = Scale::Lin,
+        let (slot, what) = match option.trim() {
+            "log" => (scale.replace(Scale::Log).is_some(), "the scale"),
+            "lin" => (scale.replace(Scale::Lin).is_some(), "the scale"),
             other => {
-                levels = other.parse().map_err(|_| {
+                let n = other.parse().map_err(|_| {
                     syntax(&format!(
                         "`{other}` is neither `log`, `lin` nor a number of levels"
                     ))
-                })?
+                })?;
+                (levels.replace(n).is_some(), "the number of levels")
             }
+        };
+        if slot {
+            return Err(syntax(&format!(
+                "{what} is given twice: write NAME=LOW..HIGH[:log][:LEVELS] with each once"
+            )));
         }
     }
+    let (scale, levels) = (
+        scale.unwrap_or(Scale::Lin),
+        levels.unwrap_or(DEFAULT_LEVELS),
+    );
     let rename = |e: SpecError| match e {
         SpecError::EmptyRange { low, high, .. } => SpecError::EmptyRange {
             spec: spec.to_string(),
@@ -198,7 +208,14 @@ pub fn parse(spec: &str, base: &Params) -> Result<Factor, SpecError> {
         other => other,
     };
     let factor = Factor::new(registered.name, low, high, scale, levels).map_err(rename)?;
-    // Both ends must be physical values of this parameter on this topology.
+    // The whole range, not only its ends, must be physical values of this parameter
+    // (a ratio from −1 to 1 passes through 0), each end on this topology.
+    if let Some(fault) = registered
+        .constraint
+        .range_fault(low.min(high), low.max(high))
+    {
+        return Err(syntax(fault));
+    }
     for v in [low, high] {
         let mut p = base.clone();
         p.set(registered.name, v)
@@ -262,7 +279,10 @@ mod tests {
             ("Kw=1e5", "expected NAME=LOW..HIGH"),
             ("Kw=a..1", "LOW `a` is not a number"),
             ("Kw=1..2:cubic", "`cubic` is neither"),
-            ("Kw=-1..2", "Kw = -1"),
+            ("Kw=-1..2", "must be positive: the range may not go below 0"),
+            ("Rg=-1..1", "may not pass through 0"),
+            ("Kw=1e5..2e5:log:log", "the scale is given twice"),
+            ("Kw=1e5..2e5:5:7", "the number of levels is given twice"),
         ];
         for (spec, want) in cases {
             let err = parse(spec, &worm()).unwrap_err().to_string();

@@ -4,8 +4,14 @@
 use anyhow::bail;
 use rtid::names::Num;
 
+/// The largest magnitude an option's value may have (in its own unit): beyond, no
+/// drive test's quantity, but a slip (1e308 made infinite samples that were then
+/// named by the file's cell rather than by the option).
+pub const MAX_OPTION: f64 = 1e15;
+
 /// A positive finite value.
 pub fn positive(v: f64, option: &str) -> anyhow::Result<f64> {
+    within(v, option)?;
     if v > 0.0 && v.is_finite() {
         Ok(v)
     } else {
@@ -15,6 +21,7 @@ pub fn positive(v: f64, option: &str) -> anyhow::Result<f64> {
 
 /// Zero or a positive finite value.
 pub fn non_negative(v: f64, option: &str) -> anyhow::Result<f64> {
+    within(v, option)?;
     if v >= 0.0 && v.is_finite() {
         Ok(v)
     } else {
@@ -35,11 +42,23 @@ pub fn percent(v: f64, option: &str) -> anyhow::Result<f64> {
 
 /// A finite value.
 pub fn finite(v: f64, option: &str) -> anyhow::Result<f64> {
+    within(v, option)?;
     if v.is_finite() {
         Ok(v)
     } else {
         bail!("{option} {}: must be a finite number", Num(v))
     }
+}
+
+/// `v` within ±[`MAX_OPTION`] (NaN and infinities are left to the caller's check).
+fn within(v: f64, option: &str) -> anyhow::Result<()> {
+    if v.is_finite() && v.abs() > MAX_OPTION {
+        bail!(
+            "{option} {}: beyond ±1e15, no drive test's value (a unit slip?)",
+            Num(v)
+        );
+    }
+    Ok(())
 }
 
 /// The environment variable that lifts the work limits for a rare large job.

@@ -94,13 +94,29 @@ pub struct EstimateArgs {
 }
 
 impl EstimateArgs {
-    pub fn options(&self) -> EstimateOptions {
-        EstimateOptions {
+    /// The options, each checked naming its flag.
+    pub fn options(&self) -> anyhow::Result<EstimateOptions> {
+        if let Some(s) = self.segment_s {
+            positive(s, "--segment-s")?;
+        }
+        if !(0.0..=1.0).contains(&self.min_coherence) {
+            bail!(
+                "--min-coherence {}: a coherence γ² lies in 0..1",
+                Num(self.min_coherence)
+            );
+        }
+        if !(0.0..1.0).contains(&self.settle_fraction) {
+            bail!(
+                "--settle-fraction {}: the fraction of each dwell discarded lies in 0..1 (below 1: some must be kept)",
+                Num(self.settle_fraction)
+            );
+        }
+        Ok(EstimateOptions {
             segment_s: self.segment_s,
             min_coherence: self.min_coherence,
             settle_fraction: self.settle_fraction,
             ..Default::default()
-        }
+        })
     }
 }
 
@@ -176,7 +192,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         &experiment_file::read(&path)?,
         &Plot::at(a.common.out.join(format!("{stem}.svg")), &[])?,
         a.common.json,
-        &a.estimate.options(),
+        &a.estimate.options()?,
     )
 }
 

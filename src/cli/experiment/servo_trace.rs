@@ -136,8 +136,8 @@ fn parse_move(s: &str) -> anyhow::Result<MoveTo> {
 /// The moves the flags describe, checked before anything runs.
 fn moves(a: &Args) -> anyhow::Result<TrapezoidalMoves> {
     let mut m = TrapezoidalMoves {
-        acceleration: a.acceleration,
-        dwell_s: a.dwell_s,
+        acceleration: check::positive(a.acceleration, "--acceleration")?,
+        dwell_s: check::non_negative(a.dwell_s, "--dwell-s")?,
         ..Default::default()
     };
     if !a.moves.is_empty() {

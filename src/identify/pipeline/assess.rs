@@ -7,6 +7,7 @@ use crate::identify::intervals::uncertainty;
 use crate::identify::pipeline::stages::Ran;
 use crate::identify::plan::Plan;
 use crate::identify::result::starts::StartRecord;
+use crate::identify::result::termination::Termination;
 use crate::identify::result::uncertainty::Uncertainty;
 use crate::identify::result::warning::Warning;
 use crate::identify::result::{ExperimentResidual, NonlinearCheck};
@@ -64,10 +65,16 @@ pub fn assess(
             )?,
         };
         warnings.extend(a.warnings);
+        let mut a_uncertainty = a.uncertainty;
+        warnings.extend(unconverged_corrections(
+            &ran.starts,
+            &best.values,
+            &mut a_uncertainty,
+        ));
         if plan.declared.rough {
             warnings.push(Warning::RoughCost);
         }
-        Some(a.uncertainty)
+        Some(a_uncertainty)
     };
     Ok(Assessment {
         residuals,
@@ -75,6 +82,58 @@ pub fn assess(
         uncertainty,
         nonlinear_check: ran.check.clone(),
         warnings,
+    })
+}
+
+/// A parameter that one correction still moves by more than this (relative) is not
+/// determined by the record through the nonlinear test: the worm mesh's damping Ciw,
+/// acting on a mode above the record's band, moved by 55 % and 90 %.
+const UNDETERMINED_STEP: f64 = 0.25;
+
+/// The warning that the nonlinear corrections ended still moving by more than half
+/// a standard error of some parameter (a smaller move is immaterial beside the
+/// interval). A standard error is a converged optimum's: a parameter that moved
+/// beyond its own has it widened to the move (the corrections' own spread), and one
+/// that moved beyond [`UNDETERMINED_STEP`] has it withdrawn (not determined).
+fn unconverged_corrections(
+    starts: &[StartRecord],
+    values: &[f64],
+    uncertainty: &mut Uncertainty,
+) -> Option<Warning> {
+    let (corrections, moved) = starts.iter().find_map(|s| match &s.termination {
+        Termination::Corrections {
+            corrections,
+            converged: false,
+            moved,
+            ..
+        } => Some((*corrections, moved.clone())),
+        _ => None,
+    })?;
+    let (mut undetermined, mut widened) = (Vec::new(), Vec::new());
+    let mut material = false;
+    for ((name, step), value) in moved.iter().zip(values) {
+        let Some(slot) = uncertainty
+            .standard_errors
+            .iter_mut()
+            .find(|(n, _)| n == name)
+        else {
+            continue;
+        };
+        let relative_se = slot.1.map_or(0.0, |se| se / value.abs());
+        material |= *step > 0.5 * relative_se;
+        if *step > UNDETERMINED_STEP {
+            slot.1 = None;
+            undetermined.push(name.clone());
+        } else if *step > relative_se {
+            slot.1 = Some(step * value.abs());
+            widened.push(name.clone());
+        }
+    }
+    material.then_some(Warning::CorrectionsNotConverged {
+        corrections,
+        moved,
+        widened,
+        undetermined,
     })
 }
 

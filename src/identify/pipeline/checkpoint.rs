@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::identify::config::Config;
 use crate::identify::plan::Plan;
 use crate::identify::result::starts::StartRecord;
+use crate::identify::search::problem::Monitor;
 use crate::identify::search::settings::Method;
 use crate::identify::space::ParamSpace;
 use crate::identify::Termination;
@@ -110,6 +111,20 @@ pub struct Checkpoint {
     /// The result of the finished search, once the corrections have begun.
     pub stage0_best: Option<Vec<f64>>,
     pub evaluations: usize,
+    /// The search's best evaluation so far: a start's result is the solver's point,
+    /// but the search's result is its best evaluation (a difference step's point may
+    /// cost less), which a resume must not lose — an interruption inside the first
+    /// stage's starts resumed to Ciw 0.32 against 0.15 without it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub best: Option<SavedBest>,
+}
+
+/// The best evaluation of a stage so far: its cost and the fitted parameters' values.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SavedBest {
+    pub cost: f64,
+    pub values: Vec<f64>,
 }
 
 /// Why a checkpoint cannot be used.
@@ -150,6 +165,7 @@ impl Checkpoint {
             starts: Vec::new(),
             stage0_best: None,
             evaluations: 0,
+            best: None,
         }
     }
 
@@ -209,6 +225,7 @@ impl Checkpoint {
             .iter()
             .flat_map(|s| [Some(&s.initial), s.result.as_ref()])
             .chain([self.stage0_best.as_ref()])
+            .chain([self.best.as_ref().map(|b| &b.values)])
             .flatten();
         for v in points {
             if v.len() != expected || v.iter().any(|x| !x.is_finite()) {
@@ -221,6 +238,14 @@ impl Checkpoint {
         }
         Ok(())
     }
+}
+
+/// The monitor's best evaluation, to save.
+fn saved(monitor: &Monitor) -> Option<SavedBest> {
+    monitor.best().map(|b| SavedBest {
+        cost: b.cost,
+        values: b.values,
+    })
 }
 
 /// The checkpoint of a running identification: kept in memory, written to its file
@@ -261,13 +286,15 @@ impl Checkpointer {
         self.lock().clone()
     }
 
-    /// Records a finished (or interrupted) start and writes the file. A failure to
-    /// write is not fatal here: the final write reports it.
-    pub(crate) fn save_start(&self, record: &StartRecord, evaluations: usize) {
+    /// Records a finished (or interrupted) start, the stage's best evaluation so far
+    /// and the evaluations counted, and writes the file. A failure to write is not
+    /// fatal here: the final write reports it.
+    pub(crate) fn save_start(&self, record: &StartRecord, monitor: &Monitor) {
         let mut c = self.lock();
         c.starts.retain(|s| s.index != record.index);
         c.starts.push(record.clone());
-        c.evaluations = evaluations;
+        c.evaluations = monitor.evaluations();
+        c.best = saved(monitor);
         if let Some(p) = &self.path {
             let _ = c.write(p);
         }
@@ -279,16 +306,21 @@ impl Checkpointer {
         c.stage = k;
         c.stage0_best = Some(best.to_vec());
         c.starts.clear();
+        c.best = None;
         c.evaluations = evaluations;
         if let Some(p) = &self.path {
             let _ = c.write(p);
         }
     }
 
-    /// The final write; the error message if it failed.
-    pub fn finish(&self, evaluations: usize) -> Option<(String, String)> {
+    /// The final write, with the evaluations counted and (in the search) the best
+    /// evaluation; the error message if it failed.
+    pub fn finish(&self, monitor: &Monitor) -> Option<(String, String)> {
         let mut c = self.lock();
-        c.evaluations = evaluations;
+        c.evaluations = monitor.evaluations();
+        if c.stage == 0 {
+            c.best = saved(monitor);
+        }
         let p = self.path.as_ref()?;
         c.write(p)
             .err()

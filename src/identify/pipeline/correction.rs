@@ -149,11 +149,12 @@ pub(crate) fn polish(
             };
         };
         corrections += 1;
-        let step = next
+        let steps: Vec<f64> = next
             .iter()
             .zip(&x)
             .map(|(a, b)| ((a - b) / b).abs())
-            .fold(0.0, f64::max);
+            .collect();
+        let step = steps.iter().copied().fold(0.0, f64::max);
         x = next;
         let (d, c) = shift(&x)?;
         nonlinear_evaluations += 1;
@@ -164,6 +165,16 @@ pub(crate) fn polish(
                 nonlinear_evaluations,
                 converged: step < STEP_TOLERANCE,
                 last_step: step,
+                moved: if step < STEP_TOLERANCE {
+                    Vec::new()
+                } else {
+                    space
+                        .names
+                        .iter()
+                        .map(|n| n.to_string())
+                        .zip(steps)
+                        .collect()
+                },
             };
         }
         if step > RESTART_STEP {

@@ -96,7 +96,7 @@ pub fn check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, Identif
             .map(|&f| nonlinear_peak_on_grid(p, &test, &grid, f).map(|pk| pk.frequency_hz))
             .collect::<Result<Vec<f64>, _>>()
             .map_err(ObjectiveError::from)?;
-        let (linear_misfit_db, noise_db) = gain_misfit_db(&spec.experiment, p)?;
+        let (linear_misfit_db, noise_db, lines) = gain_misfit_db(&spec.experiment, p)?;
         let measured_se_hz = peaks_se_hz(&spec.experiment, &measured, noise_db);
         let max_miss_hz = model
             .iter()
@@ -112,6 +112,7 @@ pub fn check(config: &Config, p: &Params) -> Result<Vec<NonlinearCheck>, Identif
             max_miss_hz,
             linear_misfit_db,
             noise_db,
+            lines,
         });
     }
     Ok(out)
@@ -133,8 +134,11 @@ pub fn assumed(p: &Params, fitted: &[&str]) -> String {
 /// The RMS of the linear model's gain against the measured one, dB, over the valid
 /// lines: the gain alone, in dB whatever the file's stated noise — a phase error (a
 /// delay, say) is not one the nonlinear test could explain; and the curve's noise
-/// ([`curve_noise::second_difference`]).
-fn gain_misfit_db(exp: &Experiment, p: &Params) -> Result<(f64, Option<f64>), IdentifyError> {
+/// ([`curve_noise::second_difference`]); with the number of lines.
+fn gain_misfit_db(
+    exp: &Experiment,
+    p: &Params,
+) -> Result<(f64, Option<f64>, usize), IdentifyError> {
     let lin = LinearResponse::new(p, Channel::TableOverMotor).map_err(ObjectiveError::from)?;
     let mut points: Vec<(f64, f64)> = measured::valid_points(exp)
         .map(|(f, g)| (f, lin.gain_db(f) - g))
@@ -142,7 +146,7 @@ fn gain_misfit_db(exp: &Experiment, p: &Params) -> Result<(f64, Option<f64>), Id
     points.sort_by(|a, b| a.0.total_cmp(&b.0));
     let errors: Vec<f64> = points.iter().map(|&(_, e)| e).collect();
     let rms = (sum_of_squares(&errors) / errors.len().max(1) as f64).sqrt();
-    Ok((rms, curve_noise::second_difference(&errors)))
+    Ok((rms, curve_noise::second_difference(&errors), errors.len()))
 }
 
 /// The standard error of each measured peak's frequency ([`vertex_se_hz`]) from the
@@ -160,10 +164,23 @@ fn peaks_se_hz(exp: &Experiment, peaks_hz: &[f64], noise_db: Option<f64>) -> Vec
         .collect()
 }
 
-/// Whether the linear fit explains a check's curve within its noise.
+/// Whether the linear fit explains a check's curve within its noise: its misfit at
+/// most [`EXPLAINED_WITHIN`] times the noise, or the chance level of that ratio on
+/// the record's lines where that is higher ([`chance_ratio`]).
 fn explained(c: &NonlinearCheck) -> bool {
-    c.noise_db
-        .is_some_and(|noise| c.linear_misfit_db <= EXPLAINED_WITHIN * noise)
+    c.noise_db.is_some_and(|noise| {
+        c.linear_misfit_db <= EXPLAINED_WITHIN.max(chance_ratio(c.lines)) * noise
+    })
+}
+
+/// The ratio of an RMS misfit to a noise estimated on the same `lines` that white
+/// noise alone exceeds once in a thousand: both squares are means of about `lines`
+/// squared normals, so their quotient is F(lines, lines)-distributed (the χ² test of
+/// a fit against a noise estimated, not known). 2.1 on 20 lines, 1.2 on 300.
+pub fn chance_ratio(lines: usize) -> f64 {
+    use statrs::distribution::{ContinuousCDF, FisherSnedecor};
+    let dof = lines.max(2) as f64;
+    FisherSnedecor::new(dof, dof).map_or(f64::INFINITY, |f| f.inverse_cdf(0.999).sqrt())
 }
 
 /// The measured resonances at which the nonlinear test at `p` resolves the table's
@@ -244,9 +261,16 @@ pub fn verdict(checks: &[NonlinearCheck], assumed: &str) -> Option<Warning> {
         })
 }
 
-/// Whether a check's miss or misfit would call for the nonlinear fit.
+/// Whether a check's miss or misfit would call for the nonlinear fit: a resonance
+/// missed, or a gain curve the linear model does not explain — beyond the curve's
+/// noise where that is known ([`explained`]: 0.66 dB against a noise of 0.061 dB is
+/// a nonlinearity, whatever a fixed rule in dB says), else beyond [`MISFIT_ABOVE_DB`].
 fn fails(miss: f64, c: &NonlinearCheck) -> bool {
-    miss > ESCALATE_ABOVE || misfit_fails(c.linear_misfit_db)
+    let misfit = match c.noise_db {
+        Some(_) => !explained(c),
+        None => misfit_fails(c.linear_misfit_db),
+    };
+    miss > ESCALATE_ABOVE || misfit
 }
 
 /// The notes that the linear fit stands where the nonlinear test disagrees with it
@@ -313,6 +337,7 @@ mod tests {
             max_miss_hz: 0.0,
             linear_misfit_db: 0.2,
             noise_db: None,
+            lines: 300,
         }
     }
 
@@ -375,5 +400,31 @@ mod tests {
             "misfit beyond the noise"
         );
         assert!(stands(&[c], "").is_empty());
+    }
+
+    /// The case: the peaks' misses within their standard errors, the misfit
+    /// 0.66 dB (under the fixed 1 dB) but 11 times the curve's noise of 0.061 dB.
+    #[test]
+    fn a_misfit_beyond_the_noise_escalates_under_a_decibel() {
+        let mut c = check(vec![200.0, 252.0]);
+        c.measured_se_hz = vec![0.83, 0.83];
+        c.linear_misfit_db = 0.66;
+        assert!(
+            verdict(&[c.clone()], "").is_none(),
+            "noise unknown: 1 dB rule"
+        );
+        c.noise_db = Some(0.061);
+        assert!(verdict(&[c.clone()], "").is_some(), "11 × the noise");
+        c.linear_misfit_db = 1.1 * 0.061;
+        assert!(verdict(&[c], "").is_none(), "about the noise");
+    }
+
+    #[test]
+    fn the_chance_ratio_falls_with_the_lines() {
+        let (few, many) = (chance_ratio(20), chance_ratio(300));
+        assert!(
+            (2.0..2.2).contains(&few) && (1.15..1.3).contains(&many),
+            "{few} {many}"
+        );
     }
 }

@@ -204,8 +204,12 @@ fn run_stage(
         Stage::Search => {
             let mut here = space.clone();
             here.start = from.to_vec();
-            let done = checkpoint.snapshot().starts;
-            let on_done = |r: &StartRecord| checkpoint.save_start(r, monitor.evaluations());
+            let resumed = checkpoint.snapshot();
+            if let Some(b) = &resumed.best {
+                monitor.offer(b.cost, &b.values);
+            }
+            let done = resumed.starts;
+            let on_done = |r: &StartRecord| checkpoint.save_start(r, monitor);
             search(&here, &joint, &settings, monitor, &done, &on_done)
         }
     };

@@ -69,6 +69,9 @@ pub struct NonlinearCheck {
     /// smooth misfit has none); `None` on fewer than 20 lines.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub noise_db: Option<f64>,
+    /// The valid measured lines the misfit and the noise come from.
+    #[serde(default)]
+    pub lines: usize,
 }
 
 /// The result of `rtid identify`.

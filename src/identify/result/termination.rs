@@ -29,6 +29,10 @@ pub enum Termination {
         converged: bool,
         /// Largest relative move of the last correction.
         last_step: f64,
+        /// Each fitted parameter's relative move in the last correction, where it
+        /// did not converge (empty when it did).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        moved: Vec<(String, f64)>,
     },
     /// The corrected linear problem could not be evaluated near this point.
     CorrectionFailed { at: String },

@@ -182,7 +182,7 @@ pub struct Conditions {
 
 impl Conditions {
     /// The JSON keys of the typed fields.
-    pub(super) const KEYS: [&'static str; 24] = [
+    pub(super) const KEYS: [&'static str; 25] = [
         "torque_amplitude_nm",
         "preload_nm",
         "amplitude_deg",
@@ -207,6 +207,7 @@ impl Conditions {
         "reference",
         "delay_s",
         "averages",
+        "controller",
     ];
 
     /// True when no condition is given.
@@ -291,6 +292,15 @@ pub(super) fn fluctuation_defaults(c: &mut Conditions, speed_deg_per_min: f64) {
 /// finite, so `<= 0` is the whole check of a positive value): the band where one is
 /// given, then the kind's own checks.
 pub(super) fn check(kind: Kind, c: &Conditions) -> Result<(), String> {
+    for name in c.extra.keys() {
+        if let Some(known) = crate::names::misspelling_of(name, &Conditions::KEYS) {
+            return Err(format!(
+                "`conditions.{name}` is not a condition rtid reads: did you mean `{known}`? \
+                 (a note of your own goes under a name unlike rtid's, or in `notes`)"
+            ));
+        }
+    }
+    check_magnitudes(c)?;
     if let Some([lo, hi]) = c.band_hz {
         if !(lo >= 0.0 && lo < hi) {
             return Err(format!(
@@ -299,6 +309,31 @@ pub(super) fn check(kind: Kind, c: &Conditions) -> Result<(), String> {
         }
     }
     (kind.definition().check)(c)
+}
+
+/// Every number of the conditions within ±1e15 (as a record's values,
+/// [`super::table::MAX_MAGNITUDE`]): a ratio of 1e308 is a slip, whose arithmetic
+/// would then fail far from the field that caused it.
+fn check_magnitudes(c: &Conditions) -> Result<(), String> {
+    let Ok(Value::Object(fields)) = serde_json::to_value(c) else {
+        return Ok(());
+    };
+    for (key, value) in &fields {
+        let numbers = match value {
+            Value::Array(items) => items.iter().filter_map(Value::as_f64).collect(),
+            v => v.as_f64().into_iter().collect::<Vec<_>>(),
+        };
+        if let Some(x) = numbers
+            .into_iter()
+            .find(|x| x.abs() > super::table::MAX_MAGNITUDE)
+        {
+            return Err(format!(
+                "`conditions.{key}` is {}: beyond ±1e15, not a test's condition (a unit slip?)",
+                crate::names::Num(x)
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A frequency-response record: a positive ratio where one is given; for a stepped

@@ -249,7 +249,7 @@ impl Table {
     }
 
     /// The column's numbers in rad (for angles) or as written; all finite, and with
-    /// [`Order::Increasing`] strictly increasing.
+    /// [`Order::Time`] strictly increasing by at least [`MIN_TIME_STEP_S`].
     fn numbers(&self, col: Col, order: Order) -> Result<Vec<f64>, Error> {
         let mut out = Vec::with_capacity(self.rows.len());
         let mut previous: Option<f64> = None;
@@ -269,9 +269,17 @@ impl Table {
                 );
                 return Err(self.cell(*line, col.index, message));
             }
-            if let (Order::Increasing | Order::Frequency, Some(p)) = (order, previous) {
+            if let (Order::Time | Order::Frequency, Some(p)) = (order, previous) {
                 if x <= p {
                     let message = format!("{x} does not increase (previous row {p})");
+                    return Err(self.cell(*line, col.index, message));
+                }
+                if order == Order::Time && x - p < MIN_TIME_STEP_S {
+                    let message = format!(
+                        "{x} is {} s after the previous row: a time step under \
+                         {MIN_TIME_STEP_S:e} s is no recorder's (times in seconds?)",
+                        crate::names::Num(x - p)
+                    );
                     return Err(self.cell(*line, col.index, message));
                 }
             }
@@ -294,12 +302,20 @@ impl Table {
     }
 
     /// The columns not taken, with a name, whose every cell is a finite number. Other
-    /// columns (text such as a timestamp) are left out rather than refused.
-    fn extras(&self) -> Columns {
+    /// columns (text such as a timestamp) are left out rather than refused; a column
+    /// whose name misspells one of the kind's `reserved` names is refused naming it.
+    fn extras(&self, reserved: &[String]) -> Result<Columns, Error> {
+        let reserved: Vec<&str> = reserved.iter().map(String::as_str).collect();
         let mut extra = Columns::new();
         for (i, name) in self.header.iter().enumerate() {
             if self.used[i] || name.is_empty() {
                 continue;
+            }
+            if let Some(known) = crate::names::misspelling_of(name, &reserved) {
+                return Err(self.header_error(format!(
+                    "column `{name}` is not one rtid reads: did you mean `{known}`? (a column \
+                     of your own goes under a name unlike rtid's)"
+                )));
             }
             let values: Option<Vec<f64>> = self
                 .rows
@@ -310,17 +326,22 @@ impl Table {
                 extra.insert(name.clone(), values);
             }
         }
-        extra
+        Ok(extra)
     }
 }
 
 #[derive(Clone, Copy, PartialEq)]
 enum Order {
     Any,
-    Increasing,
+    /// Time in seconds: strictly increasing, by at least [`MIN_TIME_STEP_S`].
+    Time,
     /// Strictly increasing frequencies, each at least [`MIN_FREQUENCY_HZ`].
     Frequency,
 }
+
+/// The shortest time step a record may have, s: a nanosecond, beyond any drive's
+/// recorder (a torque curve lasting 6e-298 s was evaluated to a null friction).
+pub const MIN_TIME_STEP_S: f64 = 1e-9;
 
 /// The lowest frequency a response's line may have, Hz: below, no drive test (and
 /// subnormal frequencies, 1e-319 Hz, sent the modal fit's arithmetic crawling).

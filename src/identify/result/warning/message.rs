@@ -72,6 +72,12 @@ pub(super) fn text(w: &Warning) -> String {
                 *linear_misfit_db,
             ) + &assumed_note(assumed)
         }
+        Warning::CorrectionsNotConverged {
+            corrections,
+            moved,
+            widened,
+            undetermined,
+        } => corrections_not_converged(*corrections, moved, widened, undetermined),
         Warning::LinearStands {
             source,
             linear_misfit_db,
@@ -217,4 +223,40 @@ fn profile_better_fit(name: &str, value: f64, cost: f64, fit_cost: f64) -> Strin
         "holding {name} at {} fits better than the result (cost {cost:.4e} against {fit_cost:.4e}): the search stopped short of the optimum — rerun with more --starts, or from there",
         Num(value)
     )
+}
+
+fn corrections_not_converged(
+    corrections: usize,
+    moved: &[(String, f64)],
+    widened: &[String],
+    undetermined: &[String],
+) -> String {
+    let moves: Vec<String> = moved
+        .iter()
+        .map(|(n, step)| format!("{n} {:.2} %", 100.0 * step))
+        .collect();
+    let mut text = format!(
+        "the nonlinear corrections did not converge in {corrections}: the last moved {} — the \
+         result is not an optimum of the nonlinear test",
+        moves.join(", ")
+    );
+    if !widened.is_empty() {
+        text += &format!(
+            "; the standard errors of {} are widened to that move (the corrections' own spread)",
+            widened.join(", ")
+        );
+    }
+    if !undetermined.is_empty() {
+        text +=
+            &format!(
+            "; {} moved by more than a quarter of {}: not determined by this record through the \
+             nonlinear test (no standard error given; hold {} with --set, or fit on a record \
+             that reaches {})",
+            undetermined.join(", "),
+            if undetermined.len() == 1 { "its value" } else { "their values" },
+            if undetermined.len() == 1 { "it" } else { "them" },
+            if undetermined.len() == 1 { "its mode" } else { "their modes" },
+        );
+    }
+    text
 }

@@ -101,6 +101,17 @@ pub enum Warning {
         /// The nonlinear parameters the test would have assumed.
         assumed: String,
     },
+    /// The nonlinear corrections ended at their limit still moving: the result is
+    /// not an optimum; `moved` gives each parameter's relative move in the last
+    /// correction; `widened` those whose standard error was widened to that move,
+    /// `undetermined` those it withdrew (a move beyond a quarter of the value).
+    CorrectionsNotConverged {
+        corrections: usize,
+        moved: Vec<(String, f64)>,
+        #[serde(default)]
+        widened: Vec<String>,
+        undetermined: Vec<String>,
+    },
     /// A profile stays below the 95 % level up to the parameter's bound on one side:
     /// the data bound it on the other side only; `family` are the other fitted
     /// parameters that moved along it (ratio of largest to smallest value).
@@ -141,6 +152,7 @@ impl Warning {
             Warning::EstimateUnused { .. } => "estimate_unused",
             Warning::Escalated { .. } => "escalated",
             Warning::LinearStands { .. } => "linear_stands",
+            Warning::CorrectionsNotConverged { .. } => "corrections_not_converged",
             Warning::ProfileOpen { .. } => "profile_open",
             Warning::ProfileBetterFit { .. } => "profile_better_fit",
         }

@@ -10,7 +10,7 @@ use crate::io::experiment_file::{
     Axis, CommandUnit, Data, ExperimentFileError as Error, FrictionMap, Kind,
 };
 
-use Order::{Any, Increasing};
+use Order::{Any, Time};
 
 /// The table's position in a torque curve: an angle, or a length on a linear axis.
 const TABLE: [&str; 2] = ["table_angle", "table_position"];
@@ -60,7 +60,7 @@ impl Table {
             frequency_hz: self.numbers(f, Order::Frequency)?,
             gain_db: self.numbers(g, Any)?,
             phase_rad: p.map(|p| self.numbers(p, Any)).transpose()?,
-            extra: self.extras(),
+            extra: self.extras(&frequency_response())?,
         })
     }
 
@@ -79,10 +79,10 @@ impl Table {
         let effort = self.effort(&CURVE_EFFORT)?;
         let table = self.position(&TABLE)?;
         let axis = self.same_axis(&[Some(effort), table])?;
-        let time_s = self.numbers(t, Increasing)?;
+        let time_s = self.numbers(t, Time)?;
         let effort = self.numbers(effort, Any)?;
         let table = table.map(|a| self.numbers(a, Any)).transpose()?;
-        let extra = self.extras();
+        let extra = self.extras(&torque_curve())?;
         Ok(match axis {
             Axis::Rotary => Data::TorqueCurve {
                 time_s,
@@ -135,7 +135,7 @@ impl Table {
             })?,
             self.parse(r, super::run)?,
         );
-        let extra = self.extras();
+        let extra = self.extras(&positioning())?;
         Ok(match axis {
             Axis::Rotary => Data::Positioning {
                 target_rad: target_si,
@@ -202,11 +202,11 @@ impl Table {
         let m = self.required_position(&["motor_angle"])?;
         let a = self.required_position(&["table_angle"])?;
         let (time_s, motor_angle_rad, table_angle_rad) = (
-            self.numbers(t, Increasing)?,
+            self.numbers(t, Time)?,
             self.numbers(m, Any)?,
             self.numbers(a, Any)?,
         );
-        let extra = self.extras();
+        let extra = self.extras(&fluctuation())?;
         Ok(if kind == Kind::Fluctuation {
             Data::Fluctuation {
                 time_s,
@@ -237,7 +237,7 @@ impl Table {
             self.numbers(m, Any)?,
             self.numbers(a, Any)?,
         );
-        let extra = self.extras();
+        let extra = self.extras(&record())?;
         Ok(match kind {
             Input::Torque => Data::FrequencyResponseTime {
                 time_s,
@@ -291,7 +291,7 @@ impl Table {
             effort: self.numbers(effort, Any)?,
             controller_output: output.map(signal).transpose()?,
             controller_added: added.map(signal).transpose()?,
-            extra: self.extras(),
+            extra: self.extras(&servo_trace())?,
         }))
     }
 
@@ -338,7 +338,7 @@ impl Table {
             samples: whole(counts[0])?,
             dropped: whole(counts[1])?,
             transient: whole(counts[2])?,
-            extra: self.extras(),
+            extra: self.extras(&friction_map())?,
         };
         Ok(Data::FrictionMap(map.sorted()))
     }
@@ -375,7 +375,7 @@ impl Table {
 
     /// Strictly increasing, uniformly sampled time.
     fn uniform_time(&self, t: Col) -> Result<Vec<f64>, Error> {
-        let time_s = self.numbers(t, Increasing)?;
+        let time_s = self.numbers(t, Time)?;
         match crate::io::experiment_file::check_uniform(&time_s) {
             Ok(()) => Ok(time_s),
             Err(e) => Err(self.cell(self.rows[e.row].0, t.index, e.to_string())),

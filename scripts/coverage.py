@@ -1,0 +1,127 @@
+#!/usr/bin/env python3
+"""Coverage of `rtid predict`'s intervals on machines that are not the model.
+
+Draws machines around the worm-gear preset (backlash and frictions moved; on the
+second half also held parameters: Kw, theta_bg, Jt), records on each the tests a user
+would (a noisy torque curve and unbalance test), runs the chain of
+docs/compensation.md (identify theta_bw, fm, fw -> compensate --fit -> predict), then
+the machine's own ISO 230-2 test before and after that compensation, and counts how
+many of the machine's values fall inside the predicted intervals.
+
+    python3 scripts/coverage.py [--rtid target/release/rtid] [--machines 6]
+        [--draws 30] [--uncertain Kw=10% --uncertain theta_bg=50% ...] [--out DIR]
+
+Standard library only; prints one line per value and the coverage; writes
+DIR/coverage.json. docs/validation.md reports what it measured.
+"""
+import argparse
+import json
+import os
+import random
+import subprocess
+import sys
+
+OUTPUTS = ["B_mean", "B", "E", "M", "R", "A"]
+
+
+def rtid(binary, *args):
+    r = subprocess.run([binary, *args], capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"rtid {' '.join(args)} failed:\n{r.stderr}")
+    return r.stdout
+
+
+def machine(k, held_moved):
+    """The parameter overrides of machine k: backlash and frictions within ±40 %;
+    with `held_moved`, Kw ±10 %, theta_bg ×0.5…1.5 and Jt ±10 % as well."""
+    rng = random.Random(1000 + k)
+    sets = {
+        "theta_bw": 8e-5 * rng.uniform(0.6, 1.4),
+        "fm": 0.14 * rng.uniform(0.6, 1.4),
+        "fw": 0.24 * rng.uniform(0.6, 1.4),
+    }
+    if held_moved:
+        sets["Kw"] = 3.1e5 * rng.choice([0.9, 1.1])
+        sets["theta_bg"] = 3e-4 * rng.uniform(0.5, 1.5)
+        sets["Jt"] = 0.108 * rng.uniform(0.9, 1.1)
+    return sets
+
+
+def iso_values(binary, manifest):
+    axis = json.loads(rtid(binary, "evaluate", manifest, "--json"))["axis"]
+    return {name: axis[name] for name in OUTPUTS}
+
+
+def one(binary, k, held_moved, args, root):
+    d = os.path.join(root, f"machine-{k}")
+    os.makedirs(d, exist_ok=True)
+    sets = machine(k, held_moved)
+    setargs = [a for n, v in sets.items() for a in ("--set", f"{n}={v!r}")]
+    params = os.path.join(d, "machine.json")
+    rtid(binary, "params", "--preset", "worm-gear", *setargs, "--out", params, "--quiet")
+    m = ["--params", params, "--quiet"]
+    rtid(binary, "experiment", "torque-curve", *m, "--noise-percent", "1", "--seed", str(k),
+         "--out", os.path.join(d, "records"))
+    rtid(binary, "experiment", "unbalance", *m, "--noise-arcsec", "0.5", "--seed", str(k),
+         "--out", os.path.join(d, "records"))
+    fit = os.path.join(d, "fit.json")
+    rtid(binary, "identify", os.path.join(d, "records", "torque_curve.json"),
+         os.path.join(d, "records", "unbalance.json"), "--preset", "worm-gear",
+         "--fit", "theta_bw,fm,fw", "--out", fit, "--quiet")
+    comp = os.path.join(d, "compensation.json")
+    rtid(binary, "compensate", "--fit", fit, "--preset", "worm-gear", "-o", comp, "--quiet")
+    uncertain = [a for u in args.uncertain for a in ("--uncertain", u)]
+    pred = json.loads(rtid(binary, "predict", fit, "--preset", "worm-gear", "--compensation",
+                           comp, "--draws", str(args.draws), "--json", "--quiet", *uncertain))
+    rtid(binary, "experiment", "positioning", *m, "--out", os.path.join(d, "before"))
+    rtid(binary, "experiment", "positioning", *m, "--compensation", comp,
+         "--out", os.path.join(d, "after"))
+    truth = {
+        "before": iso_values(binary, os.path.join(d, "before", "positioning.json")),
+        "after": iso_values(binary, os.path.join(d, "after", "positioning.json")),
+    }
+    fitted = json.load(open(fit))["parameters"]
+    rows = []
+    for case in pred["cases"]:
+        for v in case["values"]:
+            if v["name"] not in OUTPUTS:
+                continue
+            value = truth[case["case"]][v["name"]]
+            lo, hi = v["lower"], v["upper"]
+            inside = lo is not None and lo <= value <= hi
+            rows.append({"machine": k, "held_moved": held_moved, "case": case["case"],
+                         "name": v["name"], "machine_value": value, "nominal": v["nominal"],
+                         "lower": lo, "upper": hi, "inside": inside})
+    return {"machine": k, "sets": sets, "fitted": fitted, "rows": rows, "notes": pred["notes"]}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rtid", default="target/release/rtid")
+    ap.add_argument("--machines", type=int, default=6)
+    ap.add_argument("--draws", type=int, default=30)
+    ap.add_argument("--uncertain", action="append", default=[])
+    ap.add_argument("--out", default="coverage-run")
+    args = ap.parse_args()
+    results = []
+    for k in range(1, args.machines + 1):
+        r = one(args.rtid, k, k > args.machines // 2, args, args.out)
+        results.append(r)
+        for row in r["rows"]:
+            print(f"machine {k} {row['case']:6} {row['name']:6} machine {row['machine_value']:8.2f}  "
+                  f"predicted {row['nominal']:8.2f} [{row['lower']:.2f} … {row['upper']:.2f}]"
+                  f"  {'in' if row['inside'] else 'OUT'}", flush=True)
+    rows = [row for r in results for row in r["rows"]]
+    inside = sum(row["inside"] for row in rows)
+    print(f"coverage: {inside} of {len(rows)} ({100 * inside / max(len(rows), 1):.0f} %)")
+    for held in (False, True):
+        part = [row for row in rows if row["held_moved"] == held]
+        if part:
+            n = sum(row["inside"] for row in part)
+            print(f"  held parameters {'moved' if held else 'as the preset'}: {n} of {len(part)}")
+    with open(os.path.join(args.out, "coverage.json"), "w") as f:
+        json.dump({"uncertain": args.uncertain, "draws": args.draws, "machines": results}, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
