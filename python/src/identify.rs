@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use pyo3::prelude::*;
+use pyo3::types::PyList;
 
+use crate::curves;
 use crate::errors::{bad_argument, rtid_error, with_context};
 use crate::params::PyParams;
 use rtid::identify::{
@@ -39,12 +41,12 @@ pub struct Options {
 /// `experiments` (path, name to report it by); returns the result file's JSON and the
 /// identified parameter set.
 #[pyfunction]
-pub fn identify(
-    py: Python<'_>,
+pub fn identify<'py>(
+    py: Python<'py>,
     experiments: Vec<(PathBuf, String)>,
     params: PyRef<'_, PyParams>,
     options: Options,
-) -> PyResult<(String, PyParams)> {
+) -> PyResult<(String, PyParams, pyo3::Bound<'py, PyList>)> {
     let base = params.inner.clone();
     drop(params);
     let config = config(&experiments, base, &options)?;
@@ -58,7 +60,13 @@ pub fn identify(
     let outcome = std::thread::scope(|s| {
         let search = s.spawn(|| {
             let fit = rtid::identify(&config, &monitor).map_err(|e| rtid_error(&e))?;
-            with_intervals(fit, &options, &monitor)
+            let fit = with_intervals(fit, &options, &monitor)?;
+            let curves = curves::compute(
+                &config.experiments,
+                &start_params(&config.base, &fit.result),
+                &fit.params,
+            );
+            Ok::<_, PyErr>((fit, curves))
         });
         while !search.is_finished() {
             py.detach(|| std::thread::sleep(Duration::from_millis(20)));
@@ -69,12 +77,25 @@ pub fn identify(
         }
         search.join()
     });
-    let Identified { result, params, .. } = match outcome {
+    let (Identified { result, params, .. }, curves) = match outcome {
         Ok(r) => r?,
         Err(_) => return Err(bad_argument("identify", "the search panicked")),
     };
     let json = rtid::io::json::pretty(&result).map_err(|e| rtid_error(&e))?;
-    Ok((json, PyParams { inner: params }))
+    let curves = curves::to_python(py, curves)?;
+    Ok((json, PyParams { inner: params }, curves))
+}
+
+/// The parameters the search started from: the base set with the recorded start
+/// values (a direct estimate may have replaced the base's), as the command line
+/// takes them for its comparisons.
+fn start_params(base: &rtid::Params, result: &rtid::identify::result::IdentifyResult) -> rtid::Params {
+    let mut p = base.clone();
+    for (name, &v) in &result.initial {
+        // A name the result holds is one of the set's: set() cannot refuse it.
+        let _ = p.set(name, v);
+    }
+    p
 }
 
 /// The fit with the intervals `options` ask for, as `rtid identify --profile` and
