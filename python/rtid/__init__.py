@@ -751,8 +751,9 @@ def frequency_response(params: Params, freqs_hz, *, input: str = "motor_torque",
             The two ratios are responses to the motor's torque.
 
     Returns:
-        A complex128 array like `freqs_hz` (NaN where the system is singular: 0 Hz
-        on the free drive). ``20·log10(abs(h))`` is the gain in dB.
+        A complex128 array like `freqs_hz` (a complex number for a number; NaN
+        where the solve fails). ``20·log10(abs(h))`` is the gain in dB,
+        ``np.angle(h)`` the phase.
     """
     scalar = isinstance(freqs_hz, numbers.Real) and not isinstance(freqs_hz, bool)
     f = _real_array([freqs_hz] if scalar else freqs_hz, "freqs_hz")
