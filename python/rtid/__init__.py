@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _names, _rtid
+from . import _experiments, _names, _rtid
 from ._results import Curve, IdentifyResult, SweepResult
 from ._rtid import VERSION, RtidError
 
@@ -52,6 +52,7 @@ __all__ = [
     "Experiment",
     "experiment",
     "read_experiment",
+    "run_experiment",
     "evaluate",
     "IdentifyResult",
     "Curve",
@@ -478,6 +479,51 @@ def read_experiment(path) -> Experiment:
     with open(path, encoding="utf-8-sig") as f:
         manifest = json.load(f)
     return Experiment(manifest, None, path, path)
+
+
+def run_experiment(kind: str, params: Params, **settings) -> Experiment:
+    """One of the paper's tests run on the model: the experiment ``rtid experiment
+    KIND`` writes (the same manifest and columns, every number to the bit).
+
+    Args:
+        kind: ``frequency_response``, ``torque_curve``, ``fluctuation`` or
+            ``unbalance`` (``frequency-response`` … as on the command line).
+        params: the drive (:func:`params`; an identified one: ``fit.params``).
+        **settings: the test's flags, ``-`` as ``_``, with the flags' defaults:
+
+            - frequency_response: ``amplitude_nm`` (5), ``preload_nm`` (0),
+              ``from_hz`` (10), ``to_hz`` (600), ``step_hz`` (10),
+              ``refine_step_hz`` (1; 0: no refinement), ``linear`` (False: a
+              nonlinear simulation per frequency, seconds; True: the linear model,
+              milliseconds), ``noise_percent``, ``complex_noise_percent`` (0),
+              ``seed`` (1), ``response`` (``table_over_motor``, or with
+              ``linear=True`` ``motor_compliance``), ``unstated_delay_s`` (0);
+            - torque_curve: ``loop`` (``full_closed``), ``amplitude_deg`` (30) or on
+              a linear axis ``amplitude_mm`` (50), ``period_s`` (3), ``periods`` (2),
+              ``noise_percent`` (0), ``seed`` (1);
+            - fluctuation and unbalance: ``loop`` (the set's), ``revolutions`` (1),
+              ``run_in_deg`` (10), ``sample_period_s`` (0.004), ``noise_arcsec`` (0),
+              ``seed`` (1), ``speed_deg_per_min`` (180; unbalance 360); unbalance
+              also ``mass_kg``, ``radius_m`` (the set's unbalance, else 10 kg at
+              0.1 m).
+
+    Returns:
+        An :class:`Experiment` holding the manifest and the columns as arrays, for
+        :func:`evaluate` and :func:`identify`. The test runs with the GIL released.
+
+    Raises:
+        RtidError: an unknown test or setting (with the closest known name), a bad
+            value (named); TypeError: a setting of the wrong type.
+    """
+    k = _experiments.kind_of(kind)
+    values = _experiments.settings_of(k, settings)
+    p = _params_arg(params)
+    with tempfile.TemporaryDirectory(prefix="rtid-") as d:
+        path = _rtid.run_experiment(k, p, values, d)
+        with open(path, encoding="utf-8") as f:
+            manifest = json.load(f)
+        columns = _experiments.read_columns(os.path.join(d, manifest.pop("data")))
+    return Experiment(manifest, columns, None, f"{k} of {params.name}")
 
 
 def _as_experiment(e, argument: str) -> Experiment:

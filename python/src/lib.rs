@@ -8,6 +8,7 @@
 mod curves;
 mod errors;
 mod evaluate;
+mod experiment;
 mod identify;
 mod import;
 mod linear;
@@ -29,6 +30,7 @@ fn _rtid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(params::param_names, m)?)?;
     m.add_function(wrap_pyfunction!(linear::state_space, m)?)?;
     m.add_function(wrap_pyfunction!(linear::frequency_response, m)?)?;
+    m.add_function(wrap_pyfunction!(experiment::run_experiment, m)?)?;
     m.add_function(wrap_pyfunction!(params::modes, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(import::import_file, m)?)?;
