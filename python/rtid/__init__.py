@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _experiments, _names, _rtid
+from . import _experiments, _names, _progress, _rtid
 from ._results import Curve, IdentifyResult, SweepResult
 from ._rtid import VERSION, RtidError
 
@@ -604,7 +604,7 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
              method: str | None = None, model: str = "auto", starts: int | None = None,
              seed: int = 1, max_iters: int = 50, start: str = "estimate",
              weights=None, objectives=None, profile=None,
-             resample: int | None = None) -> IdentifyResult:
+             resample: int | None = None, progress=None) -> IdentifyResult:
     """Identifies parameters from experiments (``rtid identify``).
 
     Args:
@@ -639,6 +639,10 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
         profile: names to profile (``True``: every fitted parameter), for intervals
             that hold where the cost is not a bowl (``--profile``).
         resample: bootstrap replicates of the residuals' blocks (``--resample``).
+        progress: a progress bar of the searches' iterations: None (default) shows
+            a tqdm bar where tqdm is installed and the output is watched (a notebook,
+            a terminal), True always (tqdm required), False never; or a function
+            called as ``progress(done, budget, evaluations)``.
 
     Returns:
         An :class:`IdentifyResult`: ``values``, ``standard_errors``, ``covariance``,
@@ -685,9 +689,13 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
         "resample": None if resample is None else _whole(resample, "resample"),
     }
     exps = [_as_experiment(e, f"experiments[{i}]") for i, e in enumerate(experiments)]
-    with _temporary_folder() as d:
-        paths = [(e._written(d), e.name) for e in exps]
-        text, identified, comparisons = _rtid.identify(paths, _params_arg(params), options)
+    callback, close = _progress.reporter(progress, "identify", "it")
+    try:
+        with _temporary_folder() as d:
+            paths = [(e._written(d), e.name) for e in exps]
+            text, identified, comparisons = _rtid.identify(paths, _params_arg(params), options, callback)
+    finally:
+        close()
     result = IdentifyResult(json.loads(text), Params(identified), comparisons)
     if result.interrupted:
         warnings.warn("rtid.identify: interrupted; the result is the best point so far", RuntimeWarning, stacklevel=2)
@@ -699,7 +707,7 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
 
 def sweep(params: Params, vary, outputs, *, method: str = "grid", samples: int = 256,
           bootstrap: int = 500, trajectories: int = 20, levels: int = 4, step: float = 0.01,
-          seed: int = 0, tests: str = "short", out=None) -> SweepResult:
+          seed: int = 0, tests: str = "short", out=None, progress=None) -> SweepResult:
     """A sensitivity sweep (``rtid sweep``).
 
     Args:
@@ -711,6 +719,8 @@ def sweep(params: Params, vary, outputs, *, method: str = "grid", samples: int =
             ``bootstrap``, ``trajectories``, ``levels``, ``step``, ``seed``,
             ``tests`` as the flags of the same names.
         out: the sweep CSV to keep (default: a temporary file, removed).
+        progress: a progress bar of the design's points, as :func:`identify`'s (a
+            function is called as ``progress(done, total)``).
 
     Returns:
         A :class:`SweepResult`: ``design``, ``outputs``, ``indices``, and as pandas
@@ -724,9 +734,13 @@ def sweep(params: Params, vary, outputs, *, method: str = "grid", samples: int =
                    trajectories=_whole(trajectories, "trajectories"), levels=_whole(levels, "levels"),
                    step=_finite_number(step, "step"), seed=_whole(seed, "seed", 0),
                    tests=_choice(tests, "tests", ("short", "full")))
-    with tempfile.TemporaryDirectory(prefix="rtid-") as d:
-        path = os.fspath(out) if out is not None else os.path.join(d, "sweep.csv")
-        r = _rtid.sweep(_params_arg(params), options, path)
+    callback, close = _progress.reporter(progress, "sweep", "point")
+    try:
+        with tempfile.TemporaryDirectory(prefix="rtid-") as d:
+            path = os.fspath(out) if out is not None else os.path.join(d, "sweep.csv")
+            r = _rtid.sweep(_params_arg(params), options, path, callback)
+    finally:
+        close()
     return SweepResult(list(r["factors"]), r["design"], list(r["output_columns"]), r["outputs"],
                        r["index"], json.loads(r["indices_json"]))
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal, Union
 
@@ -148,6 +148,7 @@ def identify(
     objectives: Sequence[str] | None = None,
     profile: bool | str | Sequence[str] | None = None,
     resample: int | None = None,
+    progress: bool | Callable[..., object] | None = None,
 ) -> IdentifyResult: ...
 
 @dataclass
@@ -176,6 +177,7 @@ def sweep(
     seed: int = 0,
     tests: Literal["short", "full"] = "short",
     out: _Path | None = None,
+    progress: bool | Callable[..., object] | None = None,
 ) -> SweepResult: ...
 
 @dataclass

@@ -38,14 +38,18 @@ pub struct Options {
 }
 
 /// Identifies the parameters of `options.fit` from the experiment manifests
-/// `experiments` (path, name to report it by); returns the result file's JSON and the
-/// identified parameter set.
+/// `experiments` (path, name to report it by); returns the result file's JSON, the
+/// identified parameter set and the curves. `progress(done, budget, evaluations)`,
+/// if given, is called as the searches' iterations advance (an exception from it
+/// stops the search and is raised).
 #[pyfunction]
+#[pyo3(signature = (experiments, params, options, progress=None))]
 pub fn identify<'py>(
     py: Python<'py>,
     experiments: Vec<(PathBuf, String)>,
     params: PyRef<'_, PyParams>,
     options: Options,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<(String, PyParams, pyo3::Bound<'py, PyList>)> {
     let base = params.inner.clone();
     drop(params);
@@ -57,6 +61,8 @@ pub fn identify<'py>(
         ));
     }
     let monitor = Monitor::default();
+    let mut failed = None;
+    let mut shown = None;
     let outcome = std::thread::scope(|s| {
         let search = s.spawn(|| {
             let fit = rtid::identify(&config, &monitor).map_err(|e| rtid_error(&e))?;
@@ -68,15 +74,35 @@ pub fn identify<'py>(
             );
             Ok::<_, PyErr>((fit, curves))
         });
-        while !search.is_finished() {
-            py.detach(|| std::thread::sleep(Duration::from_millis(20)));
-            if py.check_signals().is_err() {
-                // Ctrl-C (KeyboardInterrupt): end the search, keep its best point.
-                monitor.stop();
+        loop {
+            let finished = search.is_finished();
+            if !finished {
+                py.detach(|| std::thread::sleep(Duration::from_millis(20)));
+                if py.check_signals().is_err() {
+                    // Ctrl-C (KeyboardInterrupt): end the search, keep its best point.
+                    monitor.stop();
+                }
+            }
+            // Once more when finished: a bar ends at the end.
+            if let (Some(callback), None) = (&progress, &failed) {
+                let now = monitor.progress().iterations();
+                if shown != Some(now) {
+                    shown = Some(now);
+                    if let Err(e) = callback.call1(py, (now.0, now.1, monitor.evaluations())) {
+                        monitor.stop();
+                        failed = Some(e);
+                    }
+                }
+            }
+            if finished {
+                break;
             }
         }
         search.join()
     });
+    if let Some(e) = failed {
+        return Err(e);
+    }
     let (Identified { result, params, .. }, curves) = match outcome {
         Ok(r) => r?,
         Err(_) => return Err(bad_argument("identify", "the search panicked")),

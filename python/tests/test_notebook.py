@@ -133,3 +133,25 @@ def test_without_pandas_the_tables_say_what_is_missing(worm_fit, monkeypatch):
     monkeypatch.setattr(builtins, "__import__", no_pandas)
     with pytest.raises(ImportError, match="to_pandas.*needs pandas.*pip install pandas"):
         worm_fit.to_pandas()
+
+
+def test_progress_reaches_a_function_and_a_tqdm_bar(root):
+    calls = []
+    worm = root / WORM
+    fit = rtid.identify(worm, rtid.params("worm-gear"), fit="Kw,Kg", model="linear",
+                        progress=lambda *counts: calls.append(counts))
+    assert fit.success and calls and all(len(c) == 3 for c in calls)
+    done, budget, evaluations = calls[-1]
+    assert 0 <= done <= budget and evaluations >= 0
+    rows = []
+    s = rtid.sweep(rtid.params("worm-gear"), "Kw=1e5..1e6:log:5", "resonances", progress=lambda *c: rows.append(c))
+    assert all(total == len(s.index) and 0 <= n <= total for n, total in rows)
+
+    def refuse(*counts):
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        rtid.identify(worm, rtid.params("worm-gear"), fit="Kw,Kg", model="linear", progress=refuse)
+    pytest.importorskip("tqdm")
+    assert rtid.identify(worm, rtid.params("worm-gear"), fit="Kw,Kg", model="linear",
+                         progress=True).values == fit.values
