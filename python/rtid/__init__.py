@@ -108,9 +108,10 @@ class Params(Mapping):
         return self.copy()
 
     def __eq__(self, other) -> bool:
+        # Two sets: the whole parameter file (name, notes, controller); else as a dict.
         if isinstance(other, Params):
             return self.to_json() == other.to_json()
-        return NotImplemented
+        return Mapping.__eq__(self, other)
 
     __hash__ = None
 

@@ -48,7 +48,15 @@ pub fn run_experiment(
             let test = fluctuation_test(&s, &p, kind == "unbalance")?;
             let (noise_arcsec, seed) = (s.get("noise_arcsec")?, s.get("seed")?);
             let (m, d) = py.detach(|| turning(&p, &test, noise_arcsec, seed))?;
-            (if kind == "unbalance" { "unbalance" } else { "fluctuation" }, m, d)
+            (
+                if kind == "unbalance" {
+                    "unbalance"
+                } else {
+                    "fluctuation"
+                },
+                m,
+                d,
+            )
         }
         other => {
             return Err(bad_argument(
@@ -76,7 +84,12 @@ impl Settings<'_, '_> {
 }
 
 /// Where the experiment file is written, as `Common::write_and_report` writes it.
-fn write(out: &std::path::Path, stem: &str, mut manifest: Manifest, data: &Data) -> PyResult<PathBuf> {
+fn write(
+    out: &std::path::Path,
+    stem: &str,
+    mut manifest: Manifest,
+    data: &Data,
+) -> PyResult<PathBuf> {
     let path = out.join(format!("{stem}.json"));
     manifest.data = Some(format!("{stem}.csv"));
     rtid::write_experiment(&path, &manifest, data).map_err(|e| rtid_error(&e))?;
@@ -112,16 +125,17 @@ struct FrOptions {
 
 impl FrOptions {
     fn of(s: &Settings) -> PyResult<FrOptions> {
-        let response = match s.get::<String>("response")?.replace('-', "_").as_str() {
-            "table_over_motor" => Response::TableOverMotor,
-            "motor_compliance" => Response::MotorCompliance,
-            other => {
-                return Err(bad_argument(
+        let response =
+            match s.get::<String>("response")?.replace('-', "_").as_str() {
+                "table_over_motor" => Response::TableOverMotor,
+                "motor_compliance" => Response::MotorCompliance,
+                other => return Err(bad_argument(
                     "response",
-                    format!("unknown response `{other}`: expected table_over_motor or motor_compliance"),
-                ))
-            }
-        };
+                    format!(
+                        "unknown response `{other}`: expected table_over_motor or motor_compliance"
+                    ),
+                )),
+            };
         let linear: bool = s.get("linear")?;
         if response == Response::MotorCompliance && !linear {
             return Err(bad_argument(
@@ -143,7 +157,10 @@ impl FrOptions {
 fn frequency_test(s: &Settings) -> PyResult<FrequencyTest> {
     let (from, to, step): (f64, f64, f64) = (s.get("from_hz")?, s.get("to_hz")?, s.get("step_hz")?);
     if to < from {
-        return Err(bad_argument("to_hz", format!("{to} is below from_hz {from}")));
+        return Err(bad_argument(
+            "to_hz",
+            format!("{to} is below from_hz {from}"),
+        ));
     }
     let shortest = 1.0 / FrequencyTest::default().max_duration_s;
     if from < shortest {
@@ -154,10 +171,15 @@ fn frequency_test(s: &Settings) -> PyResult<FrequencyTest> {
     }
     let count = ((to - from) / step + 1e-9).floor();
     if count + 1.0 > 1e5 {
-        return Err(bad_argument("step_hz", format!("{} frequencies, above the limit of 1e5", count + 1.0)));
+        return Err(bad_argument(
+            "step_hz",
+            format!("{} frequencies, above the limit of 1e5", count + 1.0),
+        ));
     }
     Ok(FrequencyTest {
-        frequencies_hz: (0..=count as usize).map(|i| from + step * i as f64).collect(),
+        frequencies_hz: (0..=count as usize)
+            .map(|i| from + step * i as f64)
+            .collect(),
         amplitude_nm: s.get("amplitude_nm")?,
         preload_nm: s.get("preload_nm")?,
         refine_step_hz: s.get("refine_step_hz")?,
@@ -166,7 +188,11 @@ fn frequency_test(s: &Settings) -> PyResult<FrequencyTest> {
 }
 
 /// `rtid experiment frequency-response`'s run: the points, the noise, the delay.
-fn frequency_response(p: &Params, test: &FrequencyTest, a: &FrOptions) -> PyResult<(Manifest, Data)> {
+fn frequency_response(
+    p: &Params,
+    test: &FrequencyTest,
+    a: &FrOptions,
+) -> PyResult<(Manifest, Data)> {
     let points = if a.linear {
         fr::linear_points(p, test, a.response).map_err(|e| rtid_error(&e))?
     } else {
@@ -174,7 +200,12 @@ fn frequency_response(p: &Params, test: &FrequencyTest, a: &FrOptions) -> PyResu
     };
     let mut data = fr::to_data(p, &points, a.response).map_err(|e| rtid_error(&e))?;
     let mut manifest = fr::manifest(p, test, a.linear, a.response);
-    if let Data::FrequencyResponse { gain_db, phase_rad: Some(phase), .. } = &mut data {
+    if let Data::FrequencyResponse {
+        gain_db,
+        phase_rad: Some(phase),
+        ..
+    } = &mut data
+    {
         let mut notes = manifest.notes.take().unwrap_or_default();
         if a.noise_percent > 0.0 {
             noise::perturb_gain_db(gain_db, a.noise_percent, a.seed);
@@ -194,7 +225,12 @@ fn frequency_response(p: &Params, test: &FrequencyTest, a: &FrOptions) -> PyResu
         manifest.notes = Some(notes);
     }
     if a.unstated_delay_s > 0.0 {
-        if let Data::FrequencyResponse { phase_rad: Some(phase), frequency_hz, .. } = &mut data {
+        if let Data::FrequencyResponse {
+            phase_rad: Some(phase),
+            frequency_hz,
+            ..
+        } = &mut data
+        {
             for (ph, f) in phase.iter_mut().zip(frequency_hz.iter()) {
                 *ph = rtid::objectives::complex_response::wrap(
                     *ph - std::f64::consts::TAU * f * a.unstated_delay_s,
@@ -213,10 +249,16 @@ fn torque_test(s: &Settings, axis: Axis) -> PyResult<TorqueTest> {
         (Axis::Rotary, deg, None) => deg.unwrap_or(30.0).to_radians(),
         (Axis::Linear, None, mm) => mm.unwrap_or(50.0) * 1e-3,
         (Axis::Rotary, _, Some(_)) => {
-            return Err(bad_argument("amplitude_mm", "for a linear axis; this axis is rotary (amplitude_deg)"))
+            return Err(bad_argument(
+                "amplitude_mm",
+                "for a linear axis; this axis is rotary (amplitude_deg)",
+            ))
         }
         (Axis::Linear, Some(_), _) => {
-            return Err(bad_argument("amplitude_deg", "for a rotary axis; this axis is linear (amplitude_mm)"))
+            return Err(bad_argument(
+                "amplitude_deg",
+                "for a rotary axis; this axis is linear (amplitude_mm)",
+            ))
         }
     };
     Ok(TorqueTest {
@@ -229,7 +271,12 @@ fn torque_test(s: &Settings, axis: Axis) -> PyResult<TorqueTest> {
 }
 
 /// `rtid experiment torque-curve`'s run.
-fn torque(p: &Params, test: &TorqueTest, noise_percent: f64, seed: u64) -> PyResult<(Manifest, Data)> {
+fn torque(
+    p: &Params,
+    test: &TorqueTest,
+    noise_percent: f64,
+    seed: u64,
+) -> PyResult<(Manifest, Data)> {
     let mut curve = torque_curve::run(p, test, |_, _| {}).map_err(|e| rtid_error(&e))?;
     noise::perturb_by_rms(&mut curve.motor_torque, noise_percent, seed);
     let mut manifest = torque_curve::manifest(p, test);
@@ -264,22 +311,36 @@ fn fluctuation_test(s: &Settings, p: &Params, unbalance: bool) -> PyResult<Fluct
         let (mass, radius): (Option<f64>, Option<f64>) = (s.get("mass_kg")?, s.get("radius_m")?);
         let own = p.unbalance_mass > 0.0 && p.unbalance_radius > 0.0;
         test.unbalance = Some(if own {
-            (mass.unwrap_or(p.unbalance_mass), radius.unwrap_or(p.unbalance_radius))
+            (
+                mass.unwrap_or(p.unbalance_mass),
+                radius.unwrap_or(p.unbalance_radius),
+            )
         } else {
-            (mass.unwrap_or(DEFAULT_UNBALANCE.0), radius.unwrap_or(DEFAULT_UNBALANCE.1))
+            (
+                mass.unwrap_or(DEFAULT_UNBALANCE.0),
+                radius.unwrap_or(DEFAULT_UNBALANCE.1),
+            )
         });
     }
     if test.duration() > 3600.0 {
         return Err(bad_argument(
             "speed_deg_per_min",
-            format!("{:.0} simulated seconds, above the limit of 3600", test.duration()),
+            format!(
+                "{:.0} simulated seconds, above the limit of 3600",
+                test.duration()
+            ),
         ));
     }
     Ok(test)
 }
 
 /// `rtid experiment fluctuation` and `unbalance`'s run.
-fn turning(p: &Params, test: &FluctuationTest, noise_arcsec: f64, seed: u64) -> PyResult<(Manifest, Data)> {
+fn turning(
+    p: &Params,
+    test: &FluctuationTest,
+    noise_arcsec: f64,
+    seed: u64,
+) -> PyResult<(Manifest, Data)> {
     let mut record = fluctuation::run(p, test, |_, _| {}).map_err(|e| rtid_error(&e))?;
     noise::perturb_absolute(&mut record.table_angle, noise_arcsec / ARCSEC_PER_RAD, seed);
     let mut manifest = fluctuation::manifest(p, test);

@@ -115,7 +115,10 @@ pub fn identify<'py>(
 /// The parameters the search started from: the base set with the recorded start
 /// values (a direct estimate may have replaced the base's), as the command line
 /// takes them for its comparisons.
-fn start_params(base: &rtid::Params, result: &rtid::identify::result::IdentifyResult) -> rtid::Params {
+fn start_params(
+    base: &rtid::Params,
+    result: &rtid::identify::result::IdentifyResult,
+) -> rtid::Params {
     let mut p = base.clone();
     for (name, &v) in &result.initial {
         // A name the result holds is one of the set's: set() cannot refuse it.

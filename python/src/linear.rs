@@ -97,7 +97,9 @@ pub fn frequency_response<'py>(
         if input != "motor_torque" {
             return Err(bad_argument(
                 "output",
-                format!("{output} is a response to the motor's torque: give input=\"motor_torque\""),
+                format!(
+                    "{output} is a response to the motor's torque: give input=\"motor_torque\""
+                ),
             ));
         }
         let r = LinearResponse::new(&params.inner, channel).map_err(|e| rtid_error(&e))?;
