@@ -822,6 +822,5 @@ def frequency_response(params: Params, freqs_hz, *, input: str = "motor_torque",
         raise TypeError(f"input: expected a name (motor_torque, table_torque), got {type(input).__name__}")
     if not isinstance(output, str):
         raise TypeError(f"output: expected a name (table_over_motor, …), got {type(output).__name__}")
-    re_, im = _rtid.frequency_response(_params_arg(params), f, input, output)
-    h = re_ + 1j * im
+    h = _rtid.frequency_response(_params_arg(params), f, input, output)
     return h[0] if scalar else h

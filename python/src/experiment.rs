@@ -125,17 +125,18 @@ struct FrOptions {
 
 impl FrOptions {
     fn of(s: &Settings) -> PyResult<FrOptions> {
-        let response =
-            match s.get::<String>("response")?.replace('-', "_").as_str() {
-                "table_over_motor" => Response::TableOverMotor,
-                "motor_compliance" => Response::MotorCompliance,
-                other => return Err(bad_argument(
+        let response = match s.get::<String>("response")?.replace('-', "_").as_str() {
+            "table_over_motor" => Response::TableOverMotor,
+            "motor_compliance" => Response::MotorCompliance,
+            other => {
+                return Err(bad_argument(
                     "response",
                     format!(
                         "unknown response `{other}`: expected table_over_motor or motor_compliance"
                     ),
-                )),
-            };
+                ))
+            }
+        };
         let linear: bool = s.get("linear")?;
         if response == Response::MotorCompliance && !linear {
             return Err(bad_argument(

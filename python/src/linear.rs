@@ -89,7 +89,7 @@ pub fn frequency_response<'py>(
     freqs_hz: PyReadonlyArray1<'py, f64>,
     input: &str,
     output: &str,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+) -> PyResult<Bound<'py, PyArray1<Complex<f64>>>> {
     let freqs = freqs_hz.as_slice()?;
     let model = model_of(&params)?;
     let i = input_dof(&model, input)?;
@@ -123,9 +123,7 @@ pub fn frequency_response<'py>(
             coordinate(&model, i, k, freqs)
         }
     };
-    let re = h.iter().map(|c| c.re).collect();
-    let im = h.iter().map(|c| c.im).collect();
-    Ok((PyArray1::from_vec(py, re), PyArray1::from_vec(py, im)))
+    Ok(PyArray1::from_vec(py, h))
 }
 
 /// State `k` of [q, q'] over a unit force on coordinate `i`, by the library's
