@@ -94,7 +94,7 @@ class Params(Mapping):
         return self._inner[name]
 
     def __setitem__(self, name: str, value) -> None:
-        _check_parameter_name(name, "name")
+        _check_parameter_name(name, name)
         self._inner[name] = _finite_number(value, name)
 
     def __reduce__(self):
@@ -295,7 +295,7 @@ def simulate(
 # --- files labs export --------------------------------------------------------------
 
 
-@dataclass
+@dataclass(repr=False)
 class Channel:
     """One channel of a recording: samples (float64, or complex128 for a complex
     channel), the unit as the file spells it, and the abscissa when the file gives
@@ -307,14 +307,22 @@ class Channel:
     abscissa: np.ndarray | None = None
     abscissa_unit: str = ""
 
+    def __repr__(self) -> str:
+        unit = f", {self.unit}" if self.unit else ""
+        return f"<rtid.Channel {self.name!r}{unit}: {self.samples.size} samples of {self.samples.dtype}>"
 
-@dataclass
+
+@dataclass(repr=False)
 class Recording:
     """What a reader found in one file: its format, channels by name, notes."""
 
     format: str
     channels: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
+
+    def __repr__(self) -> str:
+        names = ", ".join(self.channels)
+        return f"<rtid.Recording {self.format}: {len(self.channels)} channels ({names})>"
 
 
 def _channel(c: dict) -> Channel:

@@ -20,6 +20,8 @@ from rtid import _experiments
      ["--period-s", 0.5, "--periods", 1, "--noise-percent", 1]),
     ("unbalance", dict(speed_deg_per_min=3600, noise_arcsec=1.0, loop="full_closed"),
      ["--speed-deg-per-min", 3600, "--noise-arcsec", 1, "--loop", "full_closed"]),
+    ("fluctuation", dict(speed_deg_per_min=7200, run_in_deg=5), ["--speed-deg-per-min", 7200,
+                                                                 "--run-in-deg", 5]),
 ])
 def test_run_experiment_is_the_cli_file(cli, tmp_path, kind, settings, flags):
     exp = rtid.run_experiment(kind, rtid.params("worm-gear"), **settings)

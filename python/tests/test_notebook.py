@@ -38,12 +38,16 @@ def test_params_pickle_and_copy_to_the_bit():
     assert p["Kw"] == 1.2345678901234567e6
 
 
-def test_results_pickle_and_deep_copy(worm_fit):
+def test_results_pickle_and_deep_copy(worm_fit, root):
     exp = linear_gain_experiment(3.1e5)
     s = rtid.sweep(rtid.params("worm-gear"), "Kw=1e5..1e6:log:3", "resonances")
     for obj in (exp, worm_fit, s, rtid.state_space(rtid.params("worm-gear"))):
         for twin in (pickle.loads(pickle.dumps(obj)), copy.deepcopy(obj)):
             assert type(twin) is type(obj) and repr(twin) == repr(obj)
+    recording = rtid.import_file(root / "fixtures/formats/matlab/DATA_EMPS.mat")
+    twin = pickle.loads(pickle.dumps(recording))
+    assert list(twin.channels) == list(recording.channels) and len(repr(twin)) < 200
+    assert np.array_equal(twin.channels["vir"].samples, recording.channels["vir"].samples)
     fit = pickle.loads(pickle.dumps(worm_fit))
     assert fit.values == worm_fit.values and fit.params == worm_fit.params
     assert np.array_equal(fit.covariance, worm_fit.covariance)
