@@ -50,7 +50,7 @@ def test_the_worked_example_runs(root, tmp_path, monkeypatch, capsys):
     assert round(fr_fit.values["Kw"]) == 310142 and round(fr_fit.values["Kg"], 2) == 849.76
     report = text.split("```text\n", 1)[1].split("```", 1)[0]
     assert fr_fit.report().strip() == report.strip()
-    assert "[192.2 252.7 1510.7]" in text and "[ 192.17" in printed
+    assert "[192.2, 252.7, 1510.7]" in text and "[192.2, 252.7, 1510.7]" in printed
     if "pd" in namespace:
         mu = namespace["indices"].query("statistic == 'mu_star' and output == 'resonance_3_hz'")
         assert mu.set_index("parameter").value.round(1).to_dict()["Kb"] == 419.1
