@@ -407,7 +407,7 @@ def _temporary_folder():
                 raise
             raise RtidError(_without_folder(text, folder)) from None
         finally:
-            for base in [b for b in _WRITTEN if b.startswith(folder)]:
+            for base in [b for b in list(_WRITTEN) if b.startswith(folder)]:
                 _WRITTEN.pop(base, None)
 
 
