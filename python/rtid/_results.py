@@ -115,7 +115,9 @@ class IdentifyResult:
         warnings: each ``{"code", "message"}`` rtid raised (what the data cannot tell).
         cost: the cost at the result (half the sum of the scaled residuals' squares).
         termination: how the search ended, ``{"code", "message", …}``.
-        success: whether it converged (and was not interrupted).
+        success: whether the search converged — the solver's test met (or its
+            target cost reached), or the nonlinear corrections settled — and was
+            not interrupted; an iteration limit is not a success.
         message: the termination's message.
         interrupted: whether Ctrl-C ended the search (the best point so far).
         curves: each experiment's data beside the model (:class:`Curve`).
@@ -155,7 +157,9 @@ class IdentifyResult:
         self.termination = dict(result.get("termination") or {})
         self.message = self.termination.get("message", "")
         code = self.termination.get("code")
-        converged = code == "converged" or (code == "corrections" and self.termination.get("converged"))
+        converged = (code == "converged"
+                     or (code == "corrections" and self.termination.get("converged"))
+                     or (code == "solver" and "target cost" in self.termination.get("reason", "").lower()))
         self.success = bool(converged) and not self.interrupted
         self.curves = _curves(comparisons or [])
         self.params = identified
