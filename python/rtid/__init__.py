@@ -13,16 +13,20 @@ it gives the command line's numbers. Units are SI throughout.
     (501,)
 
 Errors are :class:`RtidError`, a :class:`ValueError` carrying rtid's message (the
-file, line, column or parameter at fault); bad arguments (NaN, wrong length or dtype,
-an unknown parameter) raise it naming the argument.
+file, line, column or parameter at fault); bad values (NaN, a wrong length or dtype,
+an unknown or misspelt name: the closest known one is suggested) raise it naming the
+argument, and an argument of the wrong type (``duration_s="1"``) raises
+:class:`TypeError`.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import numbers
 import os
+import re
 import tempfile
 import warnings
 from collections.abc import Mapping
@@ -30,7 +34,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _rtid
+from . import _experiments, _names, _progress, _rtid
+from ._results import Curve, IdentifyResult, SweepResult
 from ._rtid import VERSION, RtidError
 
 __all__ = [
@@ -47,11 +52,16 @@ __all__ = [
     "Experiment",
     "experiment",
     "read_experiment",
+    "run_experiment",
     "evaluate",
     "IdentifyResult",
+    "Curve",
     "identify",
     "SweepResult",
     "sweep",
+    "frequency_response",
+    "StateSpace",
+    "state_space",
 ]
 
 
@@ -59,9 +69,10 @@ __all__ = [
 
 
 def _finite_number(value, argument: str) -> float:
-    """`value` as a float, or a ValueError naming `argument`."""
+    """`value` as a float: a TypeError naming `argument` if it is not a number, a
+    ValueError if it is not finite."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise RtidError(f"{argument}: {value!r} is not a number (SI units)")
+        raise TypeError(f"{argument}: {value!r} is not a number (SI units), but {type(value).__name__}")
     v = float(value)
     if not math.isfinite(v):
         raise RtidError(f"{argument}: {v} is not a finite number")
@@ -83,7 +94,26 @@ class Params(Mapping):
         return self._inner[name]
 
     def __setitem__(self, name: str, value) -> None:
+        _check_parameter_name(name, name)
         self._inner[name] = _finite_number(value, name)
+
+    def __reduce__(self):
+        # Pickled as its parameter file's JSON (every value to the bit, the notes).
+        return (_params_from_json, (self.to_json(),))
+
+    def __copy__(self) -> "Params":
+        return self.copy()
+
+    def __deepcopy__(self, memo) -> "Params":
+        return self.copy()
+
+    def __eq__(self, other) -> bool:
+        # Two sets: the whole parameter file (name, notes, controller); else as a dict.
+        if isinstance(other, Params):
+            return self.to_json() == other.to_json()
+        return Mapping.__eq__(self, other)
+
+    __hash__ = None
 
     def __iter__(self):
         return iter(self._inner.keys())
@@ -132,6 +162,21 @@ class Params(Mapping):
         return f"<rtid.Params {self.name!r}: {self.topology}, {self.axis}, {len(self)} parameters>"
 
 
+def _params_from_json(text: str) -> Params:
+    """The set a parameter file's JSON holds (how a :class:`Params` unpickles)."""
+    return Params(_rtid.params_from_json(text))
+
+
+def _check_parameter_name(name, argument: str, keywords=()) -> None:
+    """Refuses a name no drive has, naming the closest parameter (or keyword)."""
+    if not isinstance(name, str):
+        raise TypeError(f"{argument}: {name!r} is not a parameter name (a string)")
+    known = _rtid.param_names()
+    if name not in known:
+        raise _names.unknown(argument if not keywords else name, "parameter or keyword" if keywords
+                             else "parameter", name, list(keywords) + list(known))
+
+
 def params(preset: str | None = None, *, path=None, **overrides) -> Params:
     """The parameter set of a preset or a parameter file, with overrides.
 
@@ -142,8 +187,14 @@ def params(preset: str | None = None, *, path=None, **overrides) -> Params:
         **overrides: ``NAME=VALUE`` in SI units, like ``--set NAME=VALUE``.
 
     Raises:
-        RtidError: an unknown preset or parameter, a value outside its constraint.
+        RtidError: an unknown preset or parameter (a misspelt keyword too: ``pth=``
+            names ``path``), a value outside its constraint.
+        TypeError: a value that is not a number.
     """
+    if preset is not None and not isinstance(preset, str):
+        raise TypeError(f"preset: expected a preset's name, got {type(preset).__name__}")
+    for name in overrides:
+        _check_parameter_name(name, name, keywords=("preset", "path"))
     pairs = [(name, _finite_number(v, name)) for name, v in overrides.items()]
     return Params(
         _rtid.load_params(preset, None if path is None else os.fspath(path), pairs)
@@ -157,7 +208,7 @@ def preset_names() -> list:
 
 def _params_arg(p) -> object:
     if not isinstance(p, Params):
-        raise RtidError(f"params: expected an rtid.Params (rtid.params(...)), got {type(p).__name__}")
+        raise TypeError(f"params: expected an rtid.Params (rtid.params(...)), got {type(p).__name__}")
     return p._inner
 
 
@@ -220,7 +271,7 @@ def simulate(
     Returns:
         A dict of float64 arrays named as the CLI's CSV columns: ``time_s``,
         ``motor_torque_nm``, the states (``motor_angle_rad``, …,
-        ``table_angle_rad``, ``table_velocity_rad_s``, …) and for a ``move:``
+        ``table_angle_rad``, ``table_velocity_rad_per_s``, …) and for a ``move:``
         ``reference_rad``. The kernel runs with the GIL released.
     """
     duration_s = _finite_number(duration_s, "duration_s")
@@ -244,7 +295,7 @@ def simulate(
 # --- files labs export --------------------------------------------------------------
 
 
-@dataclass
+@dataclass(repr=False)
 class Channel:
     """One channel of a recording: samples (float64, or complex128 for a complex
     channel), the unit as the file spells it, and the abscissa when the file gives
@@ -256,14 +307,22 @@ class Channel:
     abscissa: np.ndarray | None = None
     abscissa_unit: str = ""
 
+    def __repr__(self) -> str:
+        unit = f", {self.unit}" if self.unit else ""
+        return f"<rtid.Channel {self.name!r}{unit}: {self.samples.size} samples of {self.samples.dtype}>"
 
-@dataclass
+
+@dataclass(repr=False)
 class Recording:
     """What a reader found in one file: its format, channels by name, notes."""
 
     format: str
     channels: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
+
+    def __repr__(self) -> str:
+        names = ", ".join(self.channels)
+        return f"<rtid.Recording {self.format}: {len(self.channels)} channels ({names})>"
 
 
 def _channel(c: dict) -> Channel:
@@ -317,6 +376,7 @@ class Experiment:
         if self.path is not None:
             return self.path
         base = os.path.join(folder, f"experiment-{id(self)}")
+        _WRITTEN[base] = self.name
         names = list(self.columns)
         table = np.column_stack([self.columns[n] for n in names])
         np.savetxt(base + ".csv", table, fmt="%.17g", delimiter=",", header=",".join(names), comments="")
@@ -327,6 +387,47 @@ class Experiment:
 
     def __repr__(self) -> str:
         return f"<rtid.Experiment {self.kind} {self.name!r}>"
+
+
+#: The names of the experiments written to temporary files, by file stem: an error
+#: of rtid's reader names the experiment, never the temporary file.
+_WRITTEN: dict = {}
+
+
+@contextlib.contextmanager
+def _temporary_folder():
+    """A temporary folder for experiments' files; rtid's errors that name a file in
+    it name the experiment (and the row of its columns, or its manifest) instead."""
+    with tempfile.TemporaryDirectory(prefix="rtid-") as folder:
+        try:
+            yield folder
+        except RtidError as e:
+            text = str(e)
+            if folder not in text:
+                raise
+            raise RtidError(_without_folder(text, folder)) from None
+        finally:
+            for base in [b for b in list(_WRITTEN) if b.startswith(folder)]:
+                _WRITTEN.pop(base, None)
+
+
+def _without_folder(text: str, folder: str) -> str:
+    """`text` with each path into `folder` replaced by what it holds."""
+    pattern = re.escape(folder) + r"[/\\]+(experiment-\d+)\.(json|csv)(?:, line (\d+))?(?:, column (\d+))?"
+
+    def named(m):
+        name = _WRITTEN.get(os.path.join(folder, m.group(1)), "the experiment")
+        if m.group(2) == "json":
+            return f"the manifest of experiment {name!r} (kind, conditions, mechanism, notes)"
+        if m.group(3):
+            # The CSV's first line names the columns: line k holds row k − 2.
+            return f"experiment {name!r}, row {int(m.group(3)) - 2} of the columns"
+        return f"the columns of experiment {name!r}"
+
+    text, rows = re.subn(pattern, named, text)
+    if rows:
+        text = re.sub(r"\(previous row (\d+)\)", lambda m: f"(previous: row {int(m.group(1)) - 2})", text)
+    return text.replace(folder, "a temporary folder")
 
 
 def experiment(kind: str, *, conditions: dict | None = None, mechanism: str | None = None,
@@ -350,9 +451,20 @@ def experiment(kind: str, *, conditions: dict | None = None, mechanism: str | No
             length (named), or what rtid's reader refuses (a missing column, …).
     """
     if not isinstance(kind, str):
-        raise RtidError(f"kind: expected a name such as 'servo_trace', got {kind!r}")
+        raise TypeError(f"kind: expected a name such as 'servo_trace', got {kind!r}")
+    if kind not in _names.COLUMNS and kind != "resonance":
+        raise _names.unknown("kind", "kind", kind, list(_names.COLUMNS) + ["resonance"])
+    if conditions is not None:
+        if not isinstance(conditions, Mapping):
+            raise TypeError(f"conditions: expected a dict, got {type(conditions).__name__}")
+        _names.check_conditions(conditions)
+        conditions = dict(conditions)
+    for argument, value in (("mechanism", mechanism), ("notes", notes), ("name", name)):
+        if value is not None and not isinstance(value, str):
+            raise TypeError(f"{argument}: expected a string, got {type(value).__name__}")
     if not columns:
         raise RtidError("columns: no data column given (e.g. time_s=..., force_n=...)")
+    _names.check_columns(kind, columns)
     arrays = {n: _real_array(v, n) for n, v in columns.items()}
     lengths = {n: a.size for n, a in arrays.items()}
     first = next(iter(arrays))
@@ -364,7 +476,7 @@ def experiment(kind: str, *, conditions: dict | None = None, mechanism: str | No
         if value is not None:
             manifest[key] = value
     exp = Experiment(manifest, arrays, None, name or kind)
-    with tempfile.TemporaryDirectory(prefix="rtid-") as d:
+    with _temporary_folder() as d:
         _rtid.read_experiment(exp._written(d))
     return exp
 
@@ -378,12 +490,57 @@ def read_experiment(path) -> Experiment:
     return Experiment(manifest, None, path, path)
 
 
+def run_experiment(kind: str, params: Params, **settings) -> Experiment:
+    """One of the paper's tests run on the model: the experiment ``rtid experiment
+    KIND`` writes (the same manifest and columns, every number to the bit).
+
+    Args:
+        kind: ``frequency_response``, ``torque_curve``, ``fluctuation`` or
+            ``unbalance`` (``frequency-response`` … as on the command line).
+        params: the drive (:func:`params`; an identified one: ``fit.params``).
+        **settings: the test's flags, ``-`` as ``_``, with the flags' defaults:
+
+            - frequency_response: ``amplitude_nm`` (5), ``preload_nm`` (0),
+              ``from_hz`` (10), ``to_hz`` (600), ``step_hz`` (10),
+              ``refine_step_hz`` (1; 0: no refinement), ``linear`` (False: a
+              nonlinear simulation per frequency, seconds; True: the linear model,
+              milliseconds), ``noise_percent``, ``complex_noise_percent`` (0),
+              ``seed`` (1), ``response`` (``table_over_motor``, or with
+              ``linear=True`` ``motor_compliance``), ``unstated_delay_s`` (0);
+            - torque_curve: ``loop`` (``full_closed``), ``amplitude_deg`` (30) or on
+              a linear axis ``amplitude_mm`` (50), ``period_s`` (3), ``periods`` (2),
+              ``noise_percent`` (0), ``seed`` (1);
+            - fluctuation and unbalance: ``loop`` (the set's), ``revolutions`` (1),
+              ``run_in_deg`` (10), ``sample_period_s`` (0.004), ``noise_arcsec`` (0),
+              ``seed`` (1), ``speed_deg_per_min`` (180; unbalance 360); unbalance
+              also ``mass_kg``, ``radius_m`` (the set's unbalance, else 10 kg at
+              0.1 m).
+
+    Returns:
+        An :class:`Experiment` holding the manifest and the columns as arrays, for
+        :func:`evaluate` and :func:`identify`. The test runs with the GIL released.
+
+    Raises:
+        RtidError: an unknown test or setting (with the closest known name), a bad
+            value (named); TypeError: a setting of the wrong type.
+    """
+    k = _experiments.kind_of(kind)
+    values = _experiments.settings_of(k, settings)
+    p = _params_arg(params)
+    with tempfile.TemporaryDirectory(prefix="rtid-") as d:
+        path = _rtid.run_experiment(k, p, values, d)
+        with open(path, encoding="utf-8") as f:
+            manifest = json.load(f)
+        columns = _experiments.read_columns(os.path.join(d, manifest.pop("data")))
+    return Experiment(manifest, columns, None, f"{k} of {params.name}")
+
+
 def _as_experiment(e, argument: str) -> Experiment:
     if isinstance(e, Experiment):
         return e
     if isinstance(e, (str, os.PathLike)):
         return read_experiment(e)
-    raise RtidError(f"{argument}: expected an rtid.Experiment or a manifest path, got {type(e).__name__}")
+    raise TypeError(f"{argument}: expected an rtid.Experiment or a manifest path, got {type(e).__name__}")
 
 
 def evaluate(experiment, params: Params | None = None) -> dict:
@@ -397,70 +554,11 @@ def evaluate(experiment, params: Params | None = None) -> dict:
     the command line for now.)"""
     exp = _as_experiment(experiment, "experiment")
     p = None if params is None else _params_arg(params)
-    with tempfile.TemporaryDirectory(prefix="rtid-") as d:
+    with _temporary_folder() as d:
         return json.loads(_rtid.evaluate(exp._written(d), exp.name, p))
 
 
 # --- identification ---------------------------------------------------------------
-
-
-class IdentifyResult:
-    """An identification's result.
-
-    Attributes:
-        values: identified value of each fitted parameter (SI).
-        initial: where the search started.
-        standard_errors: each fitted parameter's standard error (SI), where the
-            Jacobian gives one.
-        names: the order of ``correlation``'s rows.
-        correlation: the fitted parameters' correlation matrix (float64 array).
-        intervals: ``(low, high)`` of each at 95 %: the profile's where ``profile``
-            was asked (an end the data do not bound is ``None``), else the
-            bootstrap's where ``resample`` was, else ± 1.96 standard errors.
-        interval_method: ``"profile"``, ``"bootstrap"`` or ``"standard errors"``.
-        profiles: the profiles as the result file holds them (``None`` if not asked).
-        resampling: the bootstrap as the result file holds it (``None`` if not asked).
-        warnings: each ``{"code", "message"}`` rtid raised (what the data cannot tell).
-        interrupted: whether Ctrl-C ended the search (the best point so far).
-        params: the complete identified parameter set.
-    """
-
-    def __init__(self, result: dict, identified: Params):
-        self._result = result
-        self.values = dict(result["parameters"])
-        self.initial = dict(result.get("initial", {}))
-        u = result.get("uncertainty") or {}
-        self.standard_errors = dict((n, v) for n, v in u.get("standard_errors", []) if v is not None)
-        self.names = list(u.get("names", []))
-        self.correlation = np.array(u.get("correlation", []), dtype=np.float64).reshape(len(self.names), len(self.names))
-        self.profiles = result.get("profiles")
-        self.resampling = result.get("resampling")
-        if self.profiles:
-            self.interval_method = "profile"
-            self.intervals = {n: (p.get("lower"), p.get("upper")) for n, p in self.profiles.items()}
-        elif self.resampling and self.resampling.get("intervals"):
-            self.interval_method = "bootstrap"
-            self.intervals = {n: (i["lower"], i["upper"])
-                              for n, i in self.resampling["intervals"].items()}
-        else:
-            self.interval_method = "standard errors"
-            self.intervals = {
-                n: (self.values[n] - 1.96 * se, self.values[n] + 1.96 * se)
-                for n, se in self.standard_errors.items()
-            }
-        self.warnings = list(result.get("warnings", []))
-        self.interrupted = bool(result.get("interrupted", False))
-        self.cost = result.get("cost")
-        self.params = identified
-
-    def to_dict(self) -> dict:
-        """The result file's content (``rtid identify --out``'s JSON, without the
-        provenance and the comparisons the command line adds)."""
-        return json.loads(json.dumps(self._result))
-
-    def __repr__(self) -> str:
-        body = ", ".join(f"{n}={v:.6g}" for n, v in self.values.items())
-        return f"<rtid.IdentifyResult {body}{' (interrupted)' if self.interrupted else ''}>"
 
 
 def _profile_names(profile):
@@ -477,32 +575,93 @@ def _profile_names(profile):
     return names
 
 
-def _count(n, name: str) -> int:
-    """A positive whole number argument, or a ValueError naming it."""
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise RtidError(f"{name}: {n!r} is not a positive whole number")
+def _whole(n, name: str, least: int = 1) -> int:
+    """A whole number argument of at least `least`: a TypeError naming it if it is
+    not a whole number, a ValueError if it is too small."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
+        raise TypeError(f"{name}: {n!r} is not a whole number, but {type(n).__name__}")
+    if n < least:
+        raise RtidError(f"{name}: {n!r}: must be at least {least}")
     return int(n)
+
+
+def _choice(value, name: str, choices) -> str:
+    """A string argument among `choices`, named in the error with the closest."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name}: expected a string ({', '.join(choices)}), got {type(value).__name__}")
+    if value not in choices:
+        raise _names.unknown(name, name, value, choices)
+    return value
+
+
+def _names_list(value, name: str, allow_empty: bool = False) -> list:
+    """A list of names (a comma-separated string or an iterable of strings)."""
+    if isinstance(value, str):
+        value = [n.strip() for n in value.split(",")]
+    elif isinstance(value, (Mapping, numbers.Number)) or not hasattr(value, "__iter__"):
+        raise TypeError(f"{name}: expected a list of names, got {type(value).__name__}")
+    names = list(value)
+    for n in names:
+        if not isinstance(n, str):
+            raise TypeError(f"{name}: {n!r} is not a name (a string)")
+    if not names and not allow_empty:
+        raise RtidError(f"{name}: an empty list: name at least one, or leave {name} out (None)")
+    return names
 
 
 def identify(experiments, params: Params, fit=None, *, bounds: dict | None = None,
              method: str | None = None, model: str = "auto", starts: int | None = None,
              seed: int = 1, max_iters: int = 50, start: str = "estimate",
              weights=None, objectives=None, profile=None,
-             resample: int | None = None) -> IdentifyResult:
+             resample: int | None = None, progress=None) -> IdentifyResult:
     """Identifies parameters from experiments (``rtid identify``).
 
     Args:
         experiments: an :class:`Experiment` or manifest path, or a list of them.
         params: the parameter set the others stay at (:func:`params`).
-        fit: names of the parameters to fit (default: what the experiments determine).
+        fit: names of the parameters to fit, a list or ``"Kw,Kg"`` (default, None:
+            what the experiments determine; an empty list is refused).
         bounds: ``{"Kw": (1e5, 1e7)}``, SI (``--bound``).
         method: ``lsq``, ``lm``, ``nelder-mead`` or ``pso`` (``--method``).
         model: ``auto``, ``linear`` or ``nonlinear`` (``--model``).
-        starts, seed, max_iters, start, weights, objectives: as the flags of the
-            same names.
+        starts: the number of starts of the local search (a Latin hypercube about
+            the start values; default 4, 1 when a torque curve or an unbalance test
+            is fitted: each of its evaluations is seconds of simulation).
+        seed: the seed of the Latin hypercube and of the particle swarm.
+        max_iters: the iteration limit of each local search.
+        start: ``"estimate"`` — at an experiment's direct estimate where it offers
+            one (a servo trace's IDIM-LS for Jt, Ct, ft, Tload), else at ``params``'
+            values; ``"given"`` — at ``params``' values always.
+        weights: each experiment's weight in the joint cost, in order (default 1
+            each; relative, within 1e-6..1e6).
+        objectives: the objectives to use (default: by each experiment's kind);
+            each experiment feeds those of them it can read: ``resonance`` (relative
+            error of the resonance frequencies), ``peak_amplitude`` (dB error of the
+            peaks' heights), ``gain_curve`` (dB error of the gain at every measured
+            frequency, and of the phase where the file has one), ``gain_near_peaks``
+            (the same within ±3 % of each resonance), ``torque_curve`` (the motor
+            torque of the closed-loop torque test, sample by sample),
+            ``unbalance_step`` (the table angles where an unbalance test's deviation
+            steps across the backlash), ``servo_trace`` (the trace replayed through
+            the servo: force and position), ``friction_map`` (the steady motor torque
+            at each run's speed).
         profile: names to profile (``True``: every fitted parameter), for intervals
             that hold where the cost is not a bowl (``--profile``).
         resample: bootstrap replicates of the residuals' blocks (``--resample``).
+        progress: a progress bar of the searches' iterations: None (default) shows
+            a tqdm bar where tqdm is installed and the output is watched (a notebook,
+            a terminal), True always (tqdm required), False never; or a function
+            called as ``progress(done, budget, evaluations)``.
+
+    Returns:
+        An :class:`IdentifyResult`: ``values``, ``standard_errors``, ``covariance``,
+        ``intervals``, ``report()``, ``to_pandas()``, ``curves`` (each experiment's
+        data beside the model), ``params``.
+
+    Raises:
+        RtidError: a bad value (an unknown parameter or option, with the closest
+            known name), or what rtid refuses of the experiments.
+        TypeError: an argument of the wrong type.
 
     Ctrl-C (KeyboardInterrupt, a notebook's interrupt) ends the search: the best point
     so far is returned, ``interrupted`` set and a warning issued. The search runs with
@@ -510,28 +669,43 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
     """
     if isinstance(experiments, (Experiment, str, os.PathLike)):
         experiments = [experiments]
-    exps = [_as_experiment(e, f"experiments[{i}]") for i, e in enumerate(experiments)]
-    if isinstance(fit, str):
-        fit = [n for n in fit.split(",")]
+    elif not isinstance(experiments, (list, tuple)):
+        raise TypeError(f"experiments: expected an rtid.Experiment, a manifest path or a list of them, "
+                        f"got {type(experiments).__name__}")
+    fit = [] if fit is None else _names_list(fit, "fit")
+    for name in fit:
+        _check_parameter_name(name.strip(), "fit")
+    if bounds is not None and not isinstance(bounds, Mapping):
+        raise TypeError(f"bounds: expected a dict {{name: (low, high)}}, got {type(bounds).__name__}")
+    for name in bounds or {}:
+        _check_parameter_name(name, "bounds")
+    if method is not None:
+        _choice(method.replace("_", "-") if isinstance(method, str) else method, "method",
+                ("lsq", "lm", "nelder-mead", "pso"))
     options = {
-        "fit": list(fit or []),
+        "fit": fit,
         "bounds": [(n, _finite_number(lo, f"bounds[{n}]"), _finite_number(hi, f"bounds[{n}]"))
                    for n, (lo, hi) in (bounds or {}).items()],
         "method": method,
-        "fidelity": model,
-        "starts": starts,
-        "seed": seed,
-        "max_iters": max_iters,
-        "start": start,
+        "fidelity": _choice(model, "model", ("auto", "linear", "nonlinear")),
+        "starts": None if starts is None else _whole(starts, "starts"),
+        "seed": _whole(seed, "seed", 0),
+        "max_iters": _whole(max_iters, "max_iters"),
+        "start": _choice(start, "start", ("estimate", "given")),
         "weights": None if weights is None else [_finite_number(w, "weights") for w in weights],
-        "objectives": None if objectives is None else list(objectives),
+        "objectives": None if objectives is None else _names_list(objectives, "objectives"),
         "profile": _profile_names(profile),
-        "resample": None if resample is None else _count(resample, "resample"),
+        "resample": None if resample is None else _whole(resample, "resample"),
     }
-    with tempfile.TemporaryDirectory(prefix="rtid-") as d:
-        paths = [(e._written(d), e.name) for e in exps]
-        text, identified = _rtid.identify(paths, _params_arg(params), options)
-    result = IdentifyResult(json.loads(text), Params(identified))
+    exps = [_as_experiment(e, f"experiments[{i}]") for i, e in enumerate(experiments)]
+    callback, close = _progress.reporter(progress, "identify", "it")
+    try:
+        with _temporary_folder() as d:
+            paths = [(e._written(d), e.name) for e in exps]
+            text, identified, comparisons = _rtid.identify(paths, _params_arg(params), options, callback)
+    finally:
+        close()
+    result = IdentifyResult(json.loads(text), Params(identified), comparisons)
     if result.interrupted:
         warnings.warn("rtid.identify: interrupted; the result is the best point so far", RuntimeWarning, stacklevel=2)
     return result
@@ -540,36 +714,9 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
 # --- sweeps -----------------------------------------------------------------------
 
 
-@dataclass
-class SweepResult:
-    """A sweep's design and outputs, row i for design point ``index[i]``.
-
-    Attributes:
-        factors: the varied parameters (columns of ``design``).
-        design: parameter values, SI (points × factors).
-        output_columns: the names of ``outputs``' columns.
-        outputs: the outputs at each point (points × columns; NaN where a point
-            failed).
-        index: each row's design point.
-        indices: the sensitivity indices (local, Morris, Sobol; ``rows`` per factor
-            and output, ``columns`` naming their values) as ``rtid sweep`` writes them.
-    """
-
-    factors: list
-    design: np.ndarray
-    output_columns: list
-    outputs: np.ndarray
-    index: np.ndarray
-    indices: dict
-
-    def column(self, name: str) -> np.ndarray:
-        """The output column `name`."""
-        return self.outputs[:, self.output_columns.index(name)]
-
-
 def sweep(params: Params, vary, outputs, *, method: str = "grid", samples: int = 256,
           bootstrap: int = 500, trajectories: int = 20, levels: int = 4, step: float = 0.01,
-          seed: int = 0, tests: str = "short", out=None) -> SweepResult:
+          seed: int = 0, tests: str = "short", out=None, progress=None) -> SweepResult:
     """A sensitivity sweep (``rtid sweep``).
 
     Args:
@@ -581,14 +728,107 @@ def sweep(params: Params, vary, outputs, *, method: str = "grid", samples: int =
             ``bootstrap``, ``trajectories``, ``levels``, ``step``, ``seed``,
             ``tests`` as the flags of the same names.
         out: the sweep CSV to keep (default: a temporary file, removed).
+        progress: a progress bar of the design's points, as :func:`identify`'s (a
+            function is called as ``progress(done, total)``).
+
+    Returns:
+        A :class:`SweepResult`: ``design``, ``outputs``, ``indices``, and as pandas
+        tables ``to_pandas()`` and ``indices_to_pandas()``.
     """
-    vary = [vary] if isinstance(vary, str) else list(vary)
-    outputs = [outputs] if isinstance(outputs, str) else list(outputs)
-    options = dict(vary=vary, outputs=outputs, method=method, samples=samples, bootstrap=bootstrap,
-                   trajectories=trajectories, levels=levels, step=_finite_number(step, "step"),
-                   seed=seed, tests=tests)
-    with tempfile.TemporaryDirectory(prefix="rtid-") as d:
-        path = os.fspath(out) if out is not None else os.path.join(d, "sweep.csv")
-        r = _rtid.sweep(_params_arg(params), options, path)
+    vary = [vary] if isinstance(vary, str) else _names_list(vary, "vary", allow_empty=True)
+    outputs = [outputs] if isinstance(outputs, str) else _names_list(outputs, "outputs", allow_empty=True)
+    options = dict(vary=vary, outputs=outputs,
+                   method=_choice(method, "method", ("grid", "local", "morris", "sobol")),
+                   samples=_whole(samples, "samples"), bootstrap=_whole(bootstrap, "bootstrap", 0),
+                   trajectories=_whole(trajectories, "trajectories"), levels=_whole(levels, "levels"),
+                   step=_finite_number(step, "step"), seed=_whole(seed, "seed", 0),
+                   tests=_choice(tests, "tests", ("short", "full")))
+    callback, close = _progress.reporter(progress, "sweep", "point")
+    try:
+        with tempfile.TemporaryDirectory(prefix="rtid-") as d:
+            path = os.fspath(out) if out is not None else os.path.join(d, "sweep.csv")
+            r = _rtid.sweep(_params_arg(params), options, path, callback)
+    finally:
+        close()
     return SweepResult(list(r["factors"]), r["design"], list(r["output_columns"]), r["outputs"],
                        r["index"], json.loads(r["indices_json"]))
+
+
+# --- the linear model -------------------------------------------------------------
+
+
+@dataclass(repr=False)
+class StateSpace:
+    """A state-space model ẋ = A·x + B·u, y = C·x + D·u with its names: unpacks as
+    ``A, B, C, D = rtid.state_space(p)``.
+
+    Attributes:
+        A, B, C, D: the matrices (float64 arrays).
+        states, inputs, outputs: the names of x, u and y, in the matrices' order.
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    states: list
+    inputs: list
+    outputs: list
+
+    def __iter__(self):
+        return iter((self.A, self.B, self.C, self.D))
+
+    def __repr__(self) -> str:
+        return (f"<rtid.StateSpace {len(self.states)} states ({', '.join(self.states)}), "
+                f"inputs {', '.join(self.inputs)}>")
+
+
+def state_space(params: Params) -> StateSpace:
+    """The linearised drive as a state-space model (docs/model.md §2, §11: no
+    backlash, no Coulomb friction, no fluctuation, no controller).
+
+    ẋ = A·x + B·u, y = C·x + D·u, the state x = [q, q̇]: the coordinates q
+    (``theta_m``, ``theta_w``, ``x_w``, ``theta_t``: rad, ``x_w`` in m; those of the
+    drive's topology, as :func:`modes`' ``free_dofs``) and their rates
+    (``theta_m_dot``, …); the inputs u: ``motor_torque`` (N·m on the motor) and
+    ``table_torque`` (N·m on the table; N on a linear axis's carriage); the outputs
+    y: the states (C = I, D = 0).
+
+    Returns:
+        A :class:`StateSpace`: ``A, B, C, D = rtid.state_space(p)`` (float64
+        arrays; e.g. ``control.ss(A, B, C, D)``), with ``states``, ``inputs`` and
+        ``outputs`` naming their rows and columns.
+    """
+    m = _rtid.state_space(_params_arg(params))
+    return StateSpace(m["A"], m["B"], m["C"], m["D"], list(m["states"]), list(m["inputs"]),
+                      list(m["outputs"]))
+
+
+def frequency_response(params: Params, freqs_hz, *, input: str = "motor_torque",
+                       output: str = "table_over_motor") -> np.ndarray:
+    """The linearised drive's complex frequency response at `freqs_hz` (Hz).
+
+    Args:
+        params: the drive (:func:`params`).
+        freqs_hz: frequencies, Hz (a number or a 1-D array).
+        input: ``motor_torque`` or ``table_torque`` (:func:`state_space`'s inputs).
+        output: ``table_over_motor`` — the paper's ratio X_θt / (X_θm·Rg·Rw), the
+            gain of ``rtid experiment frequency-response --linear`` (1 at low
+            frequency, peaks at the motor-held modes); ``motor_compliance`` — the
+            motor angle over its torque, rad/(N·m); or a state of
+            :func:`state_space` (``theta_t``, ``theta_t_dot``, …) over the input.
+            The two ratios are responses to the motor's torque.
+
+    Returns:
+        A complex128 array like `freqs_hz` (a complex number for a number; NaN
+        where the solve fails). ``20·log10(abs(h))`` is the gain in dB,
+        ``np.angle(h)`` the phase.
+    """
+    scalar = isinstance(freqs_hz, numbers.Real) and not isinstance(freqs_hz, bool)
+    f = _real_array([freqs_hz] if scalar else freqs_hz, "freqs_hz")
+    if not isinstance(input, str):
+        raise TypeError(f"input: expected a name (motor_torque, table_torque), got {type(input).__name__}")
+    if not isinstance(output, str):
+        raise TypeError(f"output: expected a name (table_over_motor, …), got {type(output).__name__}")
+    h = _rtid.frequency_response(_params_arg(params), f, input, output)
+    return h[0] if scalar else h

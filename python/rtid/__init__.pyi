@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal, Union
 
@@ -33,6 +33,8 @@ class Params(Mapping[str, float]):
     def to_json(self) -> str: ...
     def save(self, path: _Path) -> None: ...
     def copy(self) -> Params: ...
+    def __copy__(self) -> Params: ...
+    def __deepcopy__(self, memo: Any) -> Params: ...
 
 def params(preset: str | None = None, *, path: _Path | None = None, **overrides: float) -> Params: ...
 def preset_names() -> list[str]: ...
@@ -82,14 +84,36 @@ def experiment(
     **columns: _Floats,
 ) -> Experiment: ...
 def read_experiment(path: _Path) -> Experiment: ...
+def run_experiment(
+    kind: Literal["frequency_response", "frequency-response", "torque_curve", "torque-curve",
+                  "fluctuation", "unbalance"],
+    params: Params,
+    **settings: Any,
+) -> Experiment: ...
 def evaluate(experiment: Experiment | _Path, params: Params | None = None) -> dict[str, Any]: ...
+
+@dataclass
+class Curve:
+    experiment: str
+    quantity: str
+    unit: str
+    abscissa_name: str
+    abscissa_unit: str
+    abscissa: npt.NDArray[np.float64]
+    measured: npt.NDArray[np.float64]
+    model: npt.NDArray[np.float64]
+    residual: npt.NDArray[np.float64] | None = None
+    model_start: npt.NDArray[np.float64] | None = None
+    model_abscissa: npt.NDArray[np.float64] | None = None
 
 class IdentifyResult:
     values: dict[str, float]
     initial: dict[str, float]
+    bounds: dict[str, tuple[float, float]]
     standard_errors: dict[str, float]
     names: list[str]
     correlation: npt.NDArray[np.float64]
+    covariance: npt.NDArray[np.float64]
     intervals: dict[str, tuple[float | None, float | None]]
     interval_method: Literal["profile", "bootstrap", "standard errors"]
     profiles: dict[str, dict[str, Any]] | None
@@ -97,8 +121,16 @@ class IdentifyResult:
     warnings: list[dict[str, str]]
     interrupted: bool
     cost: float | None
+    termination: dict[str, Any]
+    success: bool
+    message: str
+    curves: list[Curve]
     params: Params
     def to_dict(self) -> dict[str, Any]: ...
+    def correlations(self, threshold: float = 0.8) -> list[tuple[str, str, float]]: ...
+    def report(self, min_correl: float = 0.8) -> str: ...
+    def to_pandas(self) -> Any: ...
+    def _repr_html_(self) -> str: ...
 
 def identify(
     experiments: Experiment | _Path | Sequence[Experiment | _Path],
@@ -116,6 +148,7 @@ def identify(
     objectives: Sequence[str] | None = None,
     profile: bool | str | Sequence[str] | None = None,
     resample: int | None = None,
+    progress: bool | Callable[..., object] | None = None,
 ) -> IdentifyResult: ...
 
 @dataclass
@@ -127,6 +160,8 @@ class SweepResult:
     index: npt.NDArray[np.uint64]
     indices: dict[str, Any]
     def column(self, name: str) -> npt.NDArray[np.float64]: ...
+    def to_pandas(self) -> Any: ...
+    def indices_to_pandas(self) -> Any: ...
 
 def sweep(
     params: Params,
@@ -142,4 +177,25 @@ def sweep(
     seed: int = 0,
     tests: Literal["short", "full"] = "short",
     out: _Path | None = None,
+    progress: bool | Callable[..., object] | None = None,
 ) -> SweepResult: ...
+
+@dataclass
+class StateSpace:
+    A: npt.NDArray[np.float64]
+    B: npt.NDArray[np.float64]
+    C: npt.NDArray[np.float64]
+    D: npt.NDArray[np.float64]
+    states: list[str]
+    inputs: list[str]
+    outputs: list[str]
+    def __iter__(self) -> Iterator[npt.NDArray[np.float64]]: ...
+
+def state_space(params: Params) -> StateSpace: ...
+def frequency_response(
+    params: Params,
+    freqs_hz: float | _Floats,
+    *,
+    input: Literal["motor_torque", "table_torque"] = "motor_torque",
+    output: str = "table_over_motor",
+) -> complex | npt.NDArray[np.complex128]: ...

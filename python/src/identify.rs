@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use pyo3::prelude::*;
+use pyo3::types::PyList;
 
+use crate::curves;
 use crate::errors::{bad_argument, rtid_error, with_context};
 use crate::params::PyParams;
 use rtid::identify::{
@@ -36,15 +38,19 @@ pub struct Options {
 }
 
 /// Identifies the parameters of `options.fit` from the experiment manifests
-/// `experiments` (path, name to report it by); returns the result file's JSON and the
-/// identified parameter set.
+/// `experiments` (path, name to report it by); returns the result file's JSON, the
+/// identified parameter set and the curves. `progress(done, budget, evaluations)`,
+/// if given, is called as the searches' iterations advance (an exception from it
+/// stops the search and is raised).
 #[pyfunction]
-pub fn identify(
-    py: Python<'_>,
+#[pyo3(signature = (experiments, params, options, progress=None))]
+pub fn identify<'py>(
+    py: Python<'py>,
     experiments: Vec<(PathBuf, String)>,
     params: PyRef<'_, PyParams>,
     options: Options,
-) -> PyResult<(String, PyParams)> {
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(String, PyParams, pyo3::Bound<'py, PyList>)> {
     let base = params.inner.clone();
     drop(params);
     let config = config(&experiments, base, &options)?;
@@ -55,26 +61,70 @@ pub fn identify(
         ));
     }
     let monitor = Monitor::default();
+    let mut failed = None;
+    let mut shown = None;
     let outcome = std::thread::scope(|s| {
         let search = s.spawn(|| {
             let fit = rtid::identify(&config, &monitor).map_err(|e| rtid_error(&e))?;
-            with_intervals(fit, &options, &monitor)
+            let fit = with_intervals(fit, &options, &monitor)?;
+            let curves = curves::compute(
+                &config.experiments,
+                &start_params(&config.base, &fit.result),
+                &fit.params,
+            );
+            Ok::<_, PyErr>((fit, curves))
         });
-        while !search.is_finished() {
-            py.detach(|| std::thread::sleep(Duration::from_millis(20)));
-            if py.check_signals().is_err() {
-                // Ctrl-C (KeyboardInterrupt): end the search, keep its best point.
-                monitor.stop();
+        loop {
+            let finished = search.is_finished();
+            if !finished {
+                py.detach(|| std::thread::sleep(Duration::from_millis(20)));
+                if py.check_signals().is_err() {
+                    // Ctrl-C (KeyboardInterrupt): end the search, keep its best point.
+                    monitor.stop();
+                }
+            }
+            // Once more when finished: a bar ends at the end.
+            if let (Some(callback), None) = (&progress, &failed) {
+                let now = monitor.progress().iterations();
+                if shown != Some(now) {
+                    shown = Some(now);
+                    if let Err(e) = callback.call1(py, (now.0, now.1, monitor.evaluations())) {
+                        monitor.stop();
+                        failed = Some(e);
+                    }
+                }
+            }
+            if finished {
+                break;
             }
         }
         search.join()
     });
-    let Identified { result, params, .. } = match outcome {
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let (Identified { result, params, .. }, curves) = match outcome {
         Ok(r) => r?,
         Err(_) => return Err(bad_argument("identify", "the search panicked")),
     };
     let json = rtid::io::json::pretty(&result).map_err(|e| rtid_error(&e))?;
-    Ok((json, PyParams { inner: params }))
+    let curves = curves::to_python(py, curves)?;
+    Ok((json, PyParams { inner: params }, curves))
+}
+
+/// The parameters the search started from: the base set with the recorded start
+/// values (a direct estimate may have replaced the base's), as the command line
+/// takes them for its comparisons.
+fn start_params(
+    base: &rtid::Params,
+    result: &rtid::identify::result::IdentifyResult,
+) -> rtid::Params {
+    let mut p = base.clone();
+    for (name, &v) in &result.initial {
+        // A name the result holds is one of the set's: set() cannot refuse it.
+        let _ = p.set(name, v);
+    }
+    p
 }
 
 /// The fit with the intervals `options` ask for, as `rtid identify --profile` and

@@ -5,10 +5,13 @@
 //! that Python gets the CLI's numbers; the long ones (simulation, identification,
 //! sweep) run with the GIL released.
 
+mod curves;
 mod errors;
 mod evaluate;
+mod experiment;
 mod identify;
 mod import;
+mod linear;
 mod params;
 mod simulate;
 mod sweep;
@@ -23,6 +26,11 @@ fn _rtid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<params::PyParams>()?;
     m.add_function(wrap_pyfunction!(params::load_params, m)?)?;
     m.add_function(wrap_pyfunction!(params::preset_names, m)?)?;
+    m.add_function(wrap_pyfunction!(params::params_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(params::param_names, m)?)?;
+    m.add_function(wrap_pyfunction!(linear::state_space, m)?)?;
+    m.add_function(wrap_pyfunction!(linear::frequency_response, m)?)?;
+    m.add_function(wrap_pyfunction!(experiment::run_experiment, m)?)?;
     m.add_function(wrap_pyfunction!(params::modes, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(import::import_file, m)?)?;

@@ -130,6 +130,20 @@ pub fn load_params(
     Ok(PyParams { inner: p })
 }
 
+/// The set a parameter file's JSON holds (`Params.to_json`'s text: pickling).
+#[pyfunction]
+pub fn params_from_json(text: &str) -> PyResult<PyParams> {
+    let inner = params_file::parse(text, std::path::Path::new("<parameter JSON>"))
+        .map_err(|e| with_context("json", &e))?;
+    Ok(PyParams { inner })
+}
+
+/// Every parameter's registry name, of any drive (for suggestions of misspelt names).
+#[pyfunction]
+pub fn param_names() -> Vec<&'static str> {
+    PARAMS.iter().map(|s| s.name).collect()
+}
+
 /// The shipped presets' names.
 #[pyfunction]
 pub fn preset_names() -> Vec<&'static str> {

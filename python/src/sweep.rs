@@ -2,6 +2,8 @@
 //! complete file read back, the indices — with the design and outputs as arrays.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Duration;
 
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -28,29 +30,69 @@ pub struct Options {
     tests: String,
 }
 
-/// Runs the sweep into the CSV `out` and returns its arrays and indices.
+/// Runs the sweep into the CSV `out` and returns its arrays and indices, on a
+/// thread of its own while this one waits with the GIL released; `progress(done,
+/// total)`, if given, is called as rows are computed (an exception from it is raised
+/// once the sweep ends).
 #[pyfunction]
+#[pyo3(signature = (params, options, out, progress=None))]
 pub fn sweep<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
     options: Options,
     out: PathBuf,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let base = params.inner.clone();
     drop(params);
     let s = build(base, &options)?;
-    let (design, rows, indices) = py.detach(|| -> PyResult<_> {
-        let design = s.design().map_err(|e| rtid_error(&e))?;
-        let opts = RunOptions {
-            overwrite: true,
-            ..RunOptions::default()
-        };
-        sw::run(&s, &out, &opts).map_err(|e| rtid_error(&e))?;
-        let (_, rows) =
-            sw::load_complete(std::slice::from_ref(&out)).map_err(|e| rtid_error(&e))?;
-        let indices = sw::analysis::analyse(&s, &rows).map_err(|e| rtid_error(&e))?;
-        Ok((design, rows, indices))
-    })?;
+    let design = py.detach(|| s.design()).map_err(|e| rtid_error(&e))?;
+    let total = design.values.nrows();
+    let done = AtomicUsize::new(0);
+    let on_row = || {
+        done.fetch_add(1, Ordering::Relaxed);
+    };
+    let mut failed = None;
+    let mut shown = None;
+    let outcome = std::thread::scope(|scope| {
+        let run = scope.spawn(|| -> PyResult<_> {
+            let opts = RunOptions {
+                overwrite: true,
+                on_row: &on_row,
+                ..RunOptions::default()
+            };
+            sw::run(&s, &out, &opts).map_err(|e| rtid_error(&e))?;
+            let (_, rows) =
+                sw::load_complete(std::slice::from_ref(&out)).map_err(|e| rtid_error(&e))?;
+            let indices = sw::analysis::analyse(&s, &rows).map_err(|e| rtid_error(&e))?;
+            Ok((rows, indices))
+        });
+        loop {
+            let finished = run.is_finished();
+            if !finished {
+                py.detach(|| std::thread::sleep(Duration::from_millis(20)));
+            }
+            // Once more when finished: a bar ends at the end.
+            let now = done.load(Ordering::Relaxed);
+            if let (Some(callback), None) = (&progress, &failed) {
+                if shown != Some(now) {
+                    shown = Some(now);
+                    failed = callback.call1(py, (now, total)).err();
+                }
+            }
+            if finished {
+                break;
+            }
+        }
+        run.join()
+    });
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let (rows, indices) = match outcome {
+        Ok(r) => r?,
+        Err(_) => return Err(bad_argument("sweep", "the sweep panicked")),
+    };
     let y = sw::output_matrix(&s, &rows);
     let rows_of = |a: &rtid::sweep::Design| -> Vec<Vec<f64>> {
         a.values.rows().into_iter().map(|r| r.to_vec()).collect()

@@ -142,7 +142,6 @@ def test_profile_and_resample_give_the_cli_intervals(cli, root, tmp_path):
 
 @pytest.mark.parametrize("kwargs, argument", [
     ({"resample": 0}, "resample"),
-    ({"resample": 2.5}, "resample"),
     ({"profile": [""]}, "profile"),
 ])
 def test_bad_interval_options_name_themselves(root, kwargs, argument):

@@ -93,5 +93,5 @@ def test_bad_input_raises_value_error_naming_the_argument(kwargs, argument):
 
 
 def test_params_must_be_a_parameter_set():
-    with pytest.raises(ValueError, match="params"):
+    with pytest.raises(TypeError, match="params"):
         rtid.simulate({"Kw": 1.0}, "none", 0.01)
