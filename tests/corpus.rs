@@ -912,3 +912,134 @@ fn a_long_noisy_response_is_evaluated_in_seconds() {
         &text[..500]
     );
 }
+
+/// Issue 50's hostile corpus: misspelt names refused with the closest known one,
+/// ranges through a parameter's forbidden zero, a doubled `:log`, a torque curve of
+/// 6e-298 s and a ratio of 1e308 — each one line naming the field or option; a
+/// frequency response written with ordinary number forms (signs, leading dots,
+/// exponents) read as any other, with a finite result.
+#[test]
+fn misspellings_and_ranges_through_zero_are_refused_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let worm = fixture("worm-gear/frequency_response.json");
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&worm).unwrap()).unwrap();
+    let csv = std::fs::read_to_string(worm.with_extension("csv")).unwrap();
+    let write = |name: &str, edit: &dyn Fn(&mut serde_json::Value), text: &str| {
+        let mut m = manifest.clone();
+        m["data"] = format!("{name}.csv").into();
+        edit(&mut m);
+        std::fs::write(d.join(format!("{name}.json")), m.to_string()).unwrap();
+        std::fs::write(d.join(format!("{name}.csv")), text).unwrap();
+    };
+    write(
+        "preload",
+        &|m| m["conditions"]["preload"] = 5.0.into(),
+        &csv,
+    );
+    write("ratio", &|m| m["conditions"]["ratio"] = 1e308.into(), &csv);
+    write(
+        "column",
+        &|_| {},
+        &csv.replacen("phase_deg", "phase_degs", 1),
+    );
+    let torque = "time_s,motor_torque_nm\n0,0.1\n2e-298,0.2\n4e-298,-0.1\n6e-298,0.0\n";
+    std::fs::write(d.join("short.json"), r#"{"kind": "torque_curve"}"#).unwrap();
+    std::fs::write(d.join("short.csv"), torque).unwrap();
+    let identify = |file: &str, more: &[&str]| {
+        let mut a = strings(&["identify", file, "--preset", "worm-gear"]);
+        a.extend(strings(more));
+        a
+    };
+    let sweep = |vary: &str| {
+        strings(&[
+            "sweep",
+            "--preset",
+            "worm-gear",
+            "--vary",
+            vary,
+            "--outputs",
+            "resonances",
+            "--out",
+            "s.csv",
+        ])
+    };
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            identify("preload.json", &[]),
+            "`conditions.preload` is not a condition rtid reads: did you mean `preload_nm`?",
+        ),
+        (identify("ratio.json", &[]), "`conditions.ratio` is 1e308"),
+        (
+            identify("column.json", &[]),
+            "column `phase_degs` is not one rtid reads: did you mean `phase_deg`?",
+        ),
+        (strings(&["evaluate", "short.json"]), "short.csv, line 3"),
+        (
+            identify(
+                worm.to_str().unwrap(),
+                &["--fit", "Kw", "--bound", "Kw=-1..1e6"],
+            ),
+            "--bound Kw=-1..1000000",
+        ),
+        (
+            identify(worm.to_str().unwrap(), &["--fit", "Kww"]),
+            "did you mean `Kw`?",
+        ),
+        (
+            sweep("Rg=-1..1"),
+            "--vary Rg=-1..1: the parameter must not be 0",
+        ),
+        (sweep("Kw=1e5..2e5:log:log"), "the scale is given twice"),
+    ];
+    for (args, culprit) in &cases {
+        let run = rtid(args, d);
+        assert_eq!(run.code, Some(1), "{args:?}: {}", run.stderr);
+        check(args, &run, culprit);
+    }
+    // The same response with each line's numbers in another ordinary form, and as
+    // Rust writes them: the same numbers, so the same fit to the last bit.
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|row| row.split(',').take(3).map(|c| c.parse().unwrap()).collect())
+        .collect();
+    let table = |form: &dyn Fn(usize, f64) -> String| {
+        let mut text = String::from("frequency_hz,gain_db,phase_deg\n");
+        for (k, cells) in rows.iter().enumerate() {
+            let line: Vec<String> = cells.iter().map(|&x| form(k, x)).collect();
+            text += &format!("{}\n", line.join(","));
+        }
+        text
+    };
+    write("plain", &|_| {}, &table(&|_, x| format!("{x}")));
+    let forms = table(&|k, x| match k % 4 {
+        0 => format!("{x:+e}"),
+        1 if x.abs() < 1.0 => format!("{x}").replacen("0.", ".", 1),
+        2 => format!("{x:E}"),
+        _ => format!("{x}"),
+    });
+    assert!(forms.contains(",+") && forms.contains(",.") && forms.contains('E'));
+    write("forms", &|_| {}, &forms);
+    // (The results to files: this corpus's runs are read after they end, and a
+    // result's JSON on stdout outgrows the pipe.)
+    let fit = |name: &str| {
+        let out = format!("{name}-fit.json");
+        let args = identify(
+            &format!("{name}.json"),
+            &[
+                "--fit", "Kw,Kg", "--model", "linear", "--out", &out, "--quiet",
+            ],
+        );
+        let run = rtid(&args, d);
+        check(&args, &run, "");
+        assert_eq!(run.code, Some(0), "{}", run.stderr);
+        let text = std::fs::read_to_string(d.join(out)).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert!(v["cost"].as_f64().is_some_and(f64::is_finite), "{text}");
+        (v["parameters"].clone(), v["cost"].clone())
+    };
+    assert_eq!(fit("forms"), fit("plain"));
+}

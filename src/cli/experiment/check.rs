@@ -83,7 +83,8 @@ pub fn work(amount: f64, limit: f64, what: &str, options: &str) -> anyhow::Resul
         bail!("{options}: ask for more {what} than can be counted");
     }
     bail!(
-        "{options}: ask for {amount:.3e} {what}, over the limit of {limit} (set {ALLOW_LARGE}=1 to run it anyway)"
+        "{options}: ask for {amount:.3e} {what}, over the limit of {} (set {ALLOW_LARGE}=1 to run it anyway)",
+        Num(limit)
     )
 }
 

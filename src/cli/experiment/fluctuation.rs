@@ -90,8 +90,8 @@ impl RunArgs {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.params()?;
-    a.common.create_out()?;
     let test = a.run.test(a.speed_deg_per_min)?;
+    a.common.create_out()?;
     run_test(&a.common, &p, &test, &a.run)
 }
 

@@ -47,7 +47,6 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let p = a.common.params()?;
-    a.common.create_out()?;
     let own = p.unbalance_mass > 0.0 && p.unbalance_radius > 0.0;
     let (mass, radius) = match (a.mass_kg, a.radius_m) {
         (m, r) if own => (
@@ -66,5 +65,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         )),
         ..a.run.test(a.speed_deg_per_min)?
     };
+    a.common.create_out()?;
     run_test(&a.common, &p, &test, &a.run)
 }
