@@ -16,7 +16,7 @@ use rtid::experiments::frequency_response::{self as fr, FrequencyTest};
 use rtid::experiments::measurement_noise as noise;
 use rtid::experiments::positioning::iso230::ARCSEC_PER_RAD;
 use rtid::experiments::torque_curve::{self, TorqueTest};
-use rtid::io::experiment_file::{Data, Delay, Manifest, Response};
+use rtid::io::experiment_file::{Data, Manifest, Response};
 use rtid::model::{Axis, LoopMode, Params};
 
 /// Runs test `kind` on `params` with `settings` and writes it as `STEM.json` and
@@ -201,45 +201,13 @@ fn frequency_response(
     };
     let mut data = fr::to_data(p, &points, a.response).map_err(|e| rtid_error(&e))?;
     let mut manifest = fr::manifest(p, test, a.linear, a.response);
-    if let Data::FrequencyResponse {
-        gain_db,
-        phase_rad: Some(phase),
-        ..
-    } = &mut data
-    {
-        let mut notes = manifest.notes.take().unwrap_or_default();
-        if a.noise_percent > 0.0 {
-            noise::perturb_gain_db(gain_db, a.noise_percent, a.seed);
-            notes += &format!(
-                "; {} % Gaussian noise on the amplitude ratio (seed {})",
-                a.noise_percent, a.seed
-            );
-        }
-        if a.complex_noise_percent > 0.0 {
-            let seed = a.seed.wrapping_add(0x9e37_79b9);
-            noise::perturb_complex(gain_db, phase, a.complex_noise_percent, seed);
-            notes += &format!(
-                "; {} % complex Gaussian noise on the ratio (seed {})",
-                a.complex_noise_percent, a.seed
-            );
-        }
-        manifest.notes = Some(notes);
+    fr::Disturbance {
+        noise_percent: a.noise_percent,
+        complex_noise_percent: a.complex_noise_percent,
+        seed: a.seed,
+        unstated_delay_s: a.unstated_delay_s,
     }
-    if a.unstated_delay_s > 0.0 {
-        if let Data::FrequencyResponse {
-            phase_rad: Some(phase),
-            frequency_hz,
-            ..
-        } = &mut data
-        {
-            for (ph, f) in phase.iter_mut().zip(frequency_hz.iter()) {
-                *ph = rtid::objectives::complex_response::wrap(
-                    *ph - std::f64::consts::TAU * f * a.unstated_delay_s,
-                );
-            }
-        }
-        manifest.conditions.delay_s = Some(Delay::Unknown);
-    }
+    .apply(&mut data, &mut manifest);
     Ok((manifest, data))
 }
 

@@ -9,10 +9,8 @@ use super::check;
 use super::Common;
 use crate::cli::common::progress;
 use rtid::experiments::frequency_response::measured;
-use rtid::experiments::frequency_response::{self as fr, modal, FrequencyTest, Point};
-use rtid::experiments::measurement_noise;
-use rtid::io::experiment_file::{Data, Delay, Experiment, Manifest, Response, ResponseForm};
-use rtid::objectives::complex_response::wrap;
+use rtid::experiments::frequency_response::{self as fr, modal, Disturbance, FrequencyTest, Point};
+use rtid::io::experiment_file::{Data, Delay, Experiment, Response, ResponseForm};
 
 pub const LONG_ABOUT: &str = "\
 Frequency response (paper §4.1): open loop, the motor driven by a sinusoidal torque \
@@ -179,51 +177,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     warn_about_backlash(&points);
     let mut data = fr::to_data(&p, &points, response)?;
     let mut manifest = fr::manifest(&p, &test, a.linear, response);
-    add_noise(&a, &mut data, &mut manifest);
-    if a.unstated_delay_s > 0.0 {
-        if let Data::FrequencyResponse {
-            phase_rad: Some(phase),
-            frequency_hz,
-            ..
-        } = &mut data
-        {
-            for (ph, f) in phase.iter_mut().zip(frequency_hz.iter()) {
-                *ph = wrap(*ph - std::f64::consts::TAU * f * a.unstated_delay_s);
-            }
-        }
-        manifest.conditions.delay_s = Some(Delay::Unknown);
+    Disturbance {
+        noise_percent: a.noise_percent,
+        complex_noise_percent: a.complex_noise_percent,
+        seed: a.seed,
+        unstated_delay_s: a.unstated_delay_s,
     }
+    .apply(&mut data, &mut manifest);
     a.common
         .write_and_report("frequency_response", manifest, &data, report)
-}
-
-/// The measurement noise of the flags, added to `data` and said in the notes.
-fn add_noise(a: &Args, data: &mut Data, manifest: &mut Manifest) {
-    let Data::FrequencyResponse {
-        gain_db,
-        phase_rad: Some(phase),
-        ..
-    } = data
-    else {
-        return;
-    };
-    let mut notes = manifest.notes.take().unwrap_or_default();
-    if a.noise_percent > 0.0 {
-        measurement_noise::perturb_gain_db(gain_db, a.noise_percent, a.seed);
-        notes += &format!(
-            "; {} % Gaussian noise on the amplitude ratio (seed {})",
-            a.noise_percent, a.seed
-        );
-    }
-    if a.complex_noise_percent > 0.0 {
-        let seed = a.seed.wrapping_add(0x9e37_79b9);
-        measurement_noise::perturb_complex(gain_db, phase, a.complex_noise_percent, seed);
-        notes += &format!(
-            "; {} % complex Gaussian noise on the ratio (seed {})",
-            a.complex_noise_percent, a.seed
-        );
-    }
-    manifest.notes = Some(notes);
 }
 
 /// Warns on stderr where a mesh lost contact, and where the table did not move.

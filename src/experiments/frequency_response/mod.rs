@@ -36,7 +36,7 @@ mod sines;
 pub mod time_evaluation;
 pub mod time_record;
 
-pub use record::{linear_points, manifest, to_data};
+pub use record::{linear_points, manifest, to_data, Disturbance};
 pub(crate) use run::initial_state;
 pub use run::simulate_point;
 

@@ -93,3 +93,55 @@ pub fn manifest(p: &Params, test: &FrequencyTest, linear: bool, response: Respon
     );
     m
 }
+
+/// What a virtual record is disturbed with to stand in for a measured one: Gaussian
+/// noise on the amplitude ratio and on the complex ratio (percent), and a delay in
+/// the phase that the manifest leaves unstated (`delay_s: "unknown"`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Disturbance {
+    pub noise_percent: f64,
+    pub complex_noise_percent: f64,
+    pub seed: u64,
+    pub unstated_delay_s: f64,
+}
+
+impl Disturbance {
+    /// `data` (a frequency response with phase; any other is left as it is)
+    /// disturbed, each disturbance said in the manifest's notes or conditions.
+    pub fn apply(&self, data: &mut Data, manifest: &mut Manifest) {
+        use crate::experiments::measurement_noise as noise;
+        let Data::FrequencyResponse {
+            gain_db,
+            phase_rad: Some(phase),
+            frequency_hz,
+            ..
+        } = data
+        else {
+            return;
+        };
+        let mut notes = manifest.notes.take().unwrap_or_default();
+        if self.noise_percent > 0.0 {
+            noise::perturb_gain_db(gain_db, self.noise_percent, self.seed);
+            notes += &format!(
+                "; {} % Gaussian noise on the amplitude ratio (seed {})",
+                self.noise_percent, self.seed
+            );
+        }
+        if self.complex_noise_percent > 0.0 {
+            let seed = self.seed.wrapping_add(0x9e37_79b9);
+            noise::perturb_complex(gain_db, phase, self.complex_noise_percent, seed);
+            notes += &format!(
+                "; {} % complex Gaussian noise on the ratio (seed {})",
+                self.complex_noise_percent, self.seed
+            );
+        }
+        manifest.notes = Some(notes);
+        if self.unstated_delay_s > 0.0 {
+            for (ph, f) in phase.iter_mut().zip(frequency_hz.iter()) {
+                let delayed = *ph - std::f64::consts::TAU * f * self.unstated_delay_s;
+                *ph = crate::objectives::complex_response::wrap(delayed);
+            }
+            manifest.conditions.delay_s = Some(crate::io::experiment_file::Delay::Unknown);
+        }
+    }
+}
