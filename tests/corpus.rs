@@ -993,10 +993,30 @@ fn misspellings_and_ranges_through_zero_are_refused_naming_them() {
         ),
         (sweep("Kw=1e5..2e5:log:log"), "the scale is given twice"),
     ];
-    for (args, culprit) in &cases {
-        let run = rtid(args, d);
+    let fit = fixture("predict/worm-gear/fit.json");
+    let predict = |uncertain: &str| {
+        strings(&[
+            "predict",
+            fit.to_str().unwrap(),
+            "--preset",
+            "worm-gear",
+            "--uncertain",
+            uncertain,
+        ])
+    };
+    let cases = cases.into_iter().chain([
+        (
+            predict("Kw=150%"),
+            "--uncertain Kw=150%: the range must lie between 0 and 100 %",
+        ),
+        (predict("fm=10%"), "fm is fitted"),
+        (predict("Kww=10%"), "did you mean `Kw`?"),
+        (predict("Kw=10"), "expected NAME=X%"),
+    ]);
+    for (args, culprit) in cases {
+        let run = rtid(&args, d);
         assert_eq!(run.code, Some(1), "{args:?}: {}", run.stderr);
-        check(args, &run, culprit);
+        check(&args, &run, culprit);
     }
     // The same response with each line's numbers in another ordinary form, and as
     // Rust writes them: the same numbers, so the same fit to the last bit.
