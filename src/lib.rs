@@ -63,6 +63,8 @@
 pub use version::VERSION;
 
 #[doc(hidden)]
+pub mod angle;
+#[doc(hidden)]
 pub mod controller;
 #[doc(hidden)]
 pub mod estimation;

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import contextlib
 import json
-import math
 import numbers
 import os
 import re
@@ -68,15 +67,7 @@ __all__ = [
 # --- parameters -------------------------------------------------------------------
 
 
-def _finite_number(value, argument: str) -> float:
-    """`value` as a float: a TypeError naming `argument` if it is not a number, a
-    ValueError if it is not finite."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{argument}: {value!r} is not a number (SI units), but {type(value).__name__}")
-    v = float(value)
-    if not math.isfinite(v):
-        raise RtidError(f"{argument}: {v} is not a finite number")
-    return v
+_finite_number = _names.finite_number
 
 
 class Params(Mapping):

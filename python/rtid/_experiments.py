@@ -3,8 +3,6 @@ defaulted as ``rtid experiment KIND``'s flags (src/cli/experiment/), checked her
 
 from __future__ import annotations
 
-import math
-import numbers
 
 import numpy as np
 
@@ -65,15 +63,6 @@ def kind_of(kind) -> str:
     return k
 
 
-def _number(name: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name}: {value!r} is not a number, but {type(value).__name__}")
-    v = float(value)
-    if not math.isfinite(v):
-        raise RtidError(f"{name}: {v} is not a finite number")
-    return v
-
-
 def _checked(name: str, value, rule: str):
     if value is None and rule.endswith("or none"):
         return None
@@ -96,7 +85,7 @@ def _checked(name: str, value, rule: str):
         if value < least:
             raise RtidError(f"{name}: {value}: must be at least {least}")
         return int(value)
-    v = _number(name, value)
+    v = _names.finite_number(value, name)
     if rule == "positive" and not v > 0:
         raise RtidError(f"{name}: {v}: must be a positive number")
     if rule == "non-negative" and v < 0:

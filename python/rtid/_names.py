@@ -10,6 +10,8 @@ docs/experiment-files.md's optional columns.
 from __future__ import annotations
 
 import difflib
+import math
+import numbers
 
 from ._rtid import RtidError
 
@@ -96,3 +98,14 @@ def check_columns(kind: str, columns) -> None:
             raise RtidError(f"{name}: not a column of a {kind} experiment; did you mean `{hint}`?"
                             " (a column a kind does not read is kept as an extra column: give"
                             " it a name of its own)")
+
+
+def finite_number(value, argument: str) -> float:
+    """`value` as a float: a TypeError naming `argument` if it is not a number, an
+    RtidError (a ValueError) if it is not finite."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{argument}: {value!r} is not a number, but {type(value).__name__}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise RtidError(f"{argument}: {v} is not a finite number")
+    return v

@@ -15,19 +15,11 @@
 //! line through the unwrapped phase error against frequency and is refined by
 //! Gauss–Newton on the wrapped errors.
 
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 use crate::experiments::frequency_response::measured::{ComplexPoints, DB_PER_NEPER};
 
-/// A phase in (−π, π].
-pub fn wrap(phase: f64) -> f64 {
-    let w = phase - TAU * (phase / TAU).round();
-    if w <= -PI {
-        w + TAU
-    } else {
-        w
-    }
-}
+pub use crate::angle::wrap;
 
 /// The measured lines' noise: σ of ln|H| and of the phase (rad) per line, the
 /// stated one or, where none is stated, `default` for both.
@@ -128,14 +120,6 @@ pub fn rms_errors(r: &[f64], sigma_ln: &[f64], sigma_phase: &[f64]) -> (f64, f64
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn wrapping_keeps_the_half_open_interval() {
-        assert_eq!(wrap(PI), PI);
-        assert!((wrap(-PI) - PI).abs() < 1e-15);
-        assert!((wrap(3.0 * TAU + 0.5) - 0.5).abs() < 1e-12);
-        assert!((wrap(-7.0) - (-7.0 + TAU)).abs() < 1e-12);
-    }
 
     #[test]
     fn a_delay_is_found_through_the_wraps_of_its_phase() {

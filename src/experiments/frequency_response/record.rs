@@ -139,7 +139,7 @@ impl Disturbance {
         if self.unstated_delay_s > 0.0 {
             for (ph, f) in phase.iter_mut().zip(frequency_hz.iter()) {
                 let delayed = *ph - std::f64::consts::TAU * f * self.unstated_delay_s;
-                *ph = crate::objectives::complex_response::wrap(delayed);
+                *ph = crate::angle::wrap(delayed);
             }
             manifest.conditions.delay_s = Some(crate::io::experiment_file::Delay::Unknown);
         }

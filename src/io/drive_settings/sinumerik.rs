@@ -76,9 +76,32 @@ pub fn fraction(x: f64, max: u64) -> Option<(u64, u64)> {
     None
 }
 
-/// The machine data's lines, in order.
+/// The machine data's name for error messages.
+const FORM: &str = "SINUMERIK machine data";
+
+/// The machine data's lines, in order: the servo gain, the gear (rotary axes), the
+/// feed-forward.
 pub fn settings(s: &ServoSettings, ctx: &SinumerikContext) -> Result<Vec<Setting>, DriveFormError> {
-    const FORM: &str = "SINUMERIK machine data";
+    let (ax, p) = check(s, ctx)?;
+    let mut out = vec![Setting::real(
+        format!("$MA_POSCTRL_GAIN[{p},{ax}]"),
+        s.kpp * 60.0 / 1000.0,
+        "1000/min",
+        format!(
+            "MD32200 servo gain factor Kv = Kpp = {} 1/s (the ratio cancels between error and speed), ·60/1000; = (m/min)/mm",
+            super::number(s.kpp)
+        ),
+    )];
+    if s.axis == Axis::Rotary {
+        out.extend(gear(s, ctx, &ax, p)?);
+    }
+    out.extend(feed_forward(s, &ax, p));
+    Ok(out)
+}
+
+/// The settings and the context checked against what the machine data can hold: the
+/// axis name (`AXn`) and the parameter set.
+fn check(s: &ServoSettings, ctx: &SinumerikContext) -> Result<(String, usize), DriveFormError> {
     s.check()?;
     let Some(n) = ctx.axis_number else {
         return Err(DriveFormError::Missing {
@@ -87,7 +110,6 @@ pub fn settings(s: &ServoSettings, ctx: &SinumerikContext) -> Result<Vec<Setting
             option: "--axis-number",
         });
     };
-    let ax = format!("AX{n}");
     let p = ctx.parameter_set;
     if p >= PARAMETER_SETS {
         return Err(DriveFormError::OutOfRange {
@@ -118,53 +140,55 @@ pub fn settings(s: &ServoSettings, ctx: &SinumerikContext) -> Result<Vec<Setting
             what: "0 to 1 (MD32610's range)",
         });
     }
-    let mut out = vec![Setting::real(
-        format!("$MA_POSCTRL_GAIN[{p},{ax}]"),
-        s.kpp * 60.0 / 1000.0,
-        "1000/min",
-        format!(
-            "MD32200 servo gain factor Kv = Kpp = {} 1/s (the ratio cancels between error and speed), ·60/1000; = (m/min)/mm",
-            super::number(s.kpp)
-        ),
-    )];
-    if s.axis == Axis::Rotary {
-        let (motor, load, from) = match ctx.gear {
-            Some((motor, load)) => {
-                if motor == 0 || load == 0 {
-                    return Err(DriveFormError::OutOfRange {
-                        field: "--gear-ratio".into(),
-                        value: (if motor == 0 { motor } else { load }) as f64,
-                        what: "whole numbers of revolutions ≥ 1",
-                    });
-                }
-                let given = load as f64 / motor as f64;
-                if (given - s.ratio).abs() > 1e-9 * s.ratio.abs() {
-                    return Err(DriveFormError::Disagrees {
-                        option: "--gear-ratio",
-                        given: format!("{motor}:{load} (table turns per motor turn {given})"),
-                        model: format!("ratio Rg·Rw = {}", s.ratio),
-                    });
-                }
-                (motor, load, "as given (--gear-ratio)")
+    Ok((format!("AX{n}"), p))
+}
+
+/// The gear's motor and load revolutions (MD31060, MD31050): `--gear-ratio` checked
+/// against the model's ratio, or that ratio as a fraction of whole revolutions.
+fn gear(
+    s: &ServoSettings,
+    ctx: &SinumerikContext,
+    ax: &str,
+    p: usize,
+) -> Result<[Setting; 2], DriveFormError> {
+    let (motor, load, from) = match ctx.gear {
+        Some((motor, load)) => {
+            if motor == 0 || load == 0 {
+                return Err(DriveFormError::OutOfRange {
+                    field: "--gear-ratio".into(),
+                    value: (if motor == 0 { motor } else { load }) as f64,
+                    what: "whole numbers of revolutions ≥ 1",
+                });
             }
-            None => match fraction(1.0 / s.ratio, MAX_REVOLUTIONS) {
-                Some((motor, load)) => (motor, load, "1/(Rg·Rw) of the model"),
-                None => {
-                    return Err(DriveFormError::Missing {
-                        form: FORM,
-                        what: "the gear as whole motor and load revolutions (MD31060/MD31050), the model's ratio Rg·Rw being no fraction of them",
-                        option: "--gear-ratio MOTOR:LOAD",
-                    })
-                }
-            },
-        };
-        out.push(Setting::integer(
+            let given = load as f64 / motor as f64;
+            if (given - s.ratio).abs() > 1e-9 * s.ratio.abs() {
+                return Err(DriveFormError::Disagrees {
+                    option: "--gear-ratio",
+                    given: format!("{motor}:{load} (table turns per motor turn {given})"),
+                    model: format!("ratio Rg·Rw = {}", s.ratio),
+                });
+            }
+            (motor, load, "as given (--gear-ratio)")
+        }
+        None => match fraction(1.0 / s.ratio, MAX_REVOLUTIONS) {
+            Some((motor, load)) => (motor, load, "1/(Rg·Rw) of the model"),
+            None => {
+                return Err(DriveFormError::Missing {
+                    form: FORM,
+                    what: "the gear as whole motor and load revolutions (MD31060/MD31050), the model's ratio Rg·Rw being no fraction of them",
+                    option: "--gear-ratio MOTOR:LOAD",
+                })
+            }
+        },
+    };
+    Ok([
+        Setting::integer(
             format!("$MA_DRIVE_AX_RATIO_DENOM[{p},{ax}]"),
             load as i64,
             "",
             format!("MD31050 load revolutions, {from}; with MD31060 the Kv is set at the table"),
-        ));
-        out.push(Setting::integer(
+        ),
+        Setting::integer(
             format!("$MA_DRIVE_AX_RATIO_NUMERA[{p},{ax}]"),
             motor as i64,
             "",
@@ -172,16 +196,29 @@ pub fn settings(s: &ServoSettings, ctx: &SinumerikContext) -> Result<Vec<Setting
                 "MD31060 motor revolutions: {motor} per {load} table turns = 1/(Rg·Rw), Rg·Rw = {}",
                 s.ratio
             ),
-        ));
+        ),
+    ])
+}
+
+/// The feed-forward's mode (MD32620) and, where it is on, its weight and the speed
+/// loop's equivalent time (MD32610, MD32810).
+fn feed_forward(s: &ServoSettings, ax: &str, p: usize) -> Vec<Setting> {
+    if s.kvff <= 0.0 {
+        return vec![Setting::integer(
+            format!("$MA_FFW_MODE[{ax}]"),
+            0,
+            "",
+            "MD32620 feed-forward mode 0: none (Kvff = 0)".into(),
+        )];
     }
-    if s.kvff > 0.0 {
-        out.push(Setting::integer(
+    vec![
+        Setting::integer(
             format!("$MA_FFW_MODE[{ax}]"),
             1,
             "",
             "MD32620 feed-forward mode 1: speed feed-forward with PT1 balancing (rtid's symmetrising lag is first order)".into(),
-        ));
-        out.push(Setting::real(
+        ),
+        Setting::real(
             format!("$MA_VELO_FFW_WEIGHT[{p},{ax}]"),
             s.kvff,
             "",
@@ -189,8 +226,8 @@ pub fn settings(s: &ServoSettings, ctx: &SinumerikContext) -> Result<Vec<Setting
                 "MD32610 speed feed-forward factor = Kvff = {}",
                 super::number(s.kvff)
             ),
-        ));
-        out.push(Setting::real(
+        ),
+        Setting::real(
             format!("$MA_EQUIV_SPEEDCTRL_TIME[{p},{ax}]"),
             s.symmetrising_s,
             "s",
@@ -198,16 +235,8 @@ pub fn settings(s: &ServoSettings, ctx: &SinumerikContext) -> Result<Vec<Setting
                 "MD32810 equivalent time constant of the speed loop for the feed-forward = symmetrising_s = {} s",
                 super::number(s.symmetrising_s)
             ),
-        ));
-    } else {
-        out.push(Setting::integer(
-            format!("$MA_FFW_MODE[{ax}]"),
-            0,
-            "",
-            "MD32620 feed-forward mode 0: none (Kvff = 0)".into(),
-        ));
-    }
-    Ok(out)
+        ),
+    ]
 }
 
 /// The machine data as `;`-commented lines `$MA_…[…,AXn]=value`.

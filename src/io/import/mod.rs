@@ -252,7 +252,7 @@ fn converted(r: &Resolved, role: &Role) -> Result<(Vec<f64>, Option<Vec<f64>>), 
         (Samples::Complex { re, im }, "frf") => {
             let pairs = re.iter().zip(im);
             let magnitude = pairs.clone().map(|(a, b)| a.hypot(*b) * r.factor.abs());
-            let phase = pairs.map(|(a, b)| wrap(b.atan2(*a) + sign_turn(r.factor)));
+            let phase = pairs.map(|(a, b)| crate::angle::wrap(b.atan2(*a) + sign_turn(r.factor)));
             Ok((magnitude.collect(), Some(phase.collect())))
         }
         (Samples::Complex { .. }, _) => Err(ImportError(format!(
@@ -564,17 +564,6 @@ fn frequency_response(filled: &[Filled], frequency_hz: Vec<f64>) -> Result<Data,
         phase_rad,
         extra: Default::default(),
     })
-}
-
-/// A phase in (−π, π].
-fn wrap(phase: f64) -> f64 {
-    let two_pi = 2.0 * std::f64::consts::PI;
-    let w = phase - two_pi * (phase / two_pi).round();
-    if w <= -std::f64::consts::PI {
-        w + two_pi
-    } else {
-        w
-    }
 }
 
 fn frequency_response_time(filled: &[Filled], time_s: Vec<f64>) -> Result<Data, ImportError> {
