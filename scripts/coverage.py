@@ -9,7 +9,15 @@ the machine's own ISO 230-2 test before and after that compensation, and counts 
 many of the machine's values fall inside the predicted intervals.
 
     python3 scripts/coverage.py [--rtid target/release/rtid] [--machines 6]
-        [--draws 30] [--uncertain Kw=10% --uncertain theta_bg=50% ...] [--out DIR]
+        [--draws 30] [--uncertain Kw=10% --uncertain theta_bg=50% ...]
+        [--resample N] [--out DIR]
+
+With --resample N the identification bootstraps its fit (N replicates, each drawing
+the --uncertain parameters within their ranges and fitted again) and predict draws
+the replicates; without, predict draws from the fit's covariance and the
+--uncertain parameters independently of it. Besides predict's intervals, the
+identification's (±1.96 standard errors; the bootstrap's) are checked against the
+machine's own parameters.
 
 Standard library only; prints one line per value and the coverage; writes
 DIR/coverage.json. docs/validation.md reports what it measured.
@@ -67,14 +75,16 @@ def one(binary, k, held_moved, args, root):
     rtid(binary, "experiment", "unbalance", *m, "--noise-arcsec", "0.5", "--seed", str(k),
          "--out", os.path.join(d, "records"))
     fit = os.path.join(d, "fit.json")
+    uncertain = [a for u in args.uncertain for a in ("--uncertain", u)]
+    resample = ["--resample", str(args.resample), *uncertain] if args.resample else []
     rtid(binary, "identify", os.path.join(d, "records", "torque_curve.json"),
          os.path.join(d, "records", "unbalance.json"), "--preset", "worm-gear",
-         "--fit", "theta_bw,fm,fw", "--out", fit, "--quiet")
+         "--fit", "theta_bw,fm,fw", "--out", fit, "--quiet", *resample)
     comp = os.path.join(d, "compensation.json")
     rtid(binary, "compensate", "--fit", fit, "--preset", "worm-gear", "-o", comp, "--quiet")
-    uncertain = [a for u in args.uncertain for a in ("--uncertain", u)]
+    later = [] if args.resample else uncertain
     pred = json.loads(rtid(binary, "predict", fit, "--preset", "worm-gear", "--compensation",
-                           comp, "--draws", str(args.draws), "--json", "--quiet", *uncertain))
+                           comp, "--draws", str(args.draws), "--json", "--quiet", *later))
     rtid(binary, "experiment", "positioning", *m, "--out", os.path.join(d, "before"))
     rtid(binary, "experiment", "positioning", *m, "--compensation", comp,
          "--out", os.path.join(d, "after"))
@@ -82,8 +92,19 @@ def one(binary, k, held_moved, args, root):
         "before": iso_values(binary, os.path.join(d, "before", "positioning.json")),
         "after": iso_values(binary, os.path.join(d, "after", "positioning.json")),
     }
-    fitted = json.load(open(fit))["parameters"]
+    result = json.load(open(fit))
+    fitted = result["parameters"]
     rows = []
+    for name, value in fitted.items():
+        se = dict(result["uncertainty"]["standard_errors"]).get(name)
+        boot = (result.get("resampling") or {}).get("intervals", {}).get(name)
+        for kind, lo, hi in [("se", value - 1.96 * se if se else None, value + 1.96 * se if se else None),
+                             ("bootstrap", boot and boot["lower"], boot and boot["upper"])]:
+            if lo is None:
+                continue
+            rows.append({"machine": k, "held_moved": held_moved, "case": "identify-" + kind,
+                         "name": name, "machine_value": sets[name], "nominal": value,
+                         "lower": lo, "upper": hi, "inside": lo <= sets[name] <= hi})
     for case in pred["cases"]:
         for v in case["values"]:
             if v["name"] not in OUTPUTS:
@@ -105,6 +126,7 @@ def main():
     ap.add_argument("--machines", type=int, default=6)
     ap.add_argument("--draws", type=int, default=30)
     ap.add_argument("--uncertain", action="append", default=[])
+    ap.add_argument("--resample", type=int, default=0)
     ap.add_argument("--out", default="coverage-run")
     args = ap.parse_args()
     results = []
@@ -112,19 +134,28 @@ def main():
         r = one(args.rtid, k, k > args.machines // 2, args, args.out)
         results.append(r)
         for row in r["rows"]:
-            print(f"machine {k} {row['case']:6} {row['name']:6} machine {row['machine_value']:8.2f}  "
-                  f"predicted {row['nominal']:8.2f} [{row['lower']:.2f} … {row['upper']:.2f}]"
+            print(f"machine {k} {row['case']:18} {row['name']:8} machine {row['machine_value']:10.4g}  "
+                  f"predicted {row['nominal']:10.4g} [{row['lower']:.4g} … {row['upper']:.4g}]"
                   f"  {'in' if row['inside'] else 'OUT'}", flush=True)
-    rows = [row for r in results for row in r["rows"]]
-    inside = sum(row["inside"] for row in rows)
-    print(f"coverage: {inside} of {len(rows)} ({100 * inside / max(len(rows), 1):.0f} %)")
-    for held in (False, True):
-        part = [row for row in rows if row["held_moved"] == held]
-        if part:
-            n = sum(row["inside"] for row in part)
-            print(f"  held parameters {'moved' if held else 'as the preset'}: {n} of {len(part)}")
+    every = [row for r in results for row in r["rows"]]
+    for label, rows in [("predict (ISO 230-2 before and after)",
+                         [row for row in every if row["case"] in ("before", "after")]),
+                        ("identify ±1.96 standard errors",
+                         [row for row in every if row["case"] == "identify-se"]),
+                        ("identify bootstrap",
+                         [row for row in every if row["case"] == "identify-bootstrap"])]:
+        if not rows:
+            continue
+        inside = sum(row["inside"] for row in rows)
+        print(f"{label}: {inside} of {len(rows)} ({100 * inside / len(rows):.0f} %)")
+        for held in (False, True):
+            part = [row for row in rows if row["held_moved"] == held]
+            if part:
+                n = sum(row["inside"] for row in part)
+                print(f"  held parameters {'moved' if held else 'as the preset'}: {n} of {len(part)}")
     with open(os.path.join(args.out, "coverage.json"), "w") as f:
-        json.dump({"uncertain": args.uncertain, "draws": args.draws, "machines": results}, f, indent=1)
+        json.dump({"uncertain": args.uncertain, "draws": args.draws, "resample": args.resample,
+                   "machines": results}, f, indent=1)
 
 
 if __name__ == "__main__":

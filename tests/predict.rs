@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use crate::cli_support::{err, ok, root, rtid};
 
-fn fit() -> PathBuf {
+fn fit_file() -> PathBuf {
     root().join("fixtures/predict/worm-gear/fit.json")
 }
 
@@ -18,7 +18,7 @@ fn json(out: &std::process::Output) -> serde_json::Value {
 
 /// `compensate --fit` into `dir`/compensation.json.
 fn compensate(dir: &Path) -> serde_json::Value {
-    let fit = fit();
+    let fit = fit_file();
     let out = rtid(
         &[
             "compensate",
@@ -38,7 +38,7 @@ fn compensate(dir: &Path) -> serde_json::Value {
 /// `predict` of the shipped fit with the compensation of `dir`, 2 runs, `draws`
 /// draws, then `extra`.
 fn predict(dir: &Path, draws: &str, extra: &[&str]) -> std::process::Output {
-    let fit = fit();
+    let fit = fit_file();
     let mut args = vec![
         "predict",
         fit.to_str().unwrap(),
@@ -120,7 +120,7 @@ fn the_fit_compensates_the_preset_and_the_prediction_holds_what_its_test_shows()
     let b = real["B_mean"].as_f64().unwrap();
     assert!(b.abs() < 2.0 && b_before < -34.0, "B̄ {b_before} → {b}″");
     // The value at the fit is the virtual test on the identified model with it.
-    let fit = fit();
+    let fit = fit_file();
     let identified = json(&rtid(
         &[
             "experiment",
@@ -188,7 +188,7 @@ fn the_model_s_friction_compensation_is_its_lumped_law() {
 fn a_parameter_the_data_did_not_determine_is_refused_until_held() {
     let dir = tempfile::tempdir().unwrap();
     let mut fit: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(fit()).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(fit_file()).unwrap()).unwrap();
     fit["uncertainty"]["standard_errors"][1][1] = serde_json::Value::Null;
     std::fs::write(dir.path().join("fit.json"), fit.to_string()).unwrap();
     let args = [
@@ -218,7 +218,7 @@ fn a_parameter_the_data_did_not_determine_is_refused_until_held() {
 #[test]
 fn bad_predict_options_are_named() {
     let dir = tempfile::tempdir().unwrap();
-    let fit = fit();
+    let fit = fit_file();
     let f = fit.to_str().unwrap();
     let cases: [(&[&str], &str); 5] = [
         (&["--draws", "3"], "--draws 3"),
@@ -267,7 +267,7 @@ fn the_shipped_fit_is_rtid_s_identification() {
     let read = |p: &Path| -> serde_json::Value {
         serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
     };
-    let (got, shipped) = (read(&dir.path().join("fit.json")), read(&fit()));
+    let (got, shipped) = (read(&dir.path().join("fit.json")), read(&fit_file()));
     for name in ["theta_bw", "fm", "fw"] {
         let (g, s) = (
             got["parameters"][name].as_f64().unwrap(),
@@ -318,7 +318,7 @@ fn the_report_puts_the_prediction_beside_the_records() {
 )]
 fn the_servo_check_of_a_tuning_is_predicted() {
     let dir = tempfile::tempdir().unwrap();
-    let fit = fit();
+    let fit = fit_file();
     let f = fit.to_str().unwrap();
     let checked = json(&rtid(
         &[
@@ -474,4 +474,154 @@ fn identify_tune_and_predict_a_tuning_in_a_chain() {
         (after / before / ratio - 1.0).abs() < 0.05,
         "{before} → {after}″"
     );
+}
+
+/// `identify --uncertain`: on a smooth cost the fit is repeated at each end of the
+/// held parameter's range, its shifts half the difference of what separate fits
+/// with the held value set give; on a rough cost it needs --resample. `predict`
+/// draws the fit's held parameters beside the fitted ones, and refuses a range the
+/// fit's replicates draw already.
+#[test]
+fn held_ranges_go_from_the_identification_into_the_prediction() {
+    let dir = tempfile::tempdir().unwrap();
+    let frf = root().join("fixtures/worm-gear/frequency_response.json");
+    let identify = |extra: &[&str]| {
+        let mut args = vec![
+            "identify",
+            frf.to_str().unwrap(),
+            "--preset",
+            "worm-gear",
+            "--fit",
+            "Kw,Kg",
+            "--model",
+            "linear",
+            "--json",
+            "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        json(&rtid(&args, dir.path()))
+    };
+    let fit = identify(&["--uncertain", "Jt=10%"]);
+    let held = &fit["held"][0];
+    assert_eq!(held["name"], "Jt");
+    let at = |name: &str| fit["parameters"][name].as_f64().unwrap().to_string();
+    let (kw, kg) = (format!("Kw={}", at("Kw")), format!("Kg={}", at("Kg")));
+    let ends: Vec<serde_json::Value> = ["Jt=0.1188", "Jt=0.0972"]
+        .iter()
+        .map(|jt| identify(&["--set", jt, "--set", &kw, "--set", &kg, "--starts", "1"]))
+        .collect();
+    for name in ["Kw", "Kg"] {
+        let end = |k: usize| ends[k]["parameters"][name].as_f64().unwrap();
+        let want = (end(0) - end(1)) / 2.0;
+        let shift = held["shifts"][name].as_f64().unwrap();
+        assert!(
+            (shift - want).abs() < 1e-6 * want.abs(),
+            "{name}: {shift} against {want}"
+        );
+    }
+    // The worm's resonances move as √(K/J): Jt + 10 % asks for Kw about 20 % higher.
+    let kw_shift =
+        held["shifts"]["Kw"].as_f64().unwrap() / fit["parameters"]["Kw"].as_f64().unwrap();
+    assert!((0.15..0.3).contains(&kw_shift), "{kw_shift}");
+
+    let torque = root().join("fixtures/worm-gear/torque_curve.json");
+    let e = err(&rtid(
+        &[
+            "identify",
+            torque.to_str().unwrap(),
+            "--preset",
+            "worm-gear",
+            "--fit",
+            "fm",
+            "--uncertain",
+            "Kw=10%",
+        ],
+        dir.path(),
+    ));
+    assert!(
+        e.contains("--uncertain") && e.contains("needs --resample"),
+        "{e}"
+    );
+
+    let mut shipped: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fit_file()).unwrap()).unwrap();
+    shipped["held"] = serde_json::json!([{"name": "theta_bg", "value": 3e-4,
+        "half_width": 0.5, "shifts": {"theta_bw": -1e-5}}]);
+    std::fs::write(dir.path().join("held.json"), shipped.to_string()).unwrap();
+    let predict = |fit: &str, extra: &[&str]| {
+        let mut args = vec![
+            "predict",
+            fit,
+            "--preset",
+            "worm-gear",
+            "--draws",
+            "10",
+            "--runs",
+            "2",
+        ];
+        args.extend_from_slice(extra);
+        rtid(&args, dir.path())
+    };
+    let p = json(&predict(
+        "held.json",
+        &["--uncertain", "theta_bg=20%", "--json"],
+    ));
+    assert_eq!(
+        p["drawn"],
+        serde_json::json!(["theta_bw", "fm", "fw", "theta_bg"])
+    );
+    let values: Vec<f64> = (0..10)
+        .map(|k| shipped["parameters"]["fm"].as_f64().unwrap() * (k as f64))
+        .collect();
+    shipped["resampling"] = serde_json::json!({"method": "residual block bootstrap",
+        "level": 0.95, "asked": 10, "fitted": 10, "block_lengths": [1, 1], "intervals": {},
+        "values": {"fm": values, "fw": values, "theta_bw": values, "theta_bg": values}});
+    shipped["held"] = serde_json::json!([]);
+    std::fs::write(dir.path().join("replicates.json"), shipped.to_string()).unwrap();
+    let e = err(&predict(
+        "replicates.json",
+        &["--uncertain", "theta_bg=20%"],
+    ));
+    assert!(
+        e.contains("--uncertain theta_bg") && e.contains("draw it already"),
+        "{e}"
+    );
+}
+
+/// The coverage docs/validation.md reports (`scripts/coverage.py`): six machines
+/// around the worm gear (backlash and frictions moved; on three, Kw, θbg and Jt),
+/// identified from their noisy torque curve and unbalance test with the held
+/// parameters' ranges (`--resample 24 --uncertain …`), compensated and predicted as
+/// docs/compensation.md does. At least 85 % of the 72 predicted ISO 230-2 values
+/// before and after hold the machine's own.
+#[test]
+#[ignore = "coverage tier (about 35 min on 2 cores): cargo test --profile test-release -- --ignored coverage_of"]
+fn coverage_of_the_predictions_on_six_machines_that_are_not_the_preset() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new("python3")
+        .arg(root().join("scripts/coverage.py"))
+        .args(["--rtid", env!("CARGO_BIN_EXE_rtid"), "--resample", "24"])
+        .args(["--uncertain", "Kw=10%", "--uncertain", "theta_bg=50%"])
+        .args(["--uncertain", "Jt=10%", "--out"])
+        .arg(dir.path())
+        .output()
+        .expect("python3 runs scripts/coverage.py");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("coverage.json")).unwrap())
+            .unwrap();
+    let rows: Vec<&serde_json::Value> = run["machines"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|m| m["rows"].as_array().unwrap())
+        .filter(|r| r["case"] == "before" || r["case"] == "after")
+        .collect();
+    assert_eq!(rows.len(), 72);
+    let inside = rows.iter().filter(|r| r["inside"] == true).count();
+    assert!(inside >= 62, "{inside} of 72 inside their 95 % intervals");
 }

@@ -19,6 +19,7 @@ fn fit_and_resample(config: &Config, replicates: usize) -> (Identified, Resampli
         objective: fit.objective.as_ref(),
         settings: fit.settings,
         replicates,
+        held: &[],
         stop: &|| false,
         on_replicate: &|| {},
     };
@@ -41,6 +42,7 @@ fn a_frequency_responses_two_resonances_are_too_few_to_resample() {
         objective: fit.objective.as_ref(),
         settings: fit.settings,
         replicates: 20,
+        held: &[],
         stop: &|| false,
         on_replicate: &|| {},
     };

@@ -600,11 +600,26 @@ def _names_list(value, name: str, allow_empty: bool = False) -> list:
     return names
 
 
+def _uncertain(uncertain) -> list:
+    """``identify``'s held ranges as (name, relative half-range) pairs."""
+    if uncertain is None:
+        return []
+    if not isinstance(uncertain, Mapping):
+        raise TypeError(f"uncertain: expected a dict {{name: relative half-range}}, "
+                        f"got {type(uncertain).__name__}")
+    out = []
+    for name, half in uncertain.items():
+        _check_parameter_name(name, "uncertain")
+        out.append((name, _finite_number(half, f"uncertain[{name}]")))
+    return out
+
+
 def identify(experiments, params: Params, fit=None, *, bounds: dict | None = None,
              method: str | None = None, model: str = "auto", starts: int | None = None,
              seed: int = 1, max_iters: int = 50, start: str = "estimate",
              weights=None, objectives=None, profile=None,
-             resample: int | None = None, progress=None) -> IdentifyResult:
+             resample: int | None = None, uncertain: dict | None = None,
+             progress=None) -> IdentifyResult:
     """Identifies parameters from experiments (``rtid identify``).
 
     Args:
@@ -639,6 +654,12 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
         profile: names to profile (``True``: every fitted parameter), for intervals
             that hold where the cost is not a bowl (``--profile``).
         resample: bootstrap replicates of the residuals' blocks (``--resample``).
+        uncertain: parameters the fit holds at assumed values, with their relative
+            half-ranges, e.g. ``{"Kw": 0.1, "theta_bg": 0.5}`` (``--uncertain
+            Kw=10%``): the fit is repeated at each end of each range and the result's
+            ``held`` says how the fitted parameters follow; with ``resample`` each
+            replicate draws them instead (required on a torque curve's, an
+            unbalance test's or a servo trace's rough cost).
         progress: a progress bar of the searches' iterations: None (default) shows
             a tqdm bar where tqdm is installed and the output is watched (a notebook,
             a terminal), True always (tqdm required), False never; or a function
@@ -687,6 +708,7 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
         "objectives": None if objectives is None else _names_list(objectives, "objectives"),
         "profile": _profile_names(profile),
         "resample": None if resample is None else _whole(resample, "resample"),
+        "uncertain": _uncertain(uncertain),
     }
     exps = [_as_experiment(e, f"experiments[{i}]") for i, e in enumerate(experiments)]
     callback, close = _progress.reporter(progress, "identify", "it")

@@ -112,6 +112,8 @@ class IdentifyResult:
         bounds: each fitted parameter's search bounds ``(low, high)``.
         profiles: the profiles as the result file holds them (``None`` if not asked).
         resampling: the bootstrap as the result file holds it (``None`` if not asked).
+        held: each held parameter's range and the fitted parameters' shift across it
+            (``uncertain`` without ``resample``), as the result file holds them.
         warnings: each ``{"code", "message"}`` rtid raised (what the data cannot tell).
         cost: the cost at the result (half the sum of the scaled residuals' squares).
         termination: how the search ended, ``{"code", "message", …}``.
@@ -138,6 +140,7 @@ class IdentifyResult:
         self.covariance = self.correlation * np.outer(se, se)
         self.profiles = result.get("profiles")
         self.resampling = result.get("resampling")
+        self.held = list(result.get("held", []))
         if self.profiles:
             self.interval_method = "profile"
             self.intervals = {n: (p.get("lower"), p.get("upper")) for n, p in self.profiles.items()}

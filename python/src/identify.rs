@@ -35,6 +35,8 @@ pub struct Options {
     profile: Option<Vec<String>>,
     /// `--resample`: bootstrap replicates.
     resample: Option<usize>,
+    /// `--uncertain`: held parameters and their relative half-ranges.
+    uncertain: Vec<(String, f64)>,
 }
 
 /// Identifies the parameters of `options.fit` from the experiment manifests
@@ -58,6 +60,13 @@ pub fn identify<'py>(
         return Err(bad_argument(
             "resample",
             "0: at least one replicate is needed",
+        ));
+    }
+    let rough = || rtid::identify::plan::Plan::new(&config).is_ok_and(|p| p.declared.rough);
+    if !options.uncertain.is_empty() && options.resample.is_none() && rough() {
+        return Err(bad_argument(
+            "uncertain",
+            "on a closed-loop simulation's rough cost (torque curve, unbalance test, servo trace) it needs resample=N: each replicate draws the held parameters and is fitted again",
         ));
     }
     let monitor = Monitor::default();
@@ -156,6 +165,7 @@ fn with_intervals(
         fit.result.warnings.extend(warnings.into_iter().map(Coded));
         profile::attach(&mut fit.result, profiles);
     }
+    let held = held_ranges(&fit, &options.uncertain)?;
     if let Some(replicates) = options.resample {
         let request = resample::Request {
             result: &fit.result,
@@ -163,13 +173,60 @@ fn with_intervals(
             objective: fit.objective.as_ref(),
             settings: fit.settings,
             replicates,
+            held: &held,
             stop: &|| monitor.stopped(),
             on_replicate: &|| {},
         };
         let resampling = resample::resample(&request).map_err(|e| rtid_error(&e))?;
         resample::attach(&mut fit.result, resampling);
+    } else if !held.is_empty() {
+        let shifts = rtid::identify::intervals::held::shifts(
+            &rtid::identify::intervals::held::Fit {
+                result: &fit.result,
+                params: &fit.params,
+                objective: fit.objective.as_ref(),
+                settings: fit.settings,
+            },
+            &held,
+        );
+        fit.result.held = shifts.map_err(|e| rtid_error(&e))?;
     }
     Ok(fit)
+}
+
+/// `uncertain` as (name, value, relative half-range), each a parameter the fit held
+/// at a nonzero value.
+fn held_ranges(fit: &Identified, uncertain: &[(String, f64)]) -> PyResult<Vec<(String, f64, f64)>> {
+    let mut out = Vec::new();
+    for (name, half) in uncertain {
+        let spec = rtid::model::spec(name).map_err(|e| bad_argument("uncertain", e))?;
+        if fit.result.parameters.contains_key(spec.name) {
+            return Err(bad_argument(
+                "uncertain",
+                format!("{}: fitted; its uncertainty is the fit's", spec.name),
+            ));
+        }
+        if !(*half > 0.0 && *half < 1.0) {
+            return Err(bad_argument(
+                "uncertain",
+                format!(
+                    "{}: {half}: the relative half-range must lie between 0 and 1",
+                    spec.name
+                ),
+            ));
+        }
+        let value = spec.get(&fit.params).filter(|v| *v != 0.0).ok_or_else(|| {
+            bad_argument(
+                "uncertain",
+                format!(
+                    "{}: zero or not a parameter of this model: a relative range needs a value",
+                    spec.name
+                ),
+            )
+        })?;
+        out.push((spec.name.to_string(), value, *half));
+    }
+    Ok(out)
 }
 
 /// The configuration, checked before any work as the command line checks it.

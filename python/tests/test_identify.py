@@ -140,8 +140,26 @@ def test_profile_and_resample_give_the_cli_intervals(cli, root, tmp_path):
     assert rtid.identify(worm, p, fit="Kw,Kg", model="linear").interval_method == "standard errors"
 
 
+def test_held_ranges_give_the_cli_shifts(cli, root, tmp_path):
+    worm = root / "fixtures/worm-gear/frequency_response.json"
+    out = tmp_path / "fit.json"
+    cli("identify", worm, "--preset", "worm-gear", "--fit", "Kw,Kg", "--model", "linear",
+        "--uncertain", "Jt=10%", "--out", out)
+    expected = json.loads(out.read_text())["held"]
+    r = rtid.identify(worm, rtid.params("worm-gear"), fit="Kw,Kg", model="linear",
+                      uncertain={"Jt": 0.1})
+    assert [h["name"] for h in r.held] == ["Jt"]
+    for name, shift in expected[0]["shifts"].items():
+        assert r.held[0]["shifts"][name] == pytest.approx(shift, rel=1e-12, abs=0)
+    torque = root / "fixtures/worm-gear/torque_curve.json"
+    with pytest.raises(ValueError, match="uncertain.*resample"):
+        rtid.identify(torque, rtid.params("worm-gear"), fit="fm", uncertain={"Kw": 0.1})
+
+
 @pytest.mark.parametrize("kwargs, argument", [
     ({"resample": 0}, "resample"),
+    ({"uncertain": {"Jt": 1.5}}, "uncertain"),
+    ({"uncertain": {"Jtt": 0.1}}, "uncertain"),
     ({"profile": [""]}, "profile"),
 ])
 def test_bad_interval_options_name_themselves(root, kwargs, argument):

@@ -9,13 +9,14 @@ use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::common::inputs::refuse_overwrite;
-use crate::cli::common::{interrupt, model_args, progress};
+use crate::cli::common::{self, interrupt, model_args, progress};
 use crate::cli::ModelArgs;
 use rtid::experiments::positioning::PositioningTest;
 use rtid::identify::result::IdentifyResult;
 use rtid::io::compensation_file;
 use rtid::model::Params;
 use rtid::names::Num;
+use rtid::prediction::draws::Uncertain;
 use rtid::prediction::{self, draws, Case, DrawSource, Prediction, Setup, Test};
 
 pub const LONG_ABOUT: &str = "\
@@ -114,7 +115,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut params = a.model.load()?;
     model_args::apply_fit(&mut params, &fit, &a.fit)?;
     let (source, draws) = draws(&a, &fit)?;
-    let uncertain = uncertain(&a.uncertain, &params, &fit)?;
+    let uncertain = uncertain(&a.uncertain, &params, &fit, &draws.names)?;
     let draws = draws.with_uncertain(&uncertain, a.seed);
     let cases = cases(&a, &params)?;
     let stop = Arc::new(AtomicBool::new(false));
@@ -186,42 +187,28 @@ fn draws(a: &Args, fit: &IdentifyResult) -> anyhow::Result<(DrawSource, draws::D
     Ok((DrawSource::Covariance, d))
 }
 
-/// `--uncertain NAME=X%` each: a parameter of the model not fitted, its value, and X/100.
+/// The held parameters' ranges: the fit's (`identify --uncertain`, the fitted
+/// parameters moving with them), a range given here replacing its width, and
+/// those given here alone drawn independently of the fit.
 fn uncertain(
     specs: &[String],
     params: &Params,
     fit: &IdentifyResult,
-) -> anyhow::Result<Vec<(String, f64, f64)>> {
-    let mut out: Vec<(String, f64, f64)> = Vec::new();
-    for s in specs {
-        let form = || format!("--uncertain {s}: expected NAME=X%, e.g. Kw=10%");
-        let (name, range) = s.split_once('=').with_context(form)?;
-        let percent = range
-            .trim()
-            .trim_start_matches('±')
-            .strip_suffix('%')
-            .with_context(form)?;
-        let percent: f64 = percent.trim().parse().ok().with_context(form)?;
-        if !(percent > 0.0 && percent < 100.0) {
-            bail!("--uncertain {s}: the range must lie between 0 and 100 % of the value");
-        }
-        let spec =
-            rtid::model::spec(name.trim()).map_err(|e| anyhow::anyhow!("--uncertain {s}: {e}"))?;
-        if fit.parameters.contains_key(spec.name) {
-            bail!(
-                "--uncertain {s}: {} is fitted; its uncertainty is the fit's",
-                spec.name
-            );
-        }
-        if out.iter().any(|(n, ..)| n == spec.name) {
-            bail!("--uncertain: {} is given twice", spec.name);
-        }
-        let value = spec
-            .get(params)
-            .filter(|v| *v != 0.0)
-            .with_context(|| format!("--uncertain {s}: {} is zero or not a parameter of this model: a relative range needs a value", spec.name))?;
-        out.push((spec.name.to_string(), value, percent / 100.0));
+    drawn: &[String],
+) -> anyhow::Result<Vec<Uncertain>> {
+    let given = common::uncertain::parse(specs, params, &|n| fit.parameters.contains_key(n))?;
+    if let Some((name, ..)) = given.iter().find(|g| drawn.contains(&g.0)) {
+        bail!("--uncertain {name}: the fit's bootstrap replicates draw it already, within the range `identify --uncertain` gave it");
     }
+    let width = |name: &str| given.iter().find(|g| g.0 == name).map(|g| g.2);
+    let mut out: Vec<Uncertain> = (fit.held.iter())
+        .map(|h| Uncertain::of_fit(h, fit, width(&h.name)))
+        .collect();
+    out.extend(
+        (given.iter())
+            .filter(|(n, ..)| !fit.held.iter().any(|h| &h.name == n))
+            .map(|(n, v, h)| Uncertain::independent(n, *v, *h)),
+    );
     Ok(out)
 }
 

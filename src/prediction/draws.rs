@@ -7,6 +7,7 @@ use rand::{rngs::StdRng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
 
 use super::PredictError;
+use crate::identify::result::held::Held;
 use crate::identify::result::IdentifyResult;
 
 /// Where the parameter sets come from.
@@ -97,20 +98,83 @@ pub fn from_bootstrap(fit: &IdentifyResult) -> Result<Draws, PredictError> {
     })
 }
 
+/// A held parameter drawn within value·(1 ± half_width) beside the fit's draws:
+/// what a prediction rests on besides the fit (a preset's stiffness, an inertia from
+/// a drawing). Where the fit gave its response to it (`identify --uncertain`,
+/// [`Held`]), the fitted parameters move with it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Uncertain {
+    pub name: String,
+    pub value: f64,
+    pub half_width: f64,
+    /// Each fitted parameter's value at the fit and its change with this parameter
+    /// at value·(1 + half_width) (empty: drawn independently of the fit).
+    pub moves: Vec<(String, f64, f64)>,
+}
+
+impl Uncertain {
+    /// `name` within value·(1 ± half_width), independent of the fit.
+    pub fn independent(name: &str, value: f64, half_width: f64) -> Uncertain {
+        Uncertain {
+            name: name.to_string(),
+            value,
+            half_width,
+            moves: Vec::new(),
+        }
+    }
+
+    /// The range the fit carries for `held` (its shifts scaled to `half_width`
+    /// where given), the fitted values from `fit`.
+    pub fn of_fit(held: &Held, fit: &IdentifyResult, half_width: Option<f64>) -> Uncertain {
+        let half = half_width.unwrap_or(held.half_width);
+        let moves = (held.shifts.iter())
+            .filter_map(|(n, s)| {
+                let at = fit.parameters.get(n)?;
+                Some((n.clone(), *at, s * half / held.half_width))
+            })
+            .collect();
+        Uncertain {
+            name: held.name.clone(),
+            value: held.value,
+            half_width: half,
+            moves,
+        }
+    }
+
+    /// Set `set` (names `names`) at u ∈ [−1, 1] of this range: the fitted
+    /// parameters moved by u of their shift (by a power of its ratio where the
+    /// value is positive, so it stays so), and this parameter's value returned.
+    fn apply(&self, names: &[String], set: &mut [f64], u: f64) -> f64 {
+        for (name, at, shift) in &self.moves {
+            let Some(j) = names.iter().position(|n| n == name) else {
+                continue;
+            };
+            let ratio = 1.0 + shift / at;
+            if *at > 0.0 && ratio > 0.0 {
+                set[j] *= ratio.powf(u);
+            } else {
+                set[j] += u * shift;
+            }
+        }
+        self.value * (1.0 + self.half_width * u)
+    }
+}
+
 impl Draws {
-    /// The sets widened by parameters the fit held at assumed values: each of
-    /// `uncertain` (name, its value in `base`, relative half-width) drawn uniformly
-    /// within value·(1 ± half-width), independently of the fit — what a prediction
-    /// rests on besides the fit (a preset's stiffness, an inertia from a drawing).
-    pub fn with_uncertain(mut self, uncertain: &[(String, f64, f64)], seed: u64) -> Draws {
+    /// The sets widened by parameters the fit held at assumed values
+    /// ([`Uncertain`]), each drawn uniformly within its range, independently of the
+    /// others.
+    pub fn with_uncertain(mut self, uncertain: &[Uncertain], seed: u64) -> Draws {
         use rand::Rng;
         let mut rng = StdRng::seed_from_u64(seed ^ 0x5eed_u64.rotate_left(32));
         for set in &mut self.sets {
-            for (_, value, half) in uncertain {
-                set.push(value * (1.0 + half * rng.random_range(-1.0..=1.0)));
+            let mut values = Vec::with_capacity(uncertain.len());
+            for u in uncertain {
+                values.push(u.apply(&self.names, set, rng.random_range(-1.0..=1.0)));
             }
+            set.extend(values);
         }
-        self.names.extend(uncertain.iter().map(|(n, ..)| n.clone()));
+        self.names.extend(uncertain.iter().map(|u| u.name.clone()));
         self
     }
 }
@@ -232,7 +296,7 @@ mod tests {
             serde_json::from_str(include_str!("tests/two_parameter_fit.json")).unwrap();
         let draws = from_covariance(&fit, &[], 2000, 1)
             .unwrap()
-            .with_uncertain(&[("Jt".into(), 0.1, 0.05)], 1);
+            .with_uncertain(&[Uncertain::independent("Jt", 0.1, 0.05)], 1);
         assert_eq!(draws.names, ["Kw", "c", "Jt"]);
         let jt: Vec<f64> = draws.sets.iter().map(|s| s[2]).collect();
         let (lo, hi) = jt
@@ -242,6 +306,39 @@ mod tests {
             lo >= 0.095 && hi <= 0.105 && lo < 0.0951 && hi > 0.1049,
             "{lo} {hi}"
         );
+    }
+
+    #[test]
+    fn fitted_parameters_move_with_a_held_one_as_the_fit_said() {
+        let fit: IdentifyResult =
+            serde_json::from_str(include_str!("tests/two_parameter_fit.json")).unwrap();
+        // The fit said: Jt at 0.1·(1 + 0.1) puts Kw 4 % higher and c 0.05 lower.
+        let held = Held {
+            name: "Jt".into(),
+            value: 0.1,
+            half_width: 0.1,
+            shifts: [("Kw".into(), 0.04 * 4e5), ("c".into(), -0.05)].into(),
+        };
+        // Asked at half the range: the moves halve.
+        let u = Uncertain::of_fit(&held, &fit, Some(0.05));
+        let draws = from_covariance(&fit, &["c".to_string()], 1, 1).unwrap();
+        let names = draws.names.clone();
+        let mut set = vec![4e5];
+        let jt = u.apply(&names, &mut set, 1.0);
+        assert!((jt - 0.105).abs() < 1e-15, "{jt}");
+        assert!((set[0] / 4e5 - 1.02).abs() < 1e-12, "{set:?}");
+        let mut set = vec![4e5];
+        u.apply(&names, &mut set, -1.0);
+        assert!((set[0] / 4e5 - 1.0 / 1.02).abs() < 1e-12, "{set:?}");
+        // Drawn: Kw and Jt move together. Kw's own spread (1 %, log-normal) beside
+        // the ±2 % uniform that Jt brings: correlation √(0.02²/3 / (0.01² + 0.02²/3))
+        // = 0.756.
+        let d = from_covariance(&fit, &["c".to_string()], 2000, 3)
+            .unwrap()
+            .with_uncertain(&[u], 3);
+        assert_eq!(d.names, ["Kw", "Jt"]);
+        let r = correlation_of(&d.sets, 0, 1);
+        assert!((r - 0.756).abs() < 0.04, "correlation {r}");
     }
 
     #[test]

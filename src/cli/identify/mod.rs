@@ -3,6 +3,7 @@
 //! (candidate tests ranked by the uncertainty they would give).
 
 pub mod design;
+mod held;
 mod profile;
 mod resample;
 pub mod select;
@@ -15,6 +16,8 @@ use std::time::Duration;
 use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
+use crate::cli::common::uncertain;
+use crate::cli::identify::held::{add_held, held_table};
 use crate::cli::identify::profile::{
     add_profiles, profile_table, surface_notes, write_profile_plots,
 };
@@ -201,6 +204,18 @@ pub struct Args {
     #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "20",
           value_parser = clap::value_parser!(u64).range(5..=10_000))]
     pub resample: Option<u64>,
+    /// A parameter the fit holds at an assumed value, with its uncertainty as a
+    /// relative half-range (e.g. --uncertain Kw=10% for a stiffness from a
+    /// catalogue, --uncertain theta_bg=50% for a backlash nobody measured);
+    /// repeatable. After the fit, the fit is repeated with the held parameter at
+    /// each end of its range (from the fit's values, the same search): how the
+    /// fitted parameters follow it is printed, with each one's interval widened by
+    /// it, and written in the result as `held`; `rtid predict` then draws the held
+    /// parameter within its range and moves the fitted ones with it. On a rough cost
+    /// (torque curve, unbalance test, servo trace) it needs --resample: each
+    /// replicate draws the held parameters within their ranges.
+    #[arg(long, value_name = "NAME=X%")]
+    pub uncertain: Vec<String>,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
@@ -475,6 +490,15 @@ fn usable(all: &[ObjectiveKind], spec: &ExperimentSpec) -> anyhow::Result<Vec<Ob
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let config = a.config()?;
+    let held = uncertain::parse(&a.uncertain, &config.base, &|n| {
+        config.fit.iter().any(|f| f == n)
+    })?;
+    if !held.is_empty()
+        && a.resample.is_none()
+        && rtid::identify::plan::Plan::new(&config)?.declared.rough
+    {
+        bail!("--uncertain on a closed-loop simulation's rough cost (torque curve, unbalance test, servo trace) needs --resample N: there a fit's linear response to a held parameter is not what its search does (on the worm gear's torque curve and unbalance test, 6 times too small), so each replicate draws the held parameters and is fitted again");
+    }
     let provenance = Provenance::of_this_run(&a.inputs(&config.experiments))
         .context("hashing the input files")?;
     let monitor = Arc::new(Monitor::default());
@@ -499,7 +523,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if let Some(n) = a.resample {
         let fit = (objective.as_ref(), settings);
-        add_resampling(n as usize, &mut result, &params, fit, &monitor, a.quiet)?;
+        add_resampling(
+            n as usize,
+            &held,
+            &mut result,
+            &params,
+            fit,
+            &monitor,
+            a.quiet,
+        )?;
+    } else if !held.is_empty() {
+        add_held(&held, &mut result, &params, (objective.as_ref(), settings))?;
     }
     result.provenance = Some(provenance);
     if a.out.is_some() || a.json {
@@ -602,6 +636,12 @@ fn print_summary(r: &IdentifyResult) {
         }
     }
     if let Some(t) = resample_table(r) {
+        println!("{t}");
+        if let Some(s) = &r.resampling {
+            println!("bootstrap: {}", s.method);
+        }
+    }
+    if let Some(t) = held_table(r) {
         println!("{t}");
     }
     for res in &r.residuals {

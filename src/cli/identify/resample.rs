@@ -8,10 +8,11 @@ use rtid::model::Params;
 
 use crate::cli::common::progress;
 
-/// The bootstrap of `result` with `replicates` replicates, added to it
-/// ([`resample::attach`]).
+/// The bootstrap of `result` with `replicates` replicates, each drawing the `held`
+/// parameters within their ranges, added to it ([`resample::attach`]).
 pub fn add_resampling(
     replicates: usize,
+    held: &[(String, f64, f64)],
     result: &mut IdentifyResult,
     params: &Params,
     fit: (&dyn rtid::objectives::Objective, rtid::identify::Settings),
@@ -25,6 +26,7 @@ pub fn add_resampling(
         objective: fit.0,
         settings: fit.1,
         replicates,
+        held,
         stop: &|| monitor.stopped(),
         on_replicate: &|| bar.inc(1),
     };

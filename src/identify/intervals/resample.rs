@@ -25,6 +25,7 @@ use std::collections::BTreeMap;
 use std::ops::Range;
 
 use rand::{rngs::StdRng, Rng, SeedableRng};
+use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
 use crate::identify::error::IdentifyError;
@@ -37,7 +38,7 @@ use crate::identify::search::search;
 use crate::identify::search::settings::{Method, Settings};
 use crate::identify::space::{Bound, ParamSpace};
 use crate::model::Params;
-use crate::objectives::{Objective, ObjectiveError};
+use crate::objectives::{sum_of_squares, Objective, ObjectiveError};
 
 pub use super::request::LEVEL;
 use super::request::Z;
@@ -54,6 +55,12 @@ pub struct Request<'a> {
     pub objective: &'a dyn Objective,
     pub settings: Settings,
     pub replicates: usize,
+    /// Parameters the fit held at assumed values, with their ranges (name, value,
+    /// relative half-width): each replicate draws each uniformly within
+    /// value·(1 ± half-width) and is fitted with it, so the replicates carry what the
+    /// fit absorbs of a held value that is wrong. The drawn values are in the
+    /// replicates' values beside the fitted ones.
+    pub held: &'a [(String, f64, f64)],
     /// Asked before each replicate whether to stop (Ctrl-C).
     pub stop: &'a (dyn Fn() -> bool + Sync),
     /// Called after each replicate (progress).
@@ -68,12 +75,12 @@ pub enum ResampleError {
     Interrupted,
     #[error("--resample {0}: at least {MIN_REPLICATES} replicates are needed for an interval")]
     TooFew(usize),
-    #[error("--resample: {label} has {residuals} residual(s) in {blocks} block(s) of {length}; a bootstrap needs at least {MIN_BLOCKS} blocks of each experiment's residuals to stand for their errors (use --profile, or the standard errors, for it)")]
+    #[error("--resample: {label} has {residuals} residual(s), too few for {MIN_BLOCKS} blocks (of {length}) and no more than the {fitted} fitted parameters, whose residuals cannot stand for its errors (use --profile, or the standard errors, for it)")]
     TooFewResiduals {
         label: String,
         residuals: usize,
-        blocks: usize,
         length: usize,
+        fitted: usize,
     },
     #[error("--resample: the objective cannot be evaluated at the result: {0}")]
     Objective(#[from] ObjectiveError),
@@ -81,8 +88,19 @@ pub enum ResampleError {
 
 /// Fewer blocks than this in one experiment's residuals (an objective's, where an
 /// experiment feeds several) cannot stand for their errors: the unbalance test's
-/// four step angles, a frequency response's two resonances.
+/// four step angles, a frequency response's two resonances. Such a part's errors are
+/// drawn normal instead, of its residuals' RMS (a parametric bootstrap of that part).
 pub const MIN_BLOCKS: usize = 10;
+
+/// How one part's errors are drawn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Errors {
+    /// The part's residuals in circular blocks of this length.
+    Blocks(usize),
+    /// Normal errors of this standard deviation: the part's residuals' RMS, where
+    /// they are too few for blocks.
+    Normal(f64),
+}
 
 /// The bootstrap of `request.result`.
 pub fn resample(request: &Request) -> Result<Resampling, ResampleError> {
@@ -102,6 +120,7 @@ pub fn resample(request: &Request) -> Result<Resampling, ResampleError> {
             })
             .collect(),
         names,
+        held: request.held,
         params: request.params,
         objective: request.objective,
         settings: request.settings,
@@ -135,6 +154,8 @@ struct Problem<'a> {
     fit: Vec<f64>,
     initial: Vec<f64>,
     bounds: Vec<(String, Bound)>,
+    /// The held parameters' ranges the replicates draw from.
+    held: &'a [(String, f64, f64)],
     /// The identified parameter set.
     params: &'a Params,
     objective: &'a dyn Objective,
@@ -157,15 +178,21 @@ impl Problem<'_> {
         let r0 = self.objective.residuals(self.params)?;
         let segments = self.segments(r0.len());
         let errors = modified(&centre(&r0, &segments), self.names.len());
-        let blocks = self.blocks(&errors, &segments)?;
+        let blocks = self.blocks(&errors, &r0, &segments)?;
         let replicate = |b: usize, objective: &dyn Objective| {
             if stop() {
                 return None;
             }
-            let draw = draw(&errors, &segments, &blocks, seed(self.settings.seed, b));
+            let seed = seed(self.settings.seed, b);
+            let draw = draw(&errors, &segments, &blocks, seed);
             let offset: Vec<f64> = draw.iter().zip(&r0).map(|(d, r)| d - r).collect();
+            let held = self.held_draw(seed);
             let fitted = self
-                .refit(objective, offset)
+                .refit(objective, offset, &held)
+                .map(|mut f| {
+                    f.extend(held);
+                    f
+                })
                 .map_err(|e| format!("replicate {b}: {e}"));
             on_replicate();
             Some(fitted)
@@ -206,25 +233,44 @@ impl Problem<'_> {
             .collect()
     }
 
-    /// Each segment's block length; an error naming a part with too few blocks.
-    fn blocks(&self, r: &[f64], segments: &[Range<usize>]) -> Result<Vec<usize>, ResampleError> {
-        segments
-            .iter()
-            .enumerate()
+    /// How each segment's errors are drawn: the centred residuals `centred` in
+    /// blocks, or, where a part has fewer than [`MIN_BLOCKS`], normal errors whose
+    /// variance is its residuals' `raw` sum of squares (its mean misfit is an error
+    /// too) over their count less the fitted parameters — as if the part alone had
+    /// determined them all (the unbalance test's four step angles fix the split of
+    /// the frictions), which a part with no more residuals than that cannot give.
+    fn blocks(
+        &self,
+        centred: &[f64],
+        raw: &[f64],
+        segments: &[Range<usize>],
+    ) -> Result<Vec<Errors>, ResampleError> {
+        let k = self.names.len();
+        (segments.iter().enumerate())
             .map(|(i, s)| {
-                let length = block_length(&r[s.clone()]);
-                let blocks = s.len() / length;
-                if blocks < MIN_BLOCKS {
-                    let label = self.parts.get(i).map_or("the fit".into(), |p| p.0.clone());
-                    return Err(ResampleError::TooFewResiduals {
-                        label,
+                let length = block_length(&centred[s.clone()]);
+                if s.len() / length >= MIN_BLOCKS {
+                    Ok(Errors::Blocks(length))
+                } else if s.len() > k {
+                    let ss = sum_of_squares(&raw[s.clone()]);
+                    Ok(Errors::Normal((ss / (s.len() - k) as f64).sqrt()))
+                } else {
+                    Err(ResampleError::TooFewResiduals {
+                        label: self.part(i),
                         residuals: s.len(),
-                        blocks,
                         length,
-                    });
+                        fitted: k,
+                    })
                 }
-                Ok(length)
             })
+            .collect()
+    }
+
+    /// Replicate `seed`'s draw of each held parameter within its range.
+    fn held_draw(&self, seed: u64) -> Vec<f64> {
+        let mut rng = StdRng::seed_from_u64(seed ^ 0x6865_6c64);
+        (self.held.iter())
+            .map(|(_, value, half)| value * (1.0 + half * rng.random_range(-1.0..=1.0)))
             .collect()
     }
 
@@ -234,9 +280,11 @@ impl Problem<'_> {
         &self,
         objective: &dyn Objective,
         offset: Vec<f64>,
+        held: &[f64],
     ) -> Result<Vec<f64>, IdentifyError> {
         let mut base = self.params.clone();
-        for (name, &v) in self.names.iter().zip(&self.initial) {
+        let held = self.held.iter().map(|h| &h.0).zip(held);
+        for (name, &v) in self.names.iter().zip(&self.initial).chain(held) {
             base.set(name, v).map_err(ObjectiveError::from)?;
         }
         let space = ParamSpace::new(base, &self.names, &self.bounds)?;
@@ -260,7 +308,7 @@ impl Problem<'_> {
     fn summarise(
         &self,
         asked: usize,
-        block_lengths: Vec<usize>,
+        errors: Vec<Errors>,
         outcomes: Vec<Option<Result<Vec<f64>, String>>>,
     ) -> Resampling {
         let mut notes = Vec::new();
@@ -273,15 +321,14 @@ impl Problem<'_> {
             .flatten()
             .filter_map(|o| o.map_err(|e| notes.push(e)).ok())
             .collect();
-        let values: BTreeMap<String, Vec<f64>> = self
-            .names
-            .iter()
+        let values: BTreeMap<String, Vec<f64>> = (self.names.iter())
+            .chain(self.held.iter().map(|h| &h.0))
             .enumerate()
             .map(|(i, n)| (n.clone(), fits.iter().map(|f| f[i]).collect()))
             .collect();
         let intervals = if fits.len() >= MIN_REPLICATES {
             (self.names.iter().zip(&self.fit))
-                .map(|(n, &fit)| (n.clone(), interval(fit, &values[n])))
+                .map(|(n, &fit)| (n.clone(), interval(fit, &values[n], self.held.is_empty())))
                 .collect()
         } else {
             notes.push(format!(
@@ -291,15 +338,55 @@ impl Problem<'_> {
             BTreeMap::new()
         };
         Resampling {
-            method: "residual block bootstrap".into(),
+            method: self.method(&errors),
             level: LEVEL,
             asked,
             fitted: fits.len(),
-            block_lengths,
+            block_lengths: (errors.iter())
+                .map(|e| match e {
+                    Errors::Blocks(l) => *l,
+                    Errors::Normal(_) => 1,
+                })
+                .collect(),
             intervals,
             values,
             notes,
         }
+    }
+}
+
+impl Problem<'_> {
+    /// What the bootstrap drew: blocks, normal errors where a part had too few
+    /// residuals for blocks, and the held parameters' ranges.
+    fn method(&self, errors: &[Errors]) -> String {
+        let mut method = String::from("residual block bootstrap");
+        let normal: Vec<String> = (errors.iter().enumerate())
+            .filter_map(|(i, e)| match e {
+                Errors::Normal(sd) => Some(format!("{} (sd {sd:.3} of its scale)", self.part(i))),
+                Errors::Blocks(_) => None,
+            })
+            .collect();
+        if !normal.is_empty() {
+            method += &format!(
+                "; normal errors for {}, too few residuals for {MIN_BLOCKS} blocks",
+                normal.join(", ")
+            );
+        }
+        if !self.held.is_empty() {
+            let ranges: Vec<String> = (self.held.iter())
+                .map(|(n, _, h)| format!("{n} ±{} %", crate::names::Num(100.0 * h)))
+                .collect();
+            method += &format!(
+                "; held parameters drawn uniformly within their ranges ({}), the intervals around the replicates' mean",
+                ranges.join(", ")
+            );
+        }
+        method
+    }
+
+    /// Part `i`'s name (the whole fit where the parts do not add up).
+    fn part(&self, i: usize) -> String {
+        self.parts.get(i).map_or("the fit".into(), |p| p.0.clone())
     }
 }
 
@@ -350,31 +437,45 @@ fn seed(seed: u64, b: usize) -> u64 {
     seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ (b as u64).wrapping_add(0x7265_7361_6d70)
 }
 
-/// A circular block bootstrap draw of each segment of `r`.
-fn draw(r: &[f64], segments: &[Range<usize>], blocks: &[usize], seed: u64) -> Vec<f64> {
+/// A draw of each segment of `r`: circular blocks of its residuals, or normal
+/// errors.
+fn draw(r: &[f64], segments: &[Range<usize>], errors: &[Errors], seed: u64) -> Vec<f64> {
     let mut rng = StdRng::seed_from_u64(seed);
     let mut out = Vec::with_capacity(r.len());
-    for (s, &block) in segments.iter().zip(blocks) {
+    for (s, &errors) in segments.iter().zip(errors) {
         let part = &r[s.clone()];
         let n = part.len();
         while out.len() < s.end {
-            let from = rng.random_range(0..n);
-            let take = block.min(s.end - out.len());
-            out.extend((0..take).map(|i| part[(from + i) % n]));
+            match errors {
+                Errors::Blocks(block) => {
+                    let from = rng.random_range(0..n);
+                    let take = block.min(s.end - out.len());
+                    out.extend((0..take).map(|i| part[(from + i) % n]));
+                }
+                Errors::Normal(sd) => {
+                    let z: f64 = StandardNormal.sample(&mut rng);
+                    out.push(sd * z);
+                }
+            }
         }
     }
     out
 }
 
-/// The bias-corrected normal interval of a fit `fit` from its replicates `v`.
-fn interval(fit: f64, v: &[f64]) -> Interval {
+/// The normal interval of a fit `fit` from its replicates `v`: bias-corrected
+/// (`correct`: the fit less the replicates' mean offset), or, where the replicates
+/// drew held parameters, around their mean — each replicate is then what the data
+/// say with the held values it drew, and their offset from the fit is the held
+/// ranges' pull, not a bias to reflect.
+fn interval(fit: f64, v: &[f64], correct: bool) -> Interval {
     let n = v.len() as f64;
     let mean = v.iter().sum::<f64>() / n;
     let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
     let bias = mean - fit;
+    let centre = if correct { fit - bias } else { mean };
     Interval {
-        lower: fit - bias - Z * sd,
-        upper: fit - bias + Z * sd,
+        lower: centre - Z * sd,
+        upper: centre + Z * sd,
         standard_error: sd,
         bias,
     }
@@ -502,6 +603,7 @@ mod tests {
             objective: &decay,
             settings,
             parts: vec![("decay".into(), 200)],
+            held: &[],
         };
         let r = problem.run(40, &|| false, &|| {}).unwrap();
         let se = standard_errors(&decay, &params, &names);
@@ -537,12 +639,16 @@ mod tests {
     }
 
     #[test]
-    fn too_few_residuals_are_refused_naming_the_experiment() {
+    fn a_part_too_short_for_blocks_gets_normal_errors_of_its_rms_and_is_named() {
         let p = presets::load("worm-gear").unwrap();
+        // Four residuals 0.2, 0.1, 0.1, 0.2 (a misfit of mean 0.15) after fitting one
+        // parameter: the errors' variance is their sum of squares over 4 − 1, the
+        // mean included.
         let decay = Decay {
             t: vec![0.0, 0.5, 1.0, 1.5],
             y: vec![1.0, 0.5, 0.2, -0.1],
         };
+        let r0: Vec<f64> = vec![0.2, 0.1, 0.1, 0.2];
         let problem = Problem {
             names: vec!["Kw".into()],
             fit: vec![3.1e5],
@@ -552,10 +658,32 @@ mod tests {
             objective: &decay,
             settings: Settings::default(),
             parts: vec![("unbalance.json [unbalance_step]".into(), 4)],
+            held: &[],
         };
-        let e = problem.run(20, &|| false, &|| {}).unwrap_err().to_string();
+        let segments: Vec<Range<usize>> = std::iter::once(0..4).collect();
+        let centred = centre(&r0, &segments);
+        let e = problem.blocks(&centred, &r0, &segments).unwrap();
+        let Errors::Normal(sd) = e[0] else {
+            panic!("{e:?}")
+        };
+        assert!((sd - (0.1f64 / 3.0).sqrt()).abs() < 1e-15, "{sd}");
+        let d = draw(&centred, &segments, &e, 1);
+        assert_eq!(d.len(), 4);
+        assert!(d.iter().all(|x| !centred.contains(x)), "{d:?}");
+        let r = problem.run(6, &|| false, &|| {}).unwrap();
         assert!(
-            e.contains("unbalance.json [unbalance_step] has 4 residual(s)"),
+            r.method.contains("normal errors") && r.method.contains("unbalance.json"),
+            "{}",
+            r.method
+        );
+        // One residual for one fitted parameter says nothing of the errors.
+        let one: Vec<Range<usize>> = std::iter::once(0..1).collect();
+        let e = problem
+            .blocks(&[0.0], &[0.2], &one)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("unbalance.json [unbalance_step] has 1 residual(s)"),
             "{e}"
         );
     }
@@ -582,7 +710,7 @@ mod tests {
     fn a_draw_keeps_each_segment_within_itself() {
         let r: Vec<f64> = (0..30).map(|i| if i < 10 { 1.0 } else { -1.0 }).collect();
         let segments = vec![0..10, 10..30];
-        let d = draw(&r, &segments, &[3, 4], 5);
+        let d = draw(&r, &segments, &[Errors::Blocks(3), Errors::Blocks(4)], 5);
         assert_eq!(d.len(), 30);
         assert!(d[..10].iter().all(|&x| x == 1.0));
         assert!(d[10..].iter().all(|&x| x == -1.0));
@@ -590,10 +718,13 @@ mod tests {
 
     #[test]
     fn the_interval_is_moved_against_the_bias() {
-        let i = interval(1.0, &[1.1, 1.2, 1.3]);
+        let i = interval(1.0, &[1.1, 1.2, 1.3], true);
         assert!((i.bias - 0.2).abs() < 1e-12);
         assert!((i.standard_error - 0.1).abs() < 1e-12);
         assert!((i.lower - (0.8 - Z * 0.1)).abs() < 1e-12);
         assert!((i.upper - (0.8 + Z * 0.1)).abs() < 1e-12);
+        // Replicates that drew held parameters stand as they are: around their mean.
+        let held = interval(1.0, &[1.1, 1.2, 1.3], false);
+        assert!((held.lower - (1.2 - Z * 0.1)).abs() < 1e-12);
     }
 }

@@ -80,6 +80,7 @@ pub fn assemble(
         warnings: warnings.into_iter().map(Coded).collect(),
         profiles: None,
         resampling: None,
+        held: Vec::new(),
         comparisons: Vec::new(),
         provenance: None,
     }

@@ -2,6 +2,7 @@
 //! data, importing none of the steps that produce it.
 
 pub mod comparison;
+pub mod held;
 pub mod profile;
 pub mod resampling;
 pub mod starts;
@@ -15,6 +16,7 @@ use std::path::Path;
 use crate::io::provenance::Provenance;
 use crate::objectives::Detail;
 use comparison::Comparison;
+use held::Held;
 use profile::Profile;
 use resampling::Resampling;
 use starts::{StartEstimate, StartRecord};
@@ -116,6 +118,10 @@ pub struct IdentifyResult {
     /// values and each fitted parameter's interval.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resampling: Option<Resampling>,
+    /// With `--uncertain NAME=X%`: the held parameters' ranges and the fit's
+    /// response to each ([`crate::identify::intervals::held`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub held: Vec<Held>,
     /// Each experiment's data against the model at the start and identified values,
     /// in the experiment's axes (thinned for the file), for plots and reports.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
