@@ -524,6 +524,20 @@ fn held_ranges_go_from_the_identification_into_the_prediction() {
         held["shifts"]["Kw"].as_f64().unwrap() / fit["parameters"]["Kw"].as_f64().unwrap();
     assert!((0.15..0.3).contains(&kw_shift), "{kw_shift}");
 
+    let e = err(&rtid(
+        &[
+            "identify",
+            frf.to_str().unwrap(),
+            "--preset",
+            "worm-gear",
+            "--fit",
+            "Kw",
+            "--uncertain",
+            "Kw=10%",
+        ],
+        dir.path(),
+    ));
+    assert!(e.contains("--uncertain Kw=10%: Kw is fitted"), "{e}");
     let torque = root().join("fixtures/worm-gear/torque_curve.json");
     let e = err(&rtid(
         &[

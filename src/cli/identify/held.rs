@@ -1,7 +1,6 @@
 //! `rtid identify --uncertain`: how the fit follows the held parameters' ranges,
 //! computed after the fit, and its table.
 
-use anyhow::bail;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use rtid::identify::intervals::held;
 use rtid::identify::IdentifyResult;
@@ -18,10 +17,6 @@ pub fn add_held(
     params: &Params,
     fit: (&dyn Objective, Settings),
 ) -> anyhow::Result<()> {
-    if let Some((name, ..)) = ranges.iter().find(|r| result.parameters.contains_key(&r.0)) {
-        bail!("--uncertain {name}: {name} is fitted; its uncertainty is the fit's");
-    }
-
     let fit = held::Fit {
         result,
         params,

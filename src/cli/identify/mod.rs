@@ -521,6 +521,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let fit = (objective.as_ref(), settings, smoothness);
         add_profiles(names, &mut result, &params, fit, &monitor, a.quiet)?;
     }
+    if let Some((name, ..)) = held.iter().find(|h| result.parameters.contains_key(&h.0)) {
+        bail!("--uncertain {name}: {name} is fitted; its uncertainty is the fit's");
+    }
     if let Some(n) = a.resample {
         let fit = (objective.as_ref(), settings);
         add_resampling(

@@ -33,6 +33,8 @@ use crate::objectives::{Objective, ObjectiveError};
 pub enum HeldError {
     #[error("--uncertain: the fit was stopped before it converged")]
     Interrupted,
+    #[error("--uncertain {0}: {0} is fitted; its uncertainty is the fit's")]
+    Fitted(String),
     #[error("--uncertain: {0}")]
     Space(#[from] SpaceError),
     #[error("--uncertain {name}: the fit with {name} at {value:e} failed: {error}")]
@@ -58,6 +60,9 @@ pub fn shifts(fit: &Fit, held: &[(String, f64, f64)]) -> Result<Vec<Held>, HeldE
     use rayon::prelude::*;
     if fit.result.interrupted {
         return Err(HeldError::Interrupted);
+    }
+    if let Some((name, ..)) = (held.iter()).find(|h| fit.result.parameters.contains_key(&h.0)) {
+        return Err(HeldError::Fitted(name.clone()));
     }
     let names: Vec<String> = fit.result.parameters.keys().cloned().collect();
     let ends: Vec<(usize, f64)> = (0..held.len())

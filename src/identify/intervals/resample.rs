@@ -82,6 +82,8 @@ pub enum ResampleError {
         length: usize,
         fitted: usize,
     },
+    #[error("--uncertain {0}: {0} is fitted; its uncertainty is the fit's")]
+    HeldFitted(String),
     #[error("--resample: the objective cannot be evaluated at the result: {0}")]
     Objective(#[from] ObjectiveError),
 }
@@ -108,6 +110,9 @@ pub fn resample(request: &Request) -> Result<Resampling, ResampleError> {
         return Err(ResampleError::Interrupted);
     }
     let result = request.result;
+    if let Some((name, ..)) = (request.held.iter()).find(|h| result.parameters.contains_key(&h.0)) {
+        return Err(ResampleError::HeldFitted(name.clone()));
+    }
     let names: Vec<String> = result.parameters.keys().cloned().collect();
     let problem = Problem {
         fit: names.iter().map(|n| result.parameters[n]).collect(),
