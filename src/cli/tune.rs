@@ -135,6 +135,48 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    let plot = outputs(&a)?;
+    let mut p = crate::cli::common::model_args::fitted(&a.model, a.fit.as_deref(), None)?;
+    if let Some(mode) = a.loop_mode {
+        if mode != p.controller.loop_mode && !a.quiet {
+            eprintln!(
+                "note: --loop {mode} overrides the parameter set's controller.loop ({})",
+                p.controller.loop_mode
+            );
+        }
+        p.controller.loop_mode = mode;
+    }
+    let options = options(&a)?;
+    let bar = crate::cli::common::progress::bar(0, "weighing", a.quiet || a.json);
+    let t = tuning::tune(&p, &options, &|done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })?;
+    bar.finish_and_clear();
+    let forms = drive_forms(&a, &t.params)?;
+    if let Some(out) = &a.out {
+        params_file::write(out, &t.params)?;
+    }
+    for (path, text) in forms {
+        rtid::io::atomic::write(&path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if a.plot.is_some() {
+        write_plot(&plot, &p, &t)?;
+    }
+    if a.json {
+        println!("{}", rtid::io::json::pretty(&rtid::io::json::value(&t)?)?);
+    } else {
+        print_table(&p, &t);
+        print_check(&p, &t);
+        print_warnings(&p, &t);
+    }
+    Ok(())
+}
+
+/// The written files checked against the inputs and each other (none over another),
+/// and where the plot goes.
+fn outputs(a: &Args) -> anyhow::Result<Plot> {
     let read: Vec<&Path> = a
         .model
         .params
@@ -155,24 +197,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             written.push(path);
         }
     }
-    let plot = match &a.plot {
+    match &a.plot {
         Some(path) => {
             let mut inputs = read.clone();
             inputs.extend(a.out.as_deref());
-            Plot::at(path.clone(), &inputs)?
+            Plot::at(path.clone(), &inputs)
         }
-        None => Plot::none(),
-    };
-    let mut p = crate::cli::common::model_args::fitted(&a.model, a.fit.as_deref(), None)?;
-    if let Some(mode) = a.loop_mode {
-        if mode != p.controller.loop_mode && !a.quiet {
-            eprintln!(
-                "note: --loop {mode} overrides the parameter set's controller.loop ({})",
-                p.controller.loop_mode
-            );
-        }
-        p.controller.loop_mode = mode;
+        None => Ok(Plot::none()),
     }
+}
+
+/// The search's targets, objective and limits, the margins checked.
+fn options(a: &Args) -> anyhow::Result<Options> {
     if !(a.phase_margin_deg > 0.0 && a.phase_margin_deg < 180.0) {
         bail!(
             "--phase-margin-deg {}: a phase margin lies between 0° and 180°",
@@ -185,7 +221,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             Num(a.gain_margin_db)
         );
     }
-    let options = Options {
+    Ok(Options {
         targets: Targets {
             phase_margin_deg: a.phase_margin_deg,
             gain_margin_db: a.gain_margin_db,
@@ -198,49 +234,30 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             notch_min_width: a.notch_min_width,
         },
         torque_reserve: a.torque_reserve,
-    };
-    let bar = crate::cli::common::progress::bar(0, "weighing", a.quiet || a.json);
-    let t = tuning::tune(&p, &options, &|done, total| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
-    })?;
-    bar.finish_and_clear();
-    let forms = drive_forms(&a, &t.params)?;
-    if let Some(out) = &a.out {
-        params_file::write(out, &t.params)?;
-    }
-    for (path, text) in forms {
-        rtid::io::atomic::write(&path, text.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    if a.plot.is_some() {
-        let title = format!(
-            "{}: open loops on the sampled loop, opened at the torque setpoint ({} loop)",
-            p.name, t.loop_mode
-        );
-        let curves = [
-            ("velocity loop alone, before", bode::bode(&p, &t.before)?),
-            (
-                "velocity loop alone, after",
-                bode::bode(&t.params, &t.after)?,
-            ),
-            ("cascade as it runs, before", bode::cascade(&p, &t.before)?),
-            (
-                "cascade as it runs, after",
-                bode::cascade(&t.params, &t.after)?,
-            ),
-        ];
-        let named: Vec<(&str, &bode::Bode)> = curves.iter().map(|(n, b)| (*n, b)).collect();
-        let figure = rtid::report::tuning::open_loop(&named, &title);
-        plot.write(&figure, "")?;
-    }
-    if a.json {
-        println!("{}", rtid::io::json::pretty(&rtid::io::json::value(&t)?)?);
-    } else {
-        print_table(&p, &t);
-        print_check(&p, &t);
-        print_warnings(&p, &t);
-    }
+    })
+}
+
+/// The open loops before and after: the velocity loop alone and the cascade.
+fn write_plot(plot: &Plot, p: &rtid::Params, t: &Tuned) -> anyhow::Result<()> {
+    let title = format!(
+        "{}: open loops on the sampled loop, opened at the torque setpoint ({} loop)",
+        p.name, t.loop_mode
+    );
+    let curves = [
+        ("velocity loop alone, before", bode::bode(p, &t.before)?),
+        (
+            "velocity loop alone, after",
+            bode::bode(&t.params, &t.after)?,
+        ),
+        ("cascade as it runs, before", bode::cascade(p, &t.before)?),
+        (
+            "cascade as it runs, after",
+            bode::cascade(&t.params, &t.after)?,
+        ),
+    ];
+    let named: Vec<(&str, &bode::Bode)> = curves.iter().map(|(n, b)| (*n, b)).collect();
+    let figure = rtid::report::tuning::open_loop(&named, &title);
+    plot.write(&figure, "")?;
     Ok(())
 }
 

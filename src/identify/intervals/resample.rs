@@ -91,7 +91,7 @@ pub enum ResampleError {
 /// Fewer blocks than this in one experiment's residuals (an objective's, where an
 /// experiment feeds several) cannot stand for their errors: the unbalance test's
 /// four step angles, a frequency response's two resonances. Such a part's errors are
-/// drawn normal instead, of its residuals' RMS (a parametric bootstrap of that part).
+/// drawn normal instead (a parametric bootstrap of that part; `Problem::blocks`).
 pub const MIN_BLOCKS: usize = 10;
 
 /// How one part's errors are drawn.
@@ -99,8 +99,9 @@ pub const MIN_BLOCKS: usize = 10;
 enum Errors {
     /// The part's residuals in circular blocks of this length.
     Blocks(usize),
-    /// Normal errors of this standard deviation: the part's residuals' RMS, where
-    /// they are too few for blocks.
+    /// Normal errors of this standard deviation (the part's residuals' sum of
+    /// squares over their count less the fitted parameters), where they are too few
+    /// for blocks.
     Normal(f64),
 }
 
