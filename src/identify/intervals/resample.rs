@@ -366,9 +366,19 @@ impl Problem<'_> {
     /// residuals for blocks, and the held parameters' ranges.
     fn method(&self, errors: &[Errors]) -> String {
         let mut method = String::from("residual block bootstrap");
+        // The spread as a multiple of the part's residuals' RMS, √(m/(m − k)): the
+        // joint objective scales each part, so its own sd is in no unit of the record.
+        let k = self.names.len() as f64;
         let normal: Vec<String> = (errors.iter().enumerate())
             .filter_map(|(i, e)| match e {
-                Errors::Normal(sd) => Some(format!("{} (sd {sd:.3} of its scale)", self.part(i))),
+                Errors::Normal(_) => {
+                    let m = self.parts.get(i).map_or(f64::NAN, |p| p.1 as f64);
+                    let times = (m / (m - k)).sqrt();
+                    Some(format!(
+                        "{} (sd {times:.2} × its residuals' RMS)",
+                        self.part(i)
+                    ))
+                }
                 Errors::Blocks(_) => None,
             })
             .collect();
