@@ -354,7 +354,9 @@ fn the_servo_check_of_a_tuning_is_predicted() {
         "step_overshoot_percent",
     ] {
         let (at_fit, lo, hi) = predicted(&p, "after", name);
-        let want = checked["check"]["after"]["servo"][name].as_f64().unwrap();
+        let want = checked["check"]["after"]["members"][0]["servo"][name]
+            .as_f64()
+            .unwrap();
         assert!(
             (at_fit - want).abs() < 1e-9,
             "{name}: {at_fit} against {want}"
@@ -459,7 +461,9 @@ fn identify_tune_and_predict_a_tuning_in_a_chain() {
         "step_overshoot_percent",
     ] {
         let (at_fit, lo, hi) = predicted(&servo, "after", name);
-        let want = checked["check"]["after"]["servo"][name].as_f64().unwrap();
+        let want = checked["check"]["after"]["members"][0]["servo"][name]
+            .as_f64()
+            .unwrap();
         assert!(
             (at_fit - want).abs() < 1e-9,
             "{name}: {at_fit} against {want}"

@@ -12,7 +12,8 @@ use rtid::model::{presets, SetpointFilter};
 use rtid::tuning::sampled::{Closure, DiscretePlant, SampledLoop};
 use rtid::tuning::search::Grid;
 use rtid::tuning::{
-    rule, tune, Margins, Options, Setting, Targets, TuneWarning, Tuned, VelocityLoop, VelocityPi,
+    rule, tune, Criterion, Margins, Options, Setting, Targets, TuneWarning, Tuned, VelocityLoop,
+    VelocityPi, Verdict,
 };
 
 use crate::cli_support::{err, ok, root, rtid};
@@ -187,13 +188,14 @@ fn tuned(name: &str, mode: Option<LoopMode>) -> (rtid::Params, Tuned) {
 
 /// Every preset: the proposed cascade keeps the targets as it runs (stable, 50°,
 /// 6 dB both ways, no conditional window) with the margins an independent
-/// computation gives (within 1° and 0.3 dB), and every criterion it makes worse than
-/// today's carries a warning naming it; the worm gear positions as well and settles
-/// sooner (below).
+/// computation gives (within 1° and 0.3 dB); a proposal beats today's on the
+/// objective beyond the spread of its ensemble, and every criterion its ensemble
+/// makes worse than today's carries a warning naming it; the worm gear's reported A
+/// is what the documented chain gives (below).
 #[test]
 #[cfg_attr(
     not(feature = "slow-tests"),
-    ignore = "slow tier (about a minute): --features slow-tests"
+    ignore = "slow tier (about two minutes): --features slow-tests"
 )]
 fn the_tuned_presets_keep_the_targets_on_the_cascade_and_name_what_is_worse() {
     let expected = cascade_json("cascade-expected.json");
@@ -223,40 +225,87 @@ fn the_tuned_presets_keep_the_targets_on_the_cascade_and_name_what_is_worse() {
             "gain_reduction_margin_db",
             0.3,
         );
-        let worse = rtid::tuning::objective::worse(&t.check.after, &t.check.before);
-        for w in &worse {
+        let j = &t.check.judgement;
+        assert_eq!(j.members, 8, "{name}");
+        for c in j.worse() {
             assert!(
-                t.warnings.contains(&TuneWarning::Worse(*w)),
-                "{name}: {w:?} not warned"
+                t.warnings
+                    .iter()
+                    .any(|w| matches!(w, TuneWarning::Worse(w) if w.criterion == c.criterion)),
+                "{name}: {c:?} not warned"
             );
         }
-        if name == "worm-gear" {
-            worm_gear_positions_as_well_and_settles_sooner(&p, &t);
+        if t.proposes {
+            assert_eq!(j.score.verdict, Verdict::Better, "{name}: {j:?}");
+            assert!(t.search.check_score + t.search.check_score_half_width < 1.0);
+        } else {
+            assert!(t
+                .warnings
+                .iter()
+                .any(|w| matches!(w, TuneWarning::NothingBetter { .. })));
         }
-        assert!(
-            t.search.check_score < 1.0 || !t.proposes,
-            "{name}: {:?}",
-            t.search
-        );
+        if name == "worm-gear" {
+            worm_gear_reports_what_the_documented_chain_gives(&p, &t);
+        }
     }
 }
 
-/// The worm gear, semi-closed (issue 51): with the tuned settings and a compensation
-/// built for them, ISO 230-2 A at most 1.1 times the preset's with its own, and the
-/// table settles a 1° step within 20″ sooner; no limit cycle.
-fn worm_gear_positions_as_well_and_settles_sooner(p: &rtid::Params, t: &Tuned) {
-    assert!(t.proposes);
-    let (b, a) = (&t.check.before, &t.check.after);
-    assert!(
-        a.positioning.a <= 1.1 * b.positioning.a,
-        "A {} → {}″",
-        b.positioning.a,
-        a.positioning.a
-    );
-    let settle = |c: &rtid::tuning::Criteria| c.servo.table_settling_s.unwrap();
-    assert!(settle(a) < settle(b), "{} → {} s", settle(b), settle(a));
-    let cycle = rtid::tuning::limit_cycle_threshold(p);
-    assert!(a.servo.table_motion_at_rest < cycle, "{:?}", a.servo);
+/// The worm gear, semi-closed (issue 58): where the axis comes to rest in stick
+/// decides A after compensation (0.1″ changes of the compensation move it by 1″), so
+/// `tune` reports each setting's ensemble. The documented chain — the standard cycle,
+/// the compensation built from it, the compensated cycle with the compensation's
+/// backlash changed by −1e-12°, +1e-11°, …, −1e-6° (seven runs, the opposite signs
+/// of the ensemble's own) — gives means within 0.5″ of what `tune` reports, before
+/// and after; and `tune` claims A better (or worse) only where those seven runs agree
+/// (paired, beyond the half-width of their 95 % interval). No limit cycle.
+fn worm_gear_reports_what_the_documented_chain_gives(p: &rtid::Params, t: &Tuned) {
+    use rayon::prelude::*;
+    use rtid::experiments::positioning::{self, compensate, iso230, PositioningTest};
+    let chain = |q: &rtid::Params| -> Vec<f64> {
+        let test = PositioningTest::default();
+        let first = positioning::run(q, &test, |_, _| {}).unwrap();
+        let built = compensate::compute(&first, q.axis, None)
+            .unwrap()
+            .compensation;
+        (0..7)
+            .into_par_iter()
+            .map(|k| {
+                let sign = if k % 2 == 0 { -1.0 } else { 1.0 };
+                let offset = sign * 10f64.powi(k - 12).to_radians();
+                let mut c = built.clone();
+                c.backlash = Some(c.backlash.unwrap() + offset);
+                let test = PositioningTest {
+                    compensation: c,
+                    ..test.clone()
+                };
+                let readings = positioning::run(q, &test, |_, _| {}).unwrap();
+                iso230::evaluate(&readings).unwrap().axis.in_arcsec().a
+            })
+            .collect()
+    };
+    let (before, after) = rayon::join(|| chain(p), || chain(&t.params));
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let reported = t.check.judgement.of(Criterion::Accuracy);
+    for (which, runs, spread) in [
+        ("before", &before, &reported.before),
+        ("after", &after, &reported.after),
+    ] {
+        assert!(
+            (mean(runs) - spread.mean).abs() <= 0.5,
+            "{which}: tune reports A {:.2}″, the chain's seven runs {runs:?} (mean {:.2}″)",
+            spread.mean,
+            mean(runs)
+        );
+    }
+    let chain_verdict = rtid::tuning::judge::compare(&before, &after, 0.0).verdict;
+    if reported.verdict != Verdict::NoDifferent {
+        assert_eq!(
+            reported.verdict, chain_verdict,
+            "tune: {reported:?}; the chain: {before:?} → {after:?}"
+        );
+    }
+    let a = &t.check.after.members[0];
+    assert!(a.servo.table_motion_at_rest < rtid::tuning::limit_cycle_threshold(p));
     assert_eq!(a.positioning.compensated_in, "controller");
 }
 
@@ -270,10 +319,12 @@ fn worm_gear_positions_as_well_and_settles_sooner(p: &rtid::Params, t: &Tuned) {
 fn the_tuned_full_closed_worm_gear_holds_the_table() {
     let (p, t) = tuned("worm-gear", Some(LoopMode::FullClosed));
     assert_eq!(t.loop_mode, LoopMode::FullClosed);
-    let a = &t.check.after;
-    assert!(a.positioning.a <= 1.0, "A {}″", a.positioning.a);
+    let a = t.check.judgement.of(Criterion::Accuracy).after;
+    assert!(a.max <= 1.0, "A {a:?}″");
     let cycle = rtid::tuning::limit_cycle_threshold(&p);
-    assert!(a.servo.table_motion_at_rest < cycle, "{:?}", a.servo);
+    for m in &t.check.after.members {
+        assert!(m.servo.table_motion_at_rest < cycle, "{:?}", m.servo);
+    }
     assert!(t.after.cascade.meets(50.0, 6.0));
 }
 

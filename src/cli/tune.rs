@@ -9,13 +9,14 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use crate::cli::common::inputs::refuse_overwrite;
 use crate::cli::common::plot::Plot;
 use crate::cli::ModelArgs;
+use rtid::experiments::positioning::ensemble;
 use rtid::io::params_file;
 use rtid::model::params::LoopMode;
 use rtid::model::Axis;
 use rtid::names::Num;
 use rtid::tuning::{
-    self, bode, objective, verify, Criterion, Limits, LoopMargins, Objective, Options, Setting,
-    Targets, TuneWarning, Tuned,
+    self, bode, objective, verify, Compared, Criterion, Limits, LoopMargins, Objective, Options,
+    Range, Setting, Targets, TuneWarning, Tuned, Vary, Verdict,
 };
 
 pub const LONG_ABOUT: &str = "\
@@ -100,6 +101,20 @@ pub struct Args {
     /// The fraction of the torque limit the move at speed must leave free (0 to 0.9).
     #[arg(long, value_name = "FRACTION", default_value_t = 0.2)]
     pub torque_reserve: f64,
+    /// A parameter of the machine as it may be, as ratios of its value (repeatable):
+    /// the targets must hold at the range's corners and worst case, e.g. Jt=0.5..2
+    /// for a table loaded from half to twice the model's inertia.
+    #[arg(long = "vary", value_name = "NAME=LOW..HIGH", value_parser = vary)]
+    pub vary: Vec<Vary>,
+    /// Control periods of delay the loop may have beyond the model's (0 to N, added
+    /// to the encoder's dead time): the targets must hold with each.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub delay_periods: u32,
+    /// Runs in each ensemble the check weighs a setting by (1 to 256): the standard
+    /// ISO 230-2 cycle and the servo's step and move, perturbed by sub-count offsets
+    /// that do not change the machine.
+    #[arg(long, value_name = "N", default_value_t = ensemble::DEFAULT_MEMBERS)]
+    pub ensemble: usize,
     /// Print JSON (targets, resonances, before, after, search, check, warnings)
     /// instead of tables.
     #[arg(long)]
@@ -109,7 +124,8 @@ pub struct Args {
     pub out: Option<PathBuf>,
     /// Write the open loops' Bode plot — the velocity loop alone and the cascade as
     /// it runs, before and after tuning — with the margins marked (SVG; never over an
-    /// input or the -o file).
+    /// input or the -o file), and beside it (FILE-closed.svg) the loops closed: the
+    /// speed and position loops' gains and the cascade's sensitivity |S|.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
     /// Write the tuned settings as a commented SINAMICS parameter list: p1460
@@ -146,14 +162,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         p.controller.loop_mode = mode;
     }
-    let options = options(&a)?;
+    let options = options(&a, &p)?;
     let bar = crate::cli::common::progress::bar(0, "weighing", a.quiet || a.json);
     let t = tuning::tune(&p, &options, &|done, total| {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
     })?;
     bar.finish_and_clear();
-    let forms = drive_forms(&a, &t.params)?;
+    let forms = drive_forms(&a, &t)?;
     if let Some(out) = &a.out {
         params_file::write(out, &t.params)?;
     }
@@ -207,8 +223,9 @@ fn outputs(a: &Args) -> anyhow::Result<Plot> {
     }
 }
 
-/// The search's targets, objective and limits, the margins checked.
-fn options(a: &Args) -> anyhow::Result<Options> {
+/// The search's targets, objective, limits, range and ensemble (the library checks
+/// the range against `p` and the ensemble's size).
+fn options(a: &Args, p: &rtid::Params) -> anyhow::Result<Options> {
     if !(a.phase_margin_deg > 0.0 && a.phase_margin_deg < 180.0) {
         bail!(
             "--phase-margin-deg {}: a phase margin lies between 0° and 180°",
@@ -234,6 +251,37 @@ fn options(a: &Args) -> anyhow::Result<Options> {
             notch_min_width: a.notch_min_width,
         },
         torque_reserve: a.torque_reserve,
+        range: range(a, p),
+        ensemble: ensemble::Ensemble {
+            members: a.ensemble,
+        },
+    })
+}
+
+/// The range of machines: `--vary` and `--delay-periods`, or the parameter set's
+/// own where neither is given.
+fn range(a: &Args, p: &rtid::Params) -> Range {
+    if a.vary.is_empty() && a.delay_periods == 0 {
+        tuning::range::default_range(p)
+    } else {
+        Range {
+            vary: a.vary.clone(),
+            delay_periods: a.delay_periods,
+        }
+    }
+}
+
+/// `NAME=LOW..HIGH`: a parameter's ratios.
+fn vary(s: &str) -> Result<Vary, String> {
+    let bad =
+        || format!("{s:?}: give NAME=LOW..HIGH, ratios of the parameter's value, e.g. Jt=0.5..2");
+    let (name, ratios) = s.split_once('=').ok_or_else(bad)?;
+    let (low, high) = ratios.split_once("..").ok_or_else(bad)?;
+    let number = |x: &str| x.trim().parse::<f64>().map_err(|_| bad());
+    Ok(Vary {
+        name: name.trim().to_string(),
+        low: number(low)?,
+        high: number(high)?,
     })
 }
 
@@ -258,6 +306,14 @@ fn write_plot(plot: &Plot, p: &rtid::Params, t: &Tuned) -> anyhow::Result<()> {
     let named: Vec<(&str, &bode::Bode)> = curves.iter().map(|(n, b)| (*n, b)).collect();
     let figure = rtid::report::tuning::open_loop(&named, &title);
     plot.write(&figure, "")?;
+    let (before, after) = (
+        bode::closed(p, &t.before)?,
+        bode::closed(&t.params, &t.after)?,
+    );
+    let title = format!("{}: the loops closed ({} loop)", p.name, t.loop_mode);
+    let figure =
+        rtid::report::tuning::closed_loops(&[("before", &before), ("after", &after)], &title);
+    plot.write(&figure, "-closed")?;
     Ok(())
 }
 
@@ -274,9 +330,13 @@ fn gear_ratio(s: &str) -> Result<(u64, u64), String> {
 
 /// The drive forms asked for, as (path, text), made before anything is written so
 /// that a missing quantity writes nothing.
-fn drive_forms(a: &Args, p: &rtid::Params) -> anyhow::Result<Vec<(PathBuf, String)>> {
+fn drive_forms(a: &Args, t: &Tuned) -> anyhow::Result<Vec<(PathBuf, String)>> {
     use rtid::io::drive_settings::{sinamics, sinumerik, ServoSettings};
-    let s = ServoSettings::from_params(p);
+    let s = ServoSettings {
+        equivalent_time_s: t.after.closed_loop.equivalent_time_s,
+        speed_bandwidth_hz: t.after.closed_loop.speed_bandwidth_hz,
+        ..ServoSettings::from_params(&t.params)
+    };
     let mut out = Vec::new();
     if let Some(path) = &a.sinamics {
         let text = sinamics::program(&s, &sinamics::SinamicsContext::default())
@@ -384,12 +444,99 @@ fn print_table(p: &rtid::Params, t: &Tuned) {
     table.add_row(row("position loop: peak", &|s| {
         format!("{:.2} dB", s.position_peak_db)
     }));
+    let bandwidth = |f: Option<f64>, peak: f64| {
+        format!(
+            "{}, peak {peak:+.2} dB",
+            f.map_or("none below Nyquist".into(), |f| format!("{f:.1} Hz"))
+        )
+    };
+    table.add_row(row("closed speed loop: −3 dB bandwidth", &|s| {
+        bandwidth(
+            s.closed_loop.speed_bandwidth_hz,
+            s.closed_loop.speed_peak_db,
+        )
+    }));
+    table.add_row(row("  equivalent time constant (MD32810)", &|s| {
+        s.closed_loop
+            .equivalent_time_s
+            .map_or("none".into(), |t| format!("{:.3} ms", 1e3 * t))
+    }));
+    table.add_row(row("closed position loop: −3 dB bandwidth", &|s| {
+        bandwidth(
+            s.closed_loop.position_bandwidth_hz,
+            s.closed_loop.position_peak_db,
+        )
+    }));
+    table.add_row(row("sensitivity |S|max", &|s| {
+        let c = &s.closed_loop;
+        format!(
+            "{:.2} dB at {:.1} Hz",
+            c.sensitivity_peak_db, c.sensitivity_peak_hz
+        )
+    }));
+    if let (Some(_), Some(_)) = (&b.over_range, &a.over_range) {
+        add_range_rows(&mut table, t);
+    }
     println!("{table}");
     let s = &t.search;
+    let machines = if s.machines > 1 {
+        format!(" at each of {} machines of the range", s.machines)
+    } else {
+        String::new()
+    };
+    let corners = if s.corners > 0 {
+        format!(", at the range's {} corners too", s.corners)
+    } else {
+        String::new()
+    };
     println!(
-        "search ({}): {} settings tried on the cascade, {} within the targets; {} weighed on the nonlinear model (today's among them; {} refused: a limit cycle or the torque reserve), {} checked on the standard cycle; {:.1} s",
-        t.objective, s.tried, s.within_margins, s.screened, s.refused, s.checked, s.wall_s
+        "search ({}): {} settings tried on the cascade, {} within the targets{machines}; {} weighed on the nonlinear model (today's among them{corners}; {} refused: a limit cycle or the torque reserve), {} checked with today's on the standard cycle as ensembles of {}; {:.1} s",
+        t.objective, s.tried, s.within_margins, s.screened, s.refused, s.checked, s.members, s.wall_s
     );
+}
+
+/// The worst case of both settings over the range.
+fn add_range_rows(table: &mut Table, t: &Tuned) {
+    let worst = |s: &Setting| s.over_range.clone().expect("over a range");
+    let (b, a) = (worst(&t.before), worst(&t.after));
+    let at = |m: &Option<(f64, String)>, unit: &str| {
+        m.as_ref()
+            .map_or("none".into(), |(v, w)| format!("{v:.1}{unit} at {w}"))
+    };
+    let mut row = |label: String, f: &dyn Fn(&tuning::range::OverRange) -> String| {
+        table.add_row(vec![label, f(&b), f(&a)]);
+    };
+    row(
+        format!(
+            "over the range ({}; {} machines): worst phase margin",
+            t.range.summary(),
+            b.points
+        ),
+        &|w| at(&w.phase_margin_deg, "°"),
+    );
+    row("  worst gain margin (increase)".into(), &|w| {
+        at(&w.gain_margin_db, " dB")
+    });
+    row("  worst gain margin (reduction)".into(), &|w| {
+        at(&w.gain_reduction_margin_db, " dB")
+    });
+    row("  unstable or conditionally stable at".into(), &|w| {
+        let all: Vec<String> = w
+            .unstable_at
+            .iter()
+            .map(|x| format!("unstable at {x}"))
+            .chain(
+                w.conditional_at
+                    .iter()
+                    .map(|x| format!("conditional at {x}")),
+            )
+            .collect();
+        if all.is_empty() {
+            "none".into()
+        } else {
+            all.join("\n")
+        }
+    });
 }
 
 /// `stable`, `UNSTABLE`, or the conditional window.
@@ -404,68 +551,108 @@ fn stability(m: &LoopMargins) -> String {
     }
 }
 
-/// Both settings on the standard cycle and the servo's responses.
+/// Both settings on the standard cycle and the servo's responses, as ensembles: each
+/// figure's mean ± standard deviation over the members, and the paired difference
+/// with the half-width of its 95 % interval and the verdict.
 fn print_check(p: &rtid::Params, t: &Tuned) {
     let (before, after) = (&t.check.before, &t.check.after);
-    let u = before.servo.unit;
+    let (Some(b0), Some(a0)) = (before.members.first(), after.members.first()) else {
+        return;
+    };
+    let u = b0.servo.unit;
     let effort = if p.axis == Axis::Rotary { "N·m" } else { "N" };
     println!(
-        "on the nonlinear model (backlash, friction, quantised encoders, torque limit), {} loop: the ISO 230-2 cycle ({} targets, {} runs) with the compensation built for each setting run in the controller; a {} step and a move {} out and back",
+        "on the nonlinear model (backlash, friction, quantised encoders, torque limit), {} loop: the ISO 230-2 cycle ({} targets, {} runs) with the compensation built for each setting (from its first cycle) run in the controller, a {} step read at the table on the axis so compensated, and a move {} out and back; each an ensemble of {} runs (sub-count offsets of the compensation and of the rest position), mean ± standard deviation, the difference paired run by run ± the half-width of its 95 % interval",
         t.loop_mode,
-        before.positioning.targets,
-        before.positioning.runs,
+        b0.positioning.targets,
+        b0.positioning.runs,
         if u == "″" { "1°" } else { "1 mm" },
         if u == "″" { "5° at 10°/s" } else { "5 mm at 10 mm/s" },
+        t.check.ensemble.members,
     );
     let mut table = Table::new();
     table.load_preset(UTF8_FULL_CONDENSED);
-    table.set_header(vec!["", "before", "after"]);
+    table.set_header(vec!["", "before", "after", "after − before"]);
     let fmt = |x: f64| format!("{x:.2}");
-    table.add_row(vec![
-        format!("ISO 230-2 A uncompensated ({u})"),
-        fmt(before.positioning.a_uncompensated),
-        fmt(after.positioning.a_uncompensated),
-    ]);
-    table.add_row(vec![
-        format!("ISO 230-2 B̄ uncompensated ({u})"),
-        fmt(before.positioning.b_mean_uncompensated),
-        fmt(after.positioning.b_mean_uncompensated),
-    ]);
+    let first = |label: String, f: &dyn Fn(&tuning::Criteria) -> f64| {
+        vec![
+            label,
+            fmt(f(b0)),
+            fmt(f(a0)),
+            "(first cycle: one run)".into(),
+        ]
+    };
+    table.add_row(first(format!("ISO 230-2 A uncompensated ({u})"), &|c| {
+        c.positioning.a_uncompensated
+    }));
+    table.add_row(first(format!("ISO 230-2 B̄ uncompensated ({u})"), &|c| {
+        c.positioning.b_mean_uncompensated
+    }));
+    let spread = |c: &tuning::Checked, f: &dyn Fn(&tuning::Criteria) -> f64| {
+        ensemble::Spread::of(&c.members.iter().map(f).collect::<Vec<_>>())
+    };
+    let b_mean = |c: &tuning::Checked| spread(c, &|m| m.positioning.b_mean);
     table.add_row(vec![
         format!("ISO 230-2 B̄ after compensation ({u})"),
-        fmt(before.positioning.b_mean),
-        fmt(after.positioning.b_mean),
+        with_sd(&b_mean(before)),
+        with_sd(&b_mean(after)),
+        String::new(),
     ]);
     for k in objective::ALL {
         let unit = k.unit(u, effort);
-        let show = |c: &tuning::Criteria| match (k, c.servo.table_settling_s) {
-            (Criterion::TableSettling, None) => "not within 1 s".to_string(),
-            (Criterion::TableSettling, Some(s)) => format!("{:.0} ms", s * 1e3),
-            _ => fmt(k.value(c)),
-        };
         let label = if k == Criterion::TableSettling {
             let gap = if u == "″" { "" } else { " " };
-            format!("{} within {}{gap}{u}", k.label(), verify::SETTLED)
+            format!("{} within {}{gap}{u} (s)", k.label(), verify::SETTLED)
         } else {
             format!("{} ({unit})", k.label())
         };
-        table.add_row(vec![label, show(before), show(after)]);
+        let c = t.check.judgement.of(k);
+        table.add_row(vec![
+            label,
+            with_sd(&c.before),
+            with_sd(&c.after),
+            difference(c),
+        ]);
     }
+    let score = &t.check.judgement.score;
     table.add_row(vec![
-        format!("step overshoot, motor × ratio (%)"),
-        fmt(before.servo.step_overshoot_percent),
-        fmt(after.servo.step_overshoot_percent),
+        format!("score, {} objective (today's 1)", t.objective),
+        with_sd(&score.before),
+        with_sd(&score.after),
+        difference(score),
+    ]);
+    table.add_row(vec![
+        "step overshoot, motor × ratio (%)".into(),
+        fmt(b0.servo.step_overshoot_percent),
+        fmt(a0.servo.step_overshoot_percent),
+        "(unperturbed run)".into(),
     ]);
     table.add_row(vec![
         format!("peak torque, step command ({effort})"),
-        fmt(before.servo.peak_effort),
-        fmt(after.servo.peak_effort),
+        fmt(b0.servo.peak_effort),
+        fmt(a0.servo.peak_effort),
+        "(unperturbed run)".into(),
     ]);
     println!("{table}");
 }
 
+/// `3.52 ± 0.33`.
+fn with_sd(s: &ensemble::Spread) -> String {
+    format!("{:.2} ± {:.2}", s.mean, s.sd)
+}
+
+/// `−0.74 ± 0.45: better`.
+fn difference(c: &Compared) -> String {
+    let verdict = match c.verdict {
+        Verdict::Better => "better",
+        Verdict::Worse => "worse",
+        Verdict::NoDifferent => "no different (within the spread)",
+    };
+    format!("{:+.2} ± {:.2}: {verdict}", c.difference, c.half_width)
+}
+
 fn print_warnings(p: &rtid::Params, t: &Tuned) {
-    let u = t.check.before.servo.unit;
+    let u = rtid::experiments::positioning::iso230::ReportUnits::of(p.axis).deviation;
     let effort = if p.axis == Axis::Rotary { "N·m" } else { "N" };
     for w in &t.warnings {
         println!("warning: {}", warning_text(w, t.objective, u, effort));
@@ -490,14 +677,30 @@ fn warning_text(
                 w.after - w.before
             )
         }
-        TuneWarning::NothingBetter { best_check_score } => format!(
-            "no setting within the targets beats today's on the {} objective{}: today's settings are kept",
+        TuneWarning::NothingBetter {
+            best_check_score,
+            half_width,
+        } => format!(
+            "no setting within the targets beats today's on the {} objective beyond the spread of its ensemble{}: today's settings are kept",
             objective,
-            best_check_score.map_or(String::new(), |s| format!(" (the best checked scores {s:.3} against today's 1)"))
+            best_check_score.zip(*half_width).map_or(String::new(), |(s, h)| format!(
+                " (the best checked scores {s:.3} ± {h:.3} against today's 1)"
+            ))
         ),
-        TuneWarning::TodayOutsideTargets => {
-            "today's cascade does not keep the targets (see its margins)".into()
+        TuneWarning::TodayOutsideTargets { replaced: true } => {
+            "today's cascade does not keep the targets (see its margins): it is replaced by the best setting that does".into()
         }
+        TuneWarning::TodayOutsideTargets { replaced: false } => {
+            "today's cascade does not keep the targets (see its margins), and no setting that does could be checked".into()
+        }
+        TuneWarning::TorqueLimit {
+            setting,
+            test,
+            peak,
+            limit,
+        } => format!(
+            "{setting}: the {test} reaches the torque limit ({peak:.3} of {limit:.3} {effort}): the output saturates"
+        ),
     }
 }
 

@@ -19,6 +19,12 @@
 //!                                              output_delay_periods = 1
 //! ```
 //!
+//! The position loop (its error, the feed-forward, the compensations, ω*) runs every
+//! N-th sample, N = position_period_s/Tc (SINUMERIK's position-control cycle; 1 by
+//! default), ω* held between. With a current loop lag T_i > 0 the torque follows
+//! the output through a first-order lag sampled at Tc:
+//! T_k = T_{k−1} + (1 − e^{−Tc/T_i})·(drive_gain·u − T_{k−1}).
+//!
 //! On a linear axis read m for rad. `torque_limit` is the output's limit in the
 //! output's own unit (N·m for a torque command, V or A with a drive gain). With the
 //! defaults (Kpi = 0, drive_gain = 1, no delay, nothing added) this is the controller
@@ -89,10 +95,15 @@ pub struct Gains {
     pub kvff: f64,
     /// Torque feed-forward, output per motor rad/s² (m/s²).
     pub kaff: f64,
-    /// The symmetrising lag's factor 1 − e^{−Tc/T} (0: none).
+    /// The symmetrising lag's factor 1 − e^{−Tp/T} at the position cycle Tp (0: none).
     pub symmetrising: f64,
     /// The torque-setpoint filters, at rest.
     pub filters: FilterChain,
+    /// Control periods per position-controller cycle (1: every period).
+    pub position_every: u32,
+    /// The current loop's lag factor 1 − e^{−Tc/T_i} (0: none, the torque follows at
+    /// once).
+    pub current_lag: f64,
 }
 
 impl Gains {
@@ -126,12 +137,24 @@ impl Gains {
             kvff: c.kvff,
             kaff: c.kaff,
             symmetrising: if c.symmetrising_s > 0.0 {
-                -(-c.tc / c.symmetrising_s).exp_m1()
+                let tp = c.tc * f64::from(c.position_every());
+                -(-tp / c.symmetrising_s).exp_m1()
             } else {
                 0.0
             },
             filters: FilterChain::new(&c.filters, c.tc),
+            position_every: c.position_every(),
+            current_lag: if c.current_lag_s > 0.0 {
+                -(-c.tc / c.current_lag_s).exp_m1()
+            } else {
+                0.0
+            },
         })
+    }
+
+    /// The position controller's cycle, s.
+    pub fn position_period(&self) -> f64 {
+        self.tc * f64::from(self.position_every)
     }
 
     /// Whether the controller derives anything from the reference's motion (feed-
@@ -170,6 +193,13 @@ pub struct Controller {
     reference: ReferenceMotion,
     filters: FilterChain,
     compensation: Compensation,
+    /// Samples since the position loop last ran, modulo its cycle.
+    tick: u32,
+    /// The speed command and the torque feed-forward the position loop holds.
+    speed_command: f64,
+    torque_ff: f64,
+    /// The torque the current loop's lag has reached (with a lag).
+    lagged_torque: f64,
 }
 
 impl Controller {
@@ -190,6 +220,10 @@ impl Controller {
             reference: ReferenceMotion::default(),
             filters: gains.filters,
             compensation: Compensation::default(),
+            tick: 0,
+            speed_command: 0.0,
+            torque_ff: 0.0,
+            lagged_torque: 0.0,
         }
     }
 
@@ -256,19 +290,23 @@ impl Controller {
         self.history[self.head] = motor_angle;
         let motor = quantise(self.delayed_motor_angle(), g.motor_quantum);
         self.table_reading = quantise(table_angle, g.table_quantum);
-        let (position, speed_ff, torque_ff) = if self.shaping() {
-            self.shaped(reference)
-        } else {
-            (reference, 0.0, 0.0)
-        };
-        let error = match g.loop_mode {
-            LoopMode::SemiClosed => position / g.ratio - motor,
-            LoopMode::FullClosed => (position - self.table_reading) / g.ratio,
-        };
-        let speed_command = self.position_loop(error, speed_ff);
+        if self.tick == 0 {
+            let (position, speed_ff, torque_ff) = if self.shaping() {
+                self.shaped(reference)
+            } else {
+                (reference, 0.0, 0.0)
+            };
+            let error = match g.loop_mode {
+                LoopMode::SemiClosed => position / g.ratio - motor,
+                LoopMode::FullClosed => (position - self.table_reading) / g.ratio,
+            };
+            self.speed_command = self.position_loop(error, speed_ff);
+            self.torque_ff = torque_ff;
+        }
+        self.tick = (self.tick + 1) % g.position_every;
         let speed = (motor - self.previous_motor) / g.tc;
         self.previous_motor = motor;
-        let output = self.velocity_loop(speed_command - speed, torque_ff);
+        let output = self.velocity_loop(self.speed_command - speed, self.torque_ff);
         self.hold(output)
     }
 
@@ -282,7 +320,7 @@ impl Controller {
     /// compensation (output units) at reference `r`.
     fn shaped(&mut self, r: f64) -> (f64, f64, f64) {
         let g = self.gains;
-        let motion: Motion = self.reference.sample(r, g.tc, g.ratio);
+        let motion: Motion = self.reference.sample(r, g.position_period(), g.ratio);
         let c = &self.compensation;
         let mut position = r + c.position_offset(r, motion.downwards);
         if g.symmetrising != 0.0 {
@@ -306,7 +344,7 @@ impl Controller {
             let command = if ff != 0.0 { command + ff } else { command };
             return command.clamp(-g.speed_limit, g.speed_limit);
         }
-        let integral = self.position_integral + g.tc * error;
+        let integral = self.position_integral + g.position_period() * error;
         let unlimited = g.kpp * error + g.kpi * integral;
         let unlimited = if ff != 0.0 { unlimited + ff } else { unlimited };
         let command = unlimited.clamp(-g.speed_limit, g.speed_limit);
@@ -341,14 +379,22 @@ impl Controller {
         output
     }
 
-    /// Puts `output` on the D/A now, or after one sample; returns the torque applied.
+    /// Puts `output` on the D/A now, or after one sample; returns the torque applied
+    /// (through the current loop's lag, with one).
     fn hold(&mut self, output: f64) -> f64 {
-        self.output = if self.gains.one_sample_late {
+        let g = &self.gains;
+        self.output = if g.one_sample_late {
             std::mem::replace(&mut self.pending, output)
         } else {
             output
         };
-        self.torque = self.gains.drive_gain * self.output;
+        let torque = g.drive_gain * self.output;
+        self.torque = if g.current_lag > 0.0 {
+            self.lagged_torque += g.current_lag * (torque - self.lagged_torque);
+            self.lagged_torque
+        } else {
+            torque
+        };
         self.torque
     }
 
@@ -519,6 +565,46 @@ mod tests {
             (second - first - g.kvp * g.kpi * g.tc * e).abs() < 1e-9,
             "{first} {second}"
         );
+    }
+
+    #[test]
+    fn a_slower_position_cycle_holds_the_speed_command_between_its_samples() {
+        let mut p = presets::load("direct-drive").unwrap();
+        (p.controller.motor_encoder_counts, p.controller.kvi) = (0.0, 0.0);
+        p.controller.position_period_s = 4.0 * p.controller.tc;
+        let g = Gains::new(&p).unwrap();
+        assert_eq!(g.position_every, 4);
+        let mut c = Controller::new(g, 0.0, 0.0);
+        // The reference moves every sample; the position loop sees it every fourth:
+        // u = Kvp·(ω* − ω) with ω* = Kpp·e at the last position sample, the motor
+        // held at 0.
+        let outputs: Vec<f64> = (0..8)
+            .map(|k| c.update(1e-5 * k as f64, 0.0, 0.0))
+            .collect();
+        let u = |e: f64| g.kvp * g.kpp * e;
+        for (k, out) in outputs.iter().enumerate() {
+            let sampled = 1e-5 * (4 * (k / 4)) as f64;
+            assert!(
+                (out - u(sampled)).abs() < 1e-9,
+                "sample {k}: {out} vs {}",
+                u(sampled)
+            );
+        }
+    }
+
+    #[test]
+    fn the_current_loop_lags_the_torque_behind_the_output() {
+        let mut p = presets::load("direct-drive").unwrap();
+        (p.controller.motor_encoder_counts, p.controller.kvi) = (0.0, 0.0);
+        p.controller.current_lag_s = 2.0 * p.controller.tc;
+        let g = Gains::new(&p).unwrap();
+        let mut c = Controller::new(g, 0.0, 0.0);
+        let a = 1.0 - (-0.5f64).exp();
+        let first = c.update(1e-6, 0.0, 0.0);
+        let u = c.output() * g.drive_gain;
+        assert!((first - a * u).abs() < 1e-12, "{first} vs {}", a * u);
+        let second = c.update(1e-6, 0.0, 0.0);
+        assert!((second - (first + a * (u - first))).abs() < 1e-12);
     }
 
     #[test]

@@ -75,6 +75,19 @@ impl Params {
             });
         }
         let c = &self.controller;
+        let periods = c.position_period_s / c.tc;
+        if c.position_period_s > 0.0
+            && (periods < 1.0 - 1e-9 || (periods - periods.round()).abs() > 1e-6)
+        {
+            return Err(ParamError::Inconsistent {
+                name: "position_period_s",
+                value: c.position_period_s,
+                reason: format!(
+                    "the position controller's cycle is a whole number of control periods Tc = {} s (0: every period)",
+                    Num(c.tc)
+                ),
+            });
+        }
         if c.motor_encoder_counts > 0.0 && c.motor_encoder_resolution > 0.0 {
             return Err(ParamError::Inconsistent {
                 name: "motor_encoder_resolution",

@@ -198,9 +198,29 @@ pub struct ControllerParams {
     /// Filters on the torque (current) setpoint, in series (none by default).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub filters: Vec<SetpointFilter>,
+    /// The current (torque) loop's closed-loop lag, s: a first-order lag of this time
+    /// constant between the controller's output and the torque, sampled at Tc
+    /// (0, the default: the torque follows the output at once).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub current_lag_s: f64,
+    /// The position controller's own cycle, s (SINUMERIK's position-control cycle): a
+    /// whole number of control periods, the speed command held between (0, the
+    /// default: every control period).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub position_period_s: f64,
 }
 
 impl ControllerParams {
+    /// Control periods per position-controller cycle: `position_period_s`/Tc rounded
+    /// (1 for 0).
+    pub fn position_every(&self) -> u32 {
+        if self.position_period_s > 0.0 {
+            ((self.position_period_s / self.tc).round() as u32).max(1)
+        } else {
+            1
+        }
+    }
+
     /// The motor encoder's quantum, rad (m on a linear axis): its resolution, or one
     /// revolution over its counts; 0 for an ideal encoder.
     pub fn motor_quantum(&self) -> f64 {

@@ -239,6 +239,8 @@ pub const PARAMS: &[ParamSpec] = &[
     spec!("Kvff", ["-"], "velocity feed-forward: fraction of the reference's velocity added to the velocity command (0: off)", NonNegative, Always, false, 0.0, controller.kvff),
     spec!("Kaff", ["N·m·s²/rad", "N·s²/m"], "torque feed-forward: output per unit of the reference's motor acceleration (0: off; inertia at the motor over the drive gain: all of it)", NonNegative, Always, false, 0.0, controller.kaff),
     spec!("symmetrising_s", ["s"], "time constant of the symmetrising lag on the position loop's reference (0: none)", NonNegative, Always, false, 0.0, controller.symmetrising_s),
+    spec!("current_lag_s", ["s"], "the current loop's closed-loop lag: a first-order lag from the controller's output to the torque, sampled at Tc (0: none)", NonNegative, Always, false, 0.0, controller.current_lag_s),
+    spec!("position_period_s", ["s"], "the position controller's own cycle, a whole number of control periods (0: every control period)", NonNegative, Always, false, 0.0, controller.position_period_s),
 ];
 
 /// Looks a parameter up by name (exact, case-sensitive: `Kw` and `kw` differ in spirit).

@@ -1,10 +1,13 @@
-//! The figure of `rtid tune --plot`: the open loops before and after tuning — the
+//! The figures of `rtid tune --plot`: the open loops before and after tuning — the
 //! velocity loop alone and the cascade as it runs — as a Bode plot (gain in dB over
 //! phase in degrees on one log frequency axis), each loop's margins marked where they
-//! are read and named in the legend with their values.
+//! are read and named in the legend with their values; and beside it the loops closed
+//! (the speed and the position loop's gains over the cascade's sensitivity |S|, its
+//! peak named).
 
 use super::figure::{Figure, Series, Style};
 use crate::tuning::bode::Bode;
+use crate::tuning::closed_loop::Curves;
 
 /// The Bode plot of `curves` (each named in the legend: `velocity loop alone,
 /// before`, …), titled `title`.
@@ -40,6 +43,56 @@ pub fn open_loop(curves: &[(&str, &Bode)], title: &str) -> Figure {
         Style::Dashed,
     ));
     gain.above(phase)
+}
+
+/// The closed loops of each setting (`before`, `after`): the closed speed and
+/// position loops' gains above, the cascade's sensitivity |S| below, with |S|max named
+/// in the legend.
+pub fn closed_loops(curves: &[(&str, &Curves)], title: &str) -> Figure {
+    let mut gain = Figure::new(title, "frequency, Hz", "|T|, dB").log_x();
+    let mut sensitivity = Figure::new("", "", "|S|, dB");
+    for (who, c) in curves {
+        gain = gain
+            .with(Series::new(
+                format!("closed speed loop, {who}"),
+                c.speed.clone(),
+                Style::Line,
+            ))
+            .with(Series::new(
+                format!("closed position loop, {who}"),
+                c.position.clone(),
+                Style::Line,
+            ));
+        let peak = c
+            .sensitivity
+            .iter()
+            .copied()
+            .fold(
+                (0.0, f64::NEG_INFINITY),
+                |a, b| if b.1 > a.1 { b } else { a },
+            );
+        sensitivity = sensitivity.with(Series::new(
+            format!(
+                "sensitivity, {who}: |S|max {:.1} dB at {} Hz",
+                peak.1,
+                hz(peak.0)
+            ),
+            c.sensitivity.clone(),
+            Style::Line,
+        ));
+    }
+    let (lo, hi) = curves
+        .iter()
+        .flat_map(|(_, c)| &c.speed)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.0), b.max(p.0))
+        });
+    gain = gain.with(Series::new(
+        "−3 dB",
+        vec![(lo, -3.0), (hi, -3.0)],
+        Style::Dashed,
+    ));
+    gain.above(sensitivity)
 }
 
 /// The frequencies the curves span, Hz.
@@ -86,5 +139,24 @@ mod tests {
         assert!(svg.contains(&degrees(pm)), "{pm}");
         assert_eq!(hz(119.44), "119");
         assert_eq!(hz(8.4321), "8.43");
+    }
+
+    #[test]
+    fn the_closed_loops_plot_names_the_sensitivity_peak() {
+        let p = presets::load("two-mass").unwrap();
+        let plant = crate::tuning::sampled::DiscretePlant::new(&p).unwrap();
+        let c = crate::tuning::closed_loop::curves(&plant, &p.controller, 0.1, 200);
+        let peak = crate::tuning::closed_loop::analyse(&plant, &p.controller).sensitivity_peak_db;
+        let svg = closed_loops(&[("before", &c)], "two-mass")
+            .render()
+            .unwrap();
+        for s in [
+            "closed speed loop, before",
+            "closed position loop, before",
+            "|S|max",
+        ] {
+            assert!(svg.contains(s), "{s}");
+        }
+        assert!(svg.contains(&format!("{peak:.1} dB")), "{peak}");
     }
 }

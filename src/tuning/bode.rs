@@ -44,13 +44,7 @@ pub fn bode(p: &Params, s: &Setting) -> Result<Bode, ParamError> {
 /// (−270°: three integrators), the margins of `s.cascade` marked.
 pub fn cascade(p: &Params, s: &Setting) -> Result<Bode, ParamError> {
     let plant = super::sampled::DiscretePlant::new(p)?;
-    let c = crate::model::params::ControllerParams {
-        kvp: s.kvp,
-        kvi: s.kvi,
-        kpp: s.kpp,
-        filters: s.filters.clone(),
-        ..p.controller.clone()
-    };
+    let c = s.controller(&p.controller);
     let l = super::sampled::SampledLoop::new(&plant, &c, super::sampled::Closure::Cascade);
     let values = on_grid(l.nyquist_hz(), |f| l.at(f));
     let mut phase = unwrapped_deg(&values);
@@ -58,6 +52,14 @@ pub fn cascade(p: &Params, s: &Setting) -> Result<Bode, ParamError> {
         phase.iter_mut().for_each(|a| *a -= 360.0);
     }
     Ok(drawn(&values, phase, &s.cascade.margins))
+}
+
+/// The closed loops of `s` on the drive `p` on the same grid
+/// ([`super::closed_loop::curves`]).
+pub fn closed(p: &Params, s: &Setting) -> Result<super::closed_loop::Curves, ParamError> {
+    let plant = super::sampled::DiscretePlant::new(p)?;
+    let c = s.controller(&p.controller);
+    Ok(super::closed_loop::curves(&plant, &c, LOWEST_HZ, POINTS))
 }
 
 /// A loop's values on the drawn grid up to 0.99·`nyquist_hz`.

@@ -2,123 +2,46 @@
 //! open-loop frequency response on the sampled loop ([`open_loop`]), its stability
 //! margins ([`margins`]), notch filters at the resonances ([`notches`]), and the
 //! velocity PI and position gain for a target phase margin with a gain-margin floor
-//! ([`search`]). [`tune`] puts them together with the margins before and after;
-//! [`bode`] gives a setting's open loop as a Bode plot draws it.
+//! ([`search`]); the cascade as it runs, exact on the sampled loop ([`sampled`],
+//! [`stability`]), its closed loops ([`closed_loop`]), over a range of machines
+//! ([`range`]); the candidates that keep the targets ([`candidates`]), weighed on the
+//! nonlinear model against today's setting as ensembles ([`weigh`]). [`tune`] puts
+//! them together; [`bode`] gives a setting's loops as a Bode plot draws them.
 //!
-//! Layer: above `model` and `controller` (it reads the linear response, the modes and
-//! the controller's discretised filters), below `experiments` and the command line.
+//! Layer: above `model`, `controller` and `experiments::positioning` (it reads the
+//! linear response, the modes and the controller's discretised filters, and runs the
+//! ISO 230-2 cycle), below the command line.
 
 pub mod bode;
 pub mod candidates;
-pub mod criteria;
+pub mod closed_loop;
 pub mod margins;
 pub mod notches;
-pub mod objective;
 pub mod open_loop;
-pub mod position;
+pub mod options;
+pub mod range;
 pub mod sampled;
 pub mod search;
 pub mod stability;
-pub mod verify;
+pub mod weigh;
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::experiments::positioning::ensemble::Ensemble;
 use crate::model::params::{ControllerParams, LoopMode};
 use crate::model::{ParamError, Params, SetpointFilter};
-use crate::sim::LANES;
 pub use candidates::{Candidate, Limits};
-pub use criteria::{Criteria, CriteriaError};
 pub use margins::Margins;
-pub use objective::{Criterion, Objective, Worse};
 pub use open_loop::{VelocityLoop, VelocityPi};
+pub use options::{Options, Targets, TuneError};
+pub use range::{Range, Vary};
 pub use stability::{LoopMargins, Stability};
-
-/// What the tuned cascade must keep.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Targets {
-    /// Phase margin, deg (default 50).
-    pub phase_margin_deg: f64,
-    /// Gain margin floor, both ways, dB (default 6).
-    pub gain_margin_db: f64,
-}
-
-impl Default for Targets {
-    fn default() -> Self {
-        Targets {
-            phase_margin_deg: 50.0,
-            gain_margin_db: 6.0,
-        }
-    }
-}
-
-/// How to tune.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct Options {
-    pub targets: Targets,
-    pub objective: Objective,
-    pub limits: Limits,
-    /// The fraction of the torque limit the move must leave free (0 to 1).
-    pub torque_reserve: f64,
-}
-
-/// Why a drive could not be tuned.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum TuneError {
-    #[error(transparent)]
-    Params(#[from] ParamError),
-    #[error("{}", unreachable_message(*phase_margin_deg, *gain_margin_db, *best_phase_margin_deg, *best_crossover_hz, *best_gain_margin_db))]
-    Unreachable {
-        phase_margin_deg: f64,
-        gain_margin_db: f64,
-        best_phase_margin_deg: Option<f64>,
-        best_crossover_hz: Option<f64>,
-        best_gain_margin_db: Option<f64>,
-    },
-    #[error("no cascade of the {tried} tried keeps a phase margin of {phase_margin_deg}° and gain margins of {gain_margin_db} dB both ways without a conditional window; {}", best.map_or("none of them is stable".to_string(), |b| format!("the closest: {b}")))]
-    CascadeUnreachable {
-        phase_margin_deg: f64,
-        gain_margin_db: f64,
-        tried: usize,
-        best: Option<candidates::BestTried>,
-    },
-    #[error("targets must be finite with a phase margin in (0°, 180°) and a gain margin ≥ 0 dB: got {phase_margin_deg}° and {gain_margin_db} dB")]
-    Targets {
-        phase_margin_deg: f64,
-        gain_margin_db: f64,
-    },
-    #[error("{option} must be {expected}: got {value}")]
-    Option {
-        option: &'static str,
-        expected: &'static str,
-        value: f64,
-    },
-    #[error("the check of today's settings on the nonlinear model failed: {0}")]
-    Today(#[source] CriteriaError),
-}
-
-fn unreachable_message(
-    pm: f64,
-    gm: f64,
-    best: Option<f64>,
-    at: Option<f64>,
-    best_gm: Option<f64>,
-) -> String {
-    let best = match (best, at) {
-        (Some(b), Some(f)) => format!(
-            "the best is {b:.1}° at a crossover of {f:.2} Hz (gain margin {})",
-            best_gm.map_or("unbounded".into(), |g| format!("{g:.1} dB"))
-        ),
-        _ => "no gain tried crosses over".into(),
-    };
-    format!(
-        "target phase margin {pm}° with a gain margin ≥ {gm} dB not reachable with the \
-         PI corner at a quarter of the crossover: {best}"
-    )
-}
+pub use weigh::criteria::{Checked, Criteria, CriteriaError};
+pub use weigh::judge::{Compared, Judgement, Verdict};
+pub use weigh::objective::{Criterion, Objective, Worse};
+pub use weigh::{criteria, judge, limit_cycle_threshold, objective, verify, Screened};
 
 /// One setting of the cascade and its loops' margins.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -136,8 +59,13 @@ pub struct Setting {
     /// The cascade as it runs: the position loop closed in the configured loop
     /// type, exact on the sampled loop, with its stability ([`stability`]).
     pub cascade: LoopMargins,
-    /// The closed position loop's largest gain, dB ([`position::peak_db`]).
+    /// The closed position loop's largest gain, dB ([`closed_loop::peak_db`]).
     pub position_peak_db: f64,
+    /// The closed loops, exact on the sampled loop: bandwidths, peaks, |S|max and the
+    /// speed loop's equivalent time constant ([`closed_loop`]).
+    pub closed_loop: closed_loop::ClosedLoop,
+    /// The cascade's margins over the range of machines (`None`: the nominal alone).
+    pub over_range: Option<range::OverRange>,
 }
 
 impl Setting {
@@ -157,26 +85,78 @@ impl Setting {
             filters: c.filters.clone(),
             velocity_loop: search::Grid::new(&lp).margins(pi),
             cascade: stability::analyse(&cascade),
-            position_peak_db: position::peak_db(&lp, pi, c.kpp),
+            position_peak_db: closed_loop::peak_db(&lp, pi, c.kpp),
+            closed_loop: closed_loop::analyse(&plant, c),
+            over_range: None,
         })
+    }
+
+    /// `base` with this setting's gains and filters.
+    pub fn controller(&self, base: &ControllerParams) -> ControllerParams {
+        ControllerParams {
+            kvp: self.kvp,
+            kvi: self.kvi,
+            kpp: self.kpp,
+            filters: self.filters.clone(),
+            ..base.clone()
+        }
+    }
+
+    /// [`Setting::of`] with its margins at every machine of `machines`.
+    pub fn over(
+        p: &Params,
+        c: &ControllerParams,
+        machines: &range::Machines,
+    ) -> Result<Setting, ParamError> {
+        let mut s = Setting::of(p, c)?;
+        if machines.points.len() > 1 {
+            let margins = machines.margins(c, margins::GRID_POINTS);
+            s.over_range = Some(machines.worst(&margins));
+        }
+        Ok(s)
+    }
+
+    /// Whether the cascade keeps `targets` on the nominal machine and, where it has
+    /// them, at every machine of the range.
+    pub fn meets(&self, targets: Targets) -> bool {
+        let (pm, gm) = (targets.phase_margin_deg, targets.gain_margin_db);
+        let worst_ok = self.over_range.as_ref().map_or(true, |w| {
+            w.unstable_at.is_empty()
+                && w.conditional_at.is_empty()
+                && w.phase_margin_deg.as_ref().is_some_and(|p| p.0 >= pm)
+                && w.gain_margin_db.as_ref().map_or(true, |g| g.0 >= gm)
+                && w.gain_reduction_margin_db
+                    .as_ref()
+                    .map_or(true, |g| g.0 >= gm)
+        });
+        self.cascade.meets(pm, gm) && worst_ok
     }
 }
 
 /// What the search did.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SearchSummary {
-    /// Settings tried on the linear cascade, and those that kept the targets.
+    /// Settings tried on the linear cascade, and those that kept the targets (over
+    /// the range).
     pub tried: usize,
     pub within_margins: usize,
+    /// Machines of the range the margins were checked at (1: the nominal alone), and
+    /// its corners the nonlinear screening ran at.
+    pub machines: usize,
+    pub corners: usize,
     /// Settings weighed on the nonlinear model (today's among them) and those
     /// refused there (a limit cycle, the torque reserve).
     pub screened: usize,
     pub refused: usize,
-    /// Settings checked on the standard cycle.
+    /// Settings checked on the standard cycle besides today's, as ensembles of
+    /// `members`.
     pub checked: usize,
-    /// The chosen setting's score on the screening and on the check (today's: 1).
+    pub members: usize,
+    /// The chosen setting's score on the screening and its mean over the check's
+    /// ensemble (today's: 1), with the half-width of its 95 % interval.
     pub screen_score: f64,
     pub check_score: f64,
+    pub check_score_half_width: f64,
     /// Wall time of the search, s.
     pub wall_s: f64,
 }
@@ -185,12 +165,26 @@ pub struct SearchSummary {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum TuneWarning {
-    /// The proposed setting makes a criterion worse than today's.
+    /// The proposed setting makes a criterion worse than today's beyond its spread
+    /// (the ensembles' means).
     Worse(Worse),
-    /// No setting beats today's on the objective: nothing new is proposed.
-    NothingBetter { best_check_score: Option<f64> },
-    /// Today's cascade does not keep the targets.
-    TodayOutsideTargets,
+    /// No setting beats today's on the objective beyond the spread: nothing new is
+    /// proposed (the best checked: its mean score and the half-width of its 95 %
+    /// interval).
+    NothingBetter {
+        best_check_score: Option<f64>,
+        half_width: Option<f64>,
+    },
+    /// Today's cascade does not keep the targets (on the nominal machine, or
+    /// somewhere in the range): it is replaced by the best setting that does.
+    TodayOutsideTargets { replaced: bool },
+    /// A test's peak torque reaches the torque limit (the output saturates).
+    TorqueLimit {
+        setting: &'static str,
+        test: &'static str,
+        peak: f64,
+        limit: f64,
+    },
 }
 
 /// The drive's settings before and after tuning, and the tuned parameter set.
@@ -200,14 +194,17 @@ pub struct Tuned {
     pub objective: Objective,
     #[serde(rename = "loop")]
     pub loop_mode: LoopMode,
-    /// The resonances the notches sit at.
+    /// The machines the targets held on.
+    pub range: Range,
+    /// The resonances (of the nominal machine) the notches sit at.
     pub resonances: Vec<notches::Resonance>,
     pub before: Setting,
     pub after: Setting,
     /// Whether `after` is a new setting (false: today's is kept).
     pub proposes: bool,
     pub search: SearchSummary,
-    /// Both settings on the standard cycle, compensated in the controller.
+    /// Both settings on the standard cycle, compensated in the controller, as
+    /// ensembles, and how they compare.
     pub check: Check,
     pub warnings: Vec<TuneWarning>,
     /// Every candidate within the targets as the screening weighed it.
@@ -216,101 +213,105 @@ pub struct Tuned {
     pub params: Params,
 }
 
-/// A candidate as the screening weighed it (report units; `score` against today's,
-/// `None` where refused, with the reason).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Screened {
-    #[serde(rename = "Kvp")]
-    pub kvp: f64,
-    #[serde(rename = "Kvi")]
-    pub kvi: f64,
-    #[serde(rename = "Kpp")]
-    pub kpp: f64,
-    pub crossover_hz: f64,
-    pub phase_margin_deg: Option<f64>,
-    #[serde(rename = "A")]
-    pub a: Option<f64>,
-    #[serde(rename = "R")]
-    pub r: Option<f64>,
-    pub table_settling_s: Option<f64>,
-    pub following_error: Option<f64>,
-    pub table_motion_at_rest: Option<f64>,
-    pub score: Option<f64>,
-    pub refused: Option<String>,
-}
-
-/// Today's and the proposed setting on the nonlinear model.
+/// Today's and the proposed setting on the nonlinear model, as ensembles.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Check {
-    pub before: Criteria,
-    pub after: Criteria,
+    /// The ensemble's size and how its members differ.
+    pub ensemble: Ensemble,
+    pub before: Checked,
+    pub after: Checked,
+    /// `after` against `before`, member by member.
+    pub judgement: Judgement,
 }
 
-/// How many of the best screened settings are checked on the standard cycle.
-const CHECKED: usize = 3;
-
 /// Tunes `p`'s cascade (`p` validated) in its configured loop: candidates that keep
-/// the targets on the cascade, weighed on the nonlinear model against today's
-/// setting by `options.objective`; `progress(done, total)` after each batch.
+/// the targets on the cascade at every machine of `options.range`, weighed on the
+/// nonlinear model against today's setting by `options.objective` (screened, then the
+/// best checked as ensembles); `progress(done, total)` after each batch.
 pub fn tune(
     p: &Params,
     options: &Options,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Tuned, TuneError> {
     let started = Instant::now();
-    check_options(options)?;
+    options::check(options, p)?;
     let targets = options.targets;
+    let machines = range::Machines::new(p, &options.range)?;
     let nyquist = 0.5 / p.controller.tc;
     let resonances = notches::resonances(p, notches::MAX_RELATIVE_CENTRE * nyquist)?;
-    let filters = notches::notches_with(p, &options.limits)?;
-    let (found, tried) = candidates::generate(p, &filters, targets, &options.limits)?;
+    let filters = notches::notches_over(p, &options.limits, &machines.params)?;
+    let (found, tried) = candidates::generate(p, &filters, targets, &options.limits, &machines)?;
     let mut sets = vec![p.clone()];
-    sets.extend(
-        found
-            .iter()
-            .map(|c| with_controller(p, c.controller(&p.controller, &filters))),
-    );
-    let mut screened = screen(&sets, progress);
-    let today = std::mem::replace(&mut screened[0], Err(CriteriaError::Unscreened))
+    sets.extend(found.iter().map(|c| {
+        let tuned = c.controller(&p.controller, &filters);
+        with_controller(p, balanced(&machines.plants[0], tuned))
+    }));
+    let mut screened = weigh::screen(&sets, progress);
+    let today_screen = std::mem::replace(&mut screened[0], Err(CriteriaError::Unscreened))
         .map_err(TuneError::Today)?;
-    let ranked = rank(p, options, &screened, &today);
-    let table = screened_table(&found, &screened, &ranked);
-    let refused = sets.len() - 1 - ranked.len();
-    let before_check = criteria::check(p).map_err(TuneError::Today)?;
-    let chosen = choose(options.objective, &sets, &ranked, &before_check);
-    let before = Setting::of(p, &p.controller)?;
+    let caps = weigh::Caps::of(p, &today_screen.servo, options.torque_reserve);
+    let at_corners = weigh::refusals_at_corners(&sets, &options.range, options.torque_reserve);
+    let ranked = weigh::rank(
+        options.objective,
+        &caps,
+        &screened,
+        &today_screen,
+        &at_corners,
+    );
+    let table = weigh::screened_table(&found, &screened, &ranked, &caps, &at_corners);
+    let before = Setting::over(p, &p.controller, &machines)?;
+    let replace = !before.meets(targets);
+    let picked: Vec<usize> = ranked
+        .iter()
+        .filter(|r| r.1 < 1.0 || replace)
+        .take(weigh::CHECKED)
+        .map(|r| r.0)
+        .collect();
+    let chosen = weigh::choose(
+        options.objective,
+        &sets,
+        &picked,
+        &options.ensemble,
+        replace,
+    )
+    .map_err(TuneError::Today)?;
     let mut warnings = Vec::new();
-    if !before
-        .cascade
-        .meets(targets.phase_margin_deg, targets.gain_margin_db)
-    {
-        warnings.push(TuneWarning::TodayOutsideTargets);
+    if replace {
+        warnings.push(TuneWarning::TodayOutsideTargets {
+            replaced: chosen.best.is_some(),
+        });
     }
-    let (params, after_check, screen_score, check_score, proposes) = match chosen.best {
-        Some((i, check, score)) => (
+    let (params, after_check, judgement, screen_score, proposes) = match chosen.best {
+        Some((i, checked, judgement)) => (
             sets[i].clone(),
-            check,
+            checked,
+            judgement,
             ranked_score(&ranked, i),
-            score,
             true,
         ),
         None => {
             warnings.push(TuneWarning::NothingBetter {
-                best_check_score: chosen.best_failed,
+                best_check_score: chosen.best_failed.as_ref().map(|j| j.score.after.mean),
+                half_width: chosen.best_failed.as_ref().map(|j| j.score.half_width),
             });
-            (p.clone(), before_check.clone(), 1.0, 1.0, false)
+            let same = judge::judge(options.objective, &chosen.today, &chosen.today);
+            (p.clone(), chosen.today.clone(), same, 1.0, false)
         }
     };
-    warnings.extend(
-        objective::worse(&after_check, &before_check)
-            .into_iter()
-            .map(TuneWarning::Worse),
-    );
-    let after = Setting::of(&params, &params.controller)?;
+    warnings.extend(judgement.worse().map(|c| {
+        TuneWarning::Worse(Worse {
+            criterion: c.criterion,
+            before: c.compared.before.mean,
+            after: c.compared.after.mean,
+        })
+    }));
+    warnings.extend(torque_limits(p, &chosen.today, &after_check, proposes));
+    let after = Setting::over(&params, &params.controller, &machines)?;
     Ok(Tuned {
         targets,
         objective: options.objective,
         loop_mode: p.controller.loop_mode,
+        range: options.range.clone(),
         resonances,
         before,
         after,
@@ -318,16 +319,22 @@ pub fn tune(
         search: SearchSummary {
             tried,
             within_margins: found.len(),
+            machines: machines.points.len(),
+            corners: options.range.corners().len(),
             screened: sets.len(),
-            refused,
+            refused: sets.len() - 1 - ranked.len(),
             checked: chosen.checked,
+            members: options.ensemble.members,
             screen_score,
-            check_score,
+            check_score: judgement.score.after.mean,
+            check_score_half_width: judgement.score.half_width,
             wall_s: started.elapsed().as_secs_f64(),
         },
         check: Check {
-            before: before_check,
+            ensemble: options.ensemble,
+            before: chosen.today,
             after: after_check,
+            judgement,
         },
         warnings,
         candidates: table,
@@ -335,40 +342,34 @@ pub fn tune(
     })
 }
 
-/// The candidates (`found`, screened from index 1 on) as the JSON lists them.
-fn screened_table(
-    found: &[Candidate],
-    screened: &[Result<Criteria, CriteriaError>],
-    ranked: &[(usize, f64)],
-) -> Vec<Screened> {
-    found
-        .iter()
-        .zip(&screened[1..])
-        .enumerate()
-        .map(|(i, (c, r))| {
-            let ok = r.as_ref().ok();
-            let score = ranked.iter().find(|x| x.0 == i + 1).map(|x| x.1);
-            let refused = match (r, score) {
-                (Err(e), _) => Some(e.to_string()),
-                (Ok(_), None) => Some("a limit cycle or the torque reserve".to_string()),
-                _ => None,
-            };
-            Screened {
-                kvp: c.pi.0,
-                kvi: c.pi.1,
-                kpp: c.kpp,
-                crossover_hz: c.crossover_hz,
-                phase_margin_deg: c.cascade.margins.phase_margin_deg,
-                a: ok.map(|c| c.positioning.a),
-                r: ok.map(|c| c.positioning.r),
-                table_settling_s: ok.and_then(|c| c.servo.table_settling_s),
-                following_error: ok.map(|c| c.servo.following_error),
-                table_motion_at_rest: ok.map(|c| c.servo.table_motion_at_rest),
-                score,
-                refused,
+/// The warnings of tests whose peak torque reaches the limit, today's and (when a
+/// setting is proposed) the proposed one's, on their unperturbed members.
+fn torque_limits(p: &Params, today: &Checked, after: &Checked, proposes: bool) -> Vec<TuneWarning> {
+    let limit = p.controller.torque_limit * p.controller.drive_gain;
+    let mut out = Vec::new();
+    let mut settings = vec![("before", today)];
+    if proposes {
+        settings.push(("after", after));
+    }
+    for (setting, c) in settings {
+        let Some(first) = c.members.first() else {
+            continue;
+        };
+        let s = &first.servo;
+        let step = s.peak_effort.max(s.move_peak_effort);
+        for (test, peak) in [("move", s.move_peak_effort), ("step", step)] {
+            if peak >= (1.0 - 1e-9) * limit {
+                out.push(TuneWarning::TorqueLimit {
+                    setting,
+                    test,
+                    peak,
+                    limit,
+                });
+                break;
             }
-        })
-        .collect()
+        }
+    }
+    out
 }
 
 /// The linear rule of rtid's first tuning, one of the search's candidates: notches
@@ -387,58 +388,16 @@ pub fn rule(p: &Params, targets: Targets) -> Result<ControllerParams, TuneError>
     })
 }
 
-/// Refuses targets and limits out of range.
-fn check_options(o: &Options) -> Result<(), TuneError> {
-    let (pm, gm) = (o.targets.phase_margin_deg, o.targets.gain_margin_db);
-    if !(pm.is_finite() && pm > 0.0 && pm < 180.0 && gm.is_finite() && gm >= 0.0) {
-        return Err(TuneError::Targets {
-            phase_margin_deg: pm,
-            gain_margin_db: gm,
-        });
-    }
-    let l = &o.limits;
-    let positive = |option, v: Option<f64>| match v {
-        Some(v) if !(v.is_finite() && v > 0.0) => Err(TuneError::Option {
-            option,
-            expected: "finite and positive",
-            value: v,
-        }),
-        _ => Ok(()),
-    };
-    positive("--max-kpp", l.max_kpp)?;
-    positive("--max-bandwidth-hz", l.max_bandwidth_hz)?;
-    let within = |option, v: f64, lo: f64, hi: f64, expected| {
-        if v.is_finite() && v >= lo && v <= hi {
-            Ok(())
-        } else {
-            Err(TuneError::Option {
-                option,
-                expected,
-                value: v,
-            })
+/// `c` with its symmetrising lag the equivalent time constant of its closed speed
+/// loop on `plant`, where the speed feed-forward is on (the CNC balances the
+/// feed-forward with it: MD32810); `c` as it is without feed-forward.
+fn balanced(plant: &sampled::DiscretePlant, mut c: ControllerParams) -> ControllerParams {
+    if c.kvff > 0.0 {
+        if let Some(t) = closed_loop::equivalent_time(plant, &c, 1000) {
+            c.symmetrising_s = t;
         }
-    };
-    within(
-        "--notch-depth-db",
-        l.notch_depth_db,
-        -60.0,
-        -1.0,
-        "between -60 and -1 dB",
-    )?;
-    within(
-        "--notch-min-width",
-        l.notch_min_width,
-        0.01,
-        1.0,
-        "between 0.01 and 1 (of the centre)",
-    )?;
-    within(
-        "--torque-reserve",
-        o.torque_reserve,
-        0.0,
-        0.9,
-        "between 0 and 0.9",
-    )
+    }
+    c
 }
 
 /// `p` with the controller `c`.
@@ -449,112 +408,8 @@ fn with_controller(p: &Params, c: ControllerParams) -> Params {
     }
 }
 
-/// Every set's figures on the short cycle, in lane batches run in parallel.
-fn screen(
-    sets: &[Params],
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> Vec<Result<Criteria, CriteriaError>> {
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    sets.par_chunks(LANES)
-        .flat_map_iter(|chunk| {
-            let out = criteria::screen(chunk);
-            let n = done.fetch_add(chunk.len(), std::sync::atomic::Ordering::Relaxed) + chunk.len();
-            progress(n, sets.len());
-            out
-        })
-        .collect()
-}
-
-/// The candidates (indices into the sets, today's excluded) the nonlinear model
-/// admits — no limit cycle, the torque reserve kept —, with their scores: first those
-/// that keep every criterion the objective lists ([`Objective::keeps`]), best score
-/// first, then the others.
-fn rank(
-    p: &Params,
-    o: &Options,
-    screened: &[Result<Criteria, CriteriaError>],
-    today: &Criteria,
-) -> Vec<(usize, f64)> {
-    let effort_cap = (1.0 - o.torque_reserve) * p.controller.torque_limit * p.controller.drive_gain;
-    let rest_cap = limit_cycle_threshold(p).max(2.0 * today.servo.table_motion_at_rest);
-    let mut out: Vec<(usize, f64, bool)> = screened
-        .iter()
-        .enumerate()
-        .skip(1)
-        .filter_map(|(i, c)| {
-            let c = c.as_ref().ok()?;
-            let admitted = c.servo.table_motion_at_rest <= rest_cap
-                && c.servo.move_peak_effort <= effort_cap.max(today.servo.move_peak_effort);
-            let keeps = o.objective.keeps(c, today);
-            admitted.then(|| (i, o.objective.score(c, today), keeps))
-        })
-        .collect();
-    out.sort_by(|a, b| b.2.cmp(&a.2).then(a.1.total_cmp(&b.1)));
-    out.into_iter().map(|(i, score, _)| (i, score)).collect()
-}
-
-/// The table's motion at rest that counts as a limit cycle: three table-encoder
-/// counts, and at least 1 report unit (1″, 1 µm).
-pub fn limit_cycle_threshold(p: &Params) -> f64 {
-    let k = crate::experiments::positioning::iso230::ReportUnits::of(p.axis).deviation_per_si;
-    (3.0 * p.controller.table_encoder_resolution * k).max(1.0)
-}
-
 fn ranked_score(ranked: &[(usize, f64)], i: usize) -> f64 {
     ranked.iter().find(|r| r.0 == i).map_or(1.0, |r| r.1)
-}
-
-/// The outcome of checking the best screened settings.
-struct Chosen {
-    /// The one that beats today's most on the check: index, figures, score.
-    best: Option<(usize, Criteria, f64)>,
-    /// The lowest check score when none beats today's.
-    best_failed: Option<f64>,
-    checked: usize,
-}
-
-/// Checks the best [`CHECKED`] screened settings that beat today's (score < 1) on
-/// the standard cycle, and takes the one that beats today's most there among those
-/// that keep every criterion the objective lists, else among all.
-fn choose(
-    objective: Objective,
-    sets: &[Params],
-    ranked: &[(usize, f64)],
-    today: &Criteria,
-) -> Chosen {
-    let picked: Vec<usize> = ranked
-        .iter()
-        .filter(|r| r.1 < 1.0)
-        .take(CHECKED)
-        .map(|r| r.0)
-        .collect();
-    let checked: Vec<(usize, Criteria, f64)> = picked
-        .par_iter()
-        .filter_map(|&i| {
-            let c = criteria::check(&sets[i]).ok()?;
-            let score = objective.score(&c, today);
-            Some((i, c, score))
-        })
-        .collect();
-    let better = |c: &&(usize, Criteria, f64)| c.2 < 1.0;
-    let lowest = |keeping: bool| {
-        checked
-            .iter()
-            .filter(better)
-            .filter(|c| !keeping || objective.keeps(&c.1, today))
-            .min_by(|a, b| a.2.total_cmp(&b.2))
-            .cloned()
-    };
-    let best = lowest(true).or_else(|| lowest(false));
-    let best_failed = match best {
-        Some(_) => None,
-        None => checked.iter().map(|c| c.2).min_by(f64::total_cmp),
-    };
-    Chosen {
-        best,
-        best_failed,
-        checked: picked.len(),
-    }
 }
 
 #[cfg(test)]

@@ -72,6 +72,57 @@ pub fn notches_with(p: &Params, limits: &super::Limits) -> Result<Vec<SetpointFi
         .collect())
 }
 
+/// [`notches_with`] for every machine of `machines` (the nominal first): each notch
+/// at the geometric middle of where its resonance lies over the machines (the
+/// nearest to the nominal one's frequency at each), widened by that span, at most as
+/// wide as its centre. On the nominal machine alone, [`notches_with`].
+pub fn notches_over(
+    p: &Params,
+    limits: &super::Limits,
+    machines: &[Params],
+) -> Result<Vec<SetpointFilter>, ParamError> {
+    let nyquist = 0.5 / p.controller.tc;
+    let max_hz = MAX_RELATIVE_CENTRE * nyquist;
+    let nominal = resonances(p, max_hz)?;
+    let others = machines
+        .iter()
+        .map(|q| resonances(q, nyquist))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(nominal
+        .into_iter()
+        .take(MAX_FILTERS)
+        .map(|r| {
+            let (lo, hi) = others
+                .iter()
+                .filter_map(|rs| {
+                    rs.iter().min_by(|a, b| {
+                        (a.hz / r.hz)
+                            .ln()
+                            .abs()
+                            .total_cmp(&(b.hz / r.hz).ln().abs())
+                    })
+                })
+                .fold((r.hz, r.hz), |(lo, hi), x| (lo.min(x.hz), hi.max(x.hz)));
+            let centre = Resonance {
+                hz: (lo * hi).sqrt().min(max_hz),
+                damping: r.damping,
+            };
+            match notch_with(centre, limits.notch_depth_db, limits.notch_min_width) {
+                SetpointFilter::Notch {
+                    centre_hz,
+                    width_hz,
+                    depth_db,
+                } => SetpointFilter::Notch {
+                    centre_hz,
+                    width_hz: (width_hz + hi - lo).min(centre_hz),
+                    depth_db,
+                },
+                other => other,
+            }
+        })
+        .collect())
+}
+
 /// The notch of one resonance.
 pub fn notch(r: Resonance) -> SetpointFilter {
     notch_with(r, DEPTH_DB, MIN_RELATIVE_WIDTH)
@@ -101,6 +152,36 @@ mod tests {
         assert!((r[0].damping - 0.02).abs() < 2e-3, "{r:?}");
         let f = notches(&p).unwrap();
         assert_eq!(f.len(), 1);
+    }
+
+    /// The two-mass drive with Jt from half to twice its value: the coupling mode
+    /// moves from 108 to 60 Hz (√(Kw(1/Jm + 1/Jt))), and the notch covers it.
+    #[test]
+    fn a_notch_over_a_range_covers_where_its_resonance_goes() {
+        let p = presets::load("two-mass").unwrap();
+        let machines: Vec<Params> = [0.5, 2.0]
+            .iter()
+            .map(|k| Params {
+                jt: k * p.jt,
+                ..p.clone()
+            })
+            .collect();
+        let f = notches_over(&p, &crate::tuning::Limits::default(), &machines).unwrap();
+        let SetpointFilter::Notch {
+            centre_hz,
+            width_hz,
+            ..
+        } = f[0]
+        else {
+            panic!("{f:?}")
+        };
+        let mode = |jt: f64| (p.kw * (1.0 / p.jm + 1.0 / jt)).sqrt() / TAU;
+        let (lo, hi) = (mode(2.0 * p.jt), mode(0.5 * p.jt));
+        assert!((centre_hz - (lo * hi).sqrt()).abs() < 0.1, "{f:?}");
+        assert!(
+            centre_hz - width_hz / 2.0 < lo && centre_hz + width_hz / 2.0 > hi,
+            "{f:?}"
+        );
     }
 
     #[test]

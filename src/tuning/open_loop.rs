@@ -8,6 +8,8 @@
 //! H(jω)  = (1 − e^{−jωTc})/(jωTc)                          zero-order hold
 //!        · (1 − e^{−jωTc})/(jωTc)                          backward-difference speed
 //!        · e^{−jω·encoder_delay}·e^{−jωTc·output_delay_periods}
+//!        · a/(1 − (1 − a)·z⁻¹)                            the current loop's lag,
+//!                                                          a = 1 − e^{−Tc/T_i}
 //! ```
 //!
 //! This is the quasi-continuous frequency response of the sampled loop: the plant's
@@ -34,6 +36,8 @@ pub struct VelocityLoop {
     /// Encoder dead time plus the output delay, s.
     delay: f64,
     filters: Vec<Biquad>,
+    /// The current loop's lag factor a (0: none).
+    lag: f64,
 }
 
 /// Velocity PI gains: output·s/rad and output/rad.
@@ -53,6 +57,11 @@ impl VelocityLoop {
             drive_gain: c.drive_gain,
             delay: p.encoder_delay + c.output_delay_periods * c.tc,
             filters: filters.iter().map(|f| Biquad::new(f, c.tc)).collect(),
+            lag: if c.current_lag_s > 0.0 {
+                -(-c.tc / c.current_lag_s).exp_m1()
+            } else {
+                0.0
+            },
         })
     }
 
@@ -84,7 +93,13 @@ impl VelocityLoop {
                 Complex::new(re, im)
             })
             .product::<Complex<f64>>();
-        Some(filters * self.drive_gain * jw * compliance * hold * speed * delay)
+        let lag = if self.lag > 0.0 {
+            let z_inv = (-jw * self.tc).exp();
+            self.lag / (1.0 - (1.0 - self.lag) * z_inv)
+        } else {
+            Complex::new(1.0, 0.0)
+        };
+        Some(filters * self.drive_gain * jw * compliance * hold * speed * delay * lag)
     }
 
     /// C_v at `hz`: Kvp + Kvi·Tc·z/(z − 1), z = e^{jωTc}.

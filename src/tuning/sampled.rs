@@ -188,6 +188,13 @@ impl<'a> Builder<'a> {
             .map(|_| [self.state(), self.state()])
             .collect();
         let pending = (self.c.output_delay_periods == 1.0).then(|| self.state());
+        let lag = (self.c.current_lag_s > 0.0).then(|| self.state());
+        let every = self.c.position_every() as usize;
+        let held: Vec<usize> = if cascade {
+            (1..every).map(|_| self.state()).collect()
+        } else {
+            Vec::new()
+        };
         let len = self.n + 1;
         let unit = |i: usize| {
             let mut e = Expr::zeros(len);
@@ -227,14 +234,15 @@ impl<'a> Builder<'a> {
                 LoopMode::SemiClosed => -reading.clone(),
                 LoopMode::FullClosed => -unit(self.plant.table) / self.plant.ratio,
             };
-            match position_integral {
+            let now = match position_integral {
                 Some(i) => {
                     let integral = unit(i) + &error * self.c.tc;
                     self.next.push((i, integral.clone()));
                     &error * self.c.kpp + integral * self.c.kpi
                 }
                 None => error * self.c.kpp,
-            }
+            };
+            self.held_average(now, &held, &unit)
         } else {
             Expr::zeros(len)
         };
@@ -260,8 +268,40 @@ impl<'a> Builder<'a> {
             }
             None => law,
         };
+        let applied = match lag {
+            Some(i) => {
+                let a = -(-self.c.tc / self.c.current_lag_s).exp_m1();
+                let lagged = unit(i) * (1.0 - a) + applied * a;
+                self.next.push((i, lagged.clone()));
+                lagged
+            }
+            None => applied,
+        };
         let output = applied * self.c.drive_gain;
         self.matrices(output)
+    }
+
+    /// The position loop's output `now` as the velocity loop sees it when the
+    /// position controller runs every N-th sample (N − 1 = `held.len()` memories of
+    /// its past outputs): the sample-and-hold's baseband response, the mean of the
+    /// last N outputs (its images at the position cycle's rate neglected: docs/
+    /// tuning.md, "The position controller's cycle"); `now` itself for N = 1.
+    fn held_average(&mut self, now: Expr, held: &[usize], unit: &dyn Fn(usize) -> Expr) -> Expr {
+        if held.is_empty() {
+            return now;
+        }
+        let n = (held.len() + 1) as f64;
+        let mut sum = now.clone();
+        for (i, &h) in held.iter().enumerate() {
+            sum += unit(h);
+            let previous = if i == 0 {
+                now.clone()
+            } else {
+                unit(held[i - 1])
+            };
+            self.next.push((h, previous));
+        }
+        sum / n
     }
 
     /// A, B and C from the next-state expressions and the output's.

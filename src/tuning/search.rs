@@ -62,7 +62,13 @@ impl<'a> Grid<'a> {
 
     /// The gains of the rules above with their crossover at `hz`.
     pub fn gains_at(&self, hz: f64) -> Option<VelocityPi> {
-        let ratio = PI_CORNER * TAU * hz;
+        self.gains_with_corner(hz, PI_CORNER)
+    }
+
+    /// The gains with their crossover at `hz` and the PI's corner Kvi/Kvp at
+    /// `corner` of it.
+    pub fn gains_with_corner(&self, hz: f64, corner: f64) -> Option<VelocityPi> {
+        let ratio = corner * TAU * hz;
         let unit = VelocityPi {
             kvp: 1.0,
             kvi: ratio,

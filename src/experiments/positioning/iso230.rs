@@ -261,6 +261,26 @@ impl AxisStats {
         }
     }
 
+    /// The values of several evaluations combined field by field: each field is `f`
+    /// of that field's values in `all`, in order (an ensemble's mean, spread, …).
+    pub fn fieldwise(all: &[AxisStats], f: impl Fn(&[f64]) -> f64) -> AxisStats {
+        let of = |get: fn(&AxisStats) -> f64| f(&all.iter().map(get).collect::<Vec<_>>());
+        AxisStats {
+            b: of(|s| s.b),
+            b_mean: of(|s| s.b_mean),
+            r_up: of(|s| s.r_up),
+            r_down: of(|s| s.r_down),
+            r: of(|s| s.r),
+            e_up: of(|s| s.e_up),
+            e_down: of(|s| s.e_down),
+            e: of(|s| s.e),
+            m: of(|s| s.m),
+            a_up: of(|s| s.a_up),
+            a_down: of(|s| s.a_down),
+            a: of(|s| s.a),
+        }
+    }
+
     /// The axis values from the per-target statistics (at least one target).
     fn from_targets(t: &[TargetStats]) -> AxisStats {
         let max = |f: &dyn Fn(&TargetStats) -> f64| t.iter().map(f).fold(f64::MIN, f64::max);

@@ -9,6 +9,7 @@
 //! (quantised to its resolution) plus optional Gaussian measurement noise.
 
 pub mod compensate;
+pub mod ensemble;
 pub mod iso230;
 
 use rand::SeedableRng;
@@ -130,8 +131,8 @@ pub fn run(
     test: &PositioningTest,
     progress: impl FnMut(usize, usize),
 ) -> Result<Vec<Measurement>, SimError> {
-    let compensation = [test.compensation.clone()];
-    let [one] = run_lanes(&[test_params(params, test)], test, compensation, progress)?;
+    let lane = [Lane::of(test)];
+    let [one] = run_lanes(&[test_params(params, test)], test, lane, progress)?;
     one
 }
 
@@ -171,11 +172,16 @@ struct Compensated<'a> {
 }
 
 impl Compensated<'_> {
-    fn of(&self, p: &Params) -> Compensation {
-        self.sets
+    fn of(&self, p: &Params) -> Lane {
+        let compensation = self
+            .sets
             .iter()
             .position(|s| s == p)
-            .map_or_else(Compensation::default, |i| self.compensations[i].clone())
+            .map_or_else(Compensation::default, |i| self.compensations[i].clone());
+        Lane {
+            compensation,
+            seed: self.test.seed,
+        }
     }
 }
 
@@ -214,8 +220,12 @@ impl LaneRun for Cycle<'_> {
         &self,
         params: &[Params; L],
     ) -> Result<[Result<Vec<Measurement>, SimError>; L], SimError> {
-        let compensations = std::array::from_fn(|_| self.0.compensation.clone());
-        run_lanes(params, self.0, compensations, |_, _| {})
+        run_lanes(
+            params,
+            self.0,
+            std::array::from_fn(|_| Lane::of(self.0)),
+            |_, _| {},
+        )
     }
 }
 
@@ -226,13 +236,32 @@ fn test_params(params: &Params, test: &PositioningTest) -> Params {
     p
 }
 
+/// What one lane of a cycle runs with beyond its parameter set: the controller's
+/// compensation and the seed of its measurement noise.
+#[derive(Clone, Debug, PartialEq)]
+struct Lane {
+    compensation: Compensation,
+    seed: u64,
+}
+
+impl Lane {
+    /// The test's own compensation and seed.
+    fn of(test: &PositioningTest) -> Lane {
+        Lane {
+            compensation: test.compensation.clone(),
+            seed: test.seed,
+        }
+    }
+}
+
 /// The cycle on `L` parameter sets at once (already [`test_params`]), lane by lane
-/// as a lone run computes it, each with its compensation: one result per set (a set
-/// that diverges fails alone). `progress` counts the readings of the cycle.
+/// as a lone run computes it, each with its compensation and noise seed: one result
+/// per set (a set that diverges fails alone). `progress` counts the readings of the
+/// cycle.
 fn run_lanes<const L: usize>(
     params: &[Params; L],
     test: &PositioningTest,
-    compensations: [Compensation; L],
+    lanes: [Lane; L],
     mut progress: impl FnMut(usize, usize),
 ) -> Result<[Result<Vec<Measurement>, SimError>; L], SimError> {
     let mut sim = LaneSimulation::<L>::of(params, crate::sim::common_step(params)?)?;
@@ -242,10 +271,11 @@ fn run_lanes<const L: usize>(
         sim.start(l, rest_state(p, stops[0].0, Preload::None), 0.0);
     }
     let mut controllers = sim.controllers(params)?;
-    for (c, compensation) in controllers.iter_mut().zip(compensations) {
-        c.set_compensation(compensation);
+    let seeds = lanes.each_ref().map(|l| l.seed);
+    for (c, lane) in controllers.iter_mut().zip(lanes) {
+        c.set_compensation(lane.compensation);
     }
-    let mut readings = Readings::<L>::new(params, test);
+    let mut readings = Readings::<L>::new(params, test, seeds);
     let mut failed: [Option<SimError>; L] = std::array::from_fn(|_| None);
     for w in stops.windows(2) {
         let (from, to) = (w[0].0, w[1].0);
@@ -283,7 +313,7 @@ struct Readings<const L: usize> {
 }
 
 impl<const L: usize> Readings<L> {
-    fn new(params: &[Params; L], test: &PositioningTest) -> Self {
+    fn new(params: &[Params; L], test: &PositioningTest, seeds: [u64; L]) -> Self {
         Readings {
             resolution: params
                 .each_ref()
@@ -291,7 +321,7 @@ impl<const L: usize> Readings<L> {
             // Invariant: Normal refuses only a non-finite σ; `noise` is finite (its
             // field's contract; the command line checks it).
             noise: Normal::new(0.0, test.noise.max(0.0)).expect("a finite σ"),
-            rng: std::array::from_fn(|_| rand::rngs::StdRng::seed_from_u64(test.seed)),
+            rng: seeds.map(rand::rngs::StdRng::seed_from_u64),
             out: std::array::from_fn(|_| Vec::with_capacity(test.readings())),
         }
     }
@@ -427,7 +457,7 @@ mod tests {
             p.controller.kvp *= 1.0 - 0.1 * l as f64;
             test_params(&p, &test)
         });
-        let none = || std::array::from_fn(|_| Compensation::default());
+        let none = || std::array::from_fn(|_| Lane::of(&test));
         let lanes = run_lanes(&sets, &test, none(), |_, _| {}).unwrap();
         for (l, p) in sets.iter().enumerate() {
             let alone = run(p, &test, |_, _| {}).unwrap();

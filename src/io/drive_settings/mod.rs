@@ -43,11 +43,20 @@ pub struct ServoSettings {
     pub symmetrising_s: f64,
     /// Control period Tc, s.
     pub tc: f64,
+    /// The current loop's lag rtid modelled, s (0: none); the drive's, not set.
+    pub current_lag_s: f64,
+    /// The position controller's cycle, s (0: every control period).
+    pub position_period_s: f64,
     /// Table turns per motor turn, Rg·Rw ([`Params::ratio`]); 1 on direct and
     /// two-mass drives and on linear axes.
     pub ratio: f64,
     /// The torque setpoint filters, in series.
     pub filters: Vec<SetpointFilter>,
+    /// The closed speed loop's equivalent time constant, s, and its −3 dB bandwidth,
+    /// Hz, where computed (`rtid tune`: `tuning::closed_loop`; `None` from a parameter
+    /// set alone).
+    pub equivalent_time_s: Option<f64>,
+    pub speed_bandwidth_hz: Option<f64>,
 }
 
 impl ServoSettings {
@@ -65,8 +74,12 @@ impl ServoSettings {
             kaff: c.kaff,
             symmetrising_s: c.symmetrising_s,
             tc: c.tc,
+            current_lag_s: c.current_lag_s,
+            position_period_s: c.position_period_s,
             ratio: p.ratio(),
             filters: c.filters.clone(),
+            equivalent_time_s: None,
+            speed_bandwidth_hz: None,
         }
     }
 
@@ -91,6 +104,10 @@ impl ServoSettings {
             ("symmetrising_s", self.symmetrising_s),
             ("Tc", self.tc),
             ("ratio", self.ratio),
+            (
+                "equivalent_time_s",
+                self.equivalent_time_s.unwrap_or_default(),
+            ),
         ];
         for (field, value) in fields {
             finite(field, value)?;
@@ -320,7 +337,11 @@ pub(crate) mod tests {
             kaff: 0.0,
             symmetrising_s: 0.002,
             tc: 250e-6,
+            current_lag_s: 0.0,
+            position_period_s: 0.0,
             ratio: 1.0 / 90.0,
+            equivalent_time_s: None,
+            speed_bandwidth_hz: None,
             filters: vec![
                 SetpointFilter::Notch {
                     centre_hz: 192.0,

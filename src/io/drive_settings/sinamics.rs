@@ -286,6 +286,19 @@ pub fn program(s: &ServoSettings, ctx: &SinamicsContext) -> Result<String, Drive
             super::number(s.kaff)
         ));
     }
+    if let (Some(t), Some(f)) = (s.equivalent_time_s, s.speed_bandwidth_hz) {
+        header.push(format!(
+            "the closed speed loop's equivalent time constant: {} s = 1/(2π·{} Hz), its -3 dB bandwidth; written as SINUMERIK's MD32810. The drive's own speed pre-control symmetrizing (p1428/p1429 as read for the task) is NOT VERIFIED and not written",
+            super::number(t),
+            super::number(f)
+        ));
+    }
+    if s.current_lag_s > 0.0 {
+        header.push(format!(
+            "rtid modelled the current loop as a first-order lag of {} s: the drive's own current controller, not set here",
+            super::number(s.current_lag_s)
+        ));
+    }
     Ok(render(&header, &lines))
 }
 

@@ -200,25 +200,27 @@ fn gear(
     ])
 }
 
-/// The feed-forward's mode (MD32620) and, where it is on, its weight and the speed
-/// loop's equivalent time (MD32610, MD32810).
+/// The feed-forward's mode (MD32620), where it is on its weight (MD32610), and the
+/// speed loop's equivalent time (MD32810): the tuned closed speed loop's where rtid
+/// computed it ([`ServoSettings::equivalent_time_s`]; written with the feed-forward
+/// off too, ready for it), else the symmetrising lag's (with the feed-forward on).
 fn feed_forward(s: &ServoSettings, ax: &str, p: usize) -> Vec<Setting> {
+    let mut out = Vec::new();
     if s.kvff <= 0.0 {
-        return vec![Setting::integer(
+        out.push(Setting::integer(
             format!("$MA_FFW_MODE[{ax}]"),
             0,
             "",
             "MD32620 feed-forward mode 0: none (Kvff = 0)".into(),
-        )];
-    }
-    vec![
-        Setting::integer(
+        ));
+    } else {
+        out.push(Setting::integer(
             format!("$MA_FFW_MODE[{ax}]"),
             1,
             "",
             "MD32620 feed-forward mode 1: speed feed-forward with PT1 balancing (rtid's symmetrising lag is first order)".into(),
-        ),
-        Setting::real(
+        ));
+        out.push(Setting::real(
             format!("$MA_VELO_FFW_WEIGHT[{p},{ax}]"),
             s.kvff,
             "",
@@ -226,17 +228,36 @@ fn feed_forward(s: &ServoSettings, ax: &str, p: usize) -> Vec<Setting> {
                 "MD32610 speed feed-forward factor = Kvff = {}",
                 super::number(s.kvff)
             ),
-        ),
-        Setting::real(
-            format!("$MA_EQUIV_SPEEDCTRL_TIME[{p},{ax}]"),
+        ));
+    }
+    let name = format!("$MA_EQUIV_SPEEDCTRL_TIME[{p},{ax}]");
+    match (s.equivalent_time_s, s.speed_bandwidth_hz) {
+        (Some(t), Some(f)) => out.push(Setting::real(
+            name,
+            t,
+            "s",
+            format!(
+                "MD32810 equivalent time constant of the closed speed loop = 1/(2π·f) with f = {} Hz its -3 dB bandwidth (the tuned loop, exact on the sampled loop){}",
+                super::number(f),
+                if s.kvff > 0.0 {
+                    "; rtid's symmetrising lag runs with it"
+                } else {
+                    "; for when the speed feed-forward is switched on"
+                }
+            ),
+        )),
+        _ if s.kvff > 0.0 => out.push(Setting::real(
+            name,
             s.symmetrising_s,
             "s",
             format!(
                 "MD32810 equivalent time constant of the speed loop for the feed-forward = symmetrising_s = {} s",
                 super::number(s.symmetrising_s)
             ),
-        ),
-    ]
+        )),
+        _ => {}
+    }
+    out
 }
 
 /// The machine data as `;`-commented lines `$MA_…[…,AXn]=value`.
@@ -250,6 +271,14 @@ pub fn program(s: &ServoSettings, ctx: &SinumerikContext) -> Result<String, Driv
         "conversions and sources: docs/drive-settings.md; the speed controller and filters are the drive's: see the SINAMICS list".into(),
         "NOT VERIFIED against a manual: the index forms [set,AXn] and [AXn] of MD31050/31060/32610/32620/32810, MD32610's unit (a factor 0-1 here)".into(),
     ];
+    if s.position_period_s > 0.0 {
+        header.push(format!(
+            "the position controller's cycle rtid modelled: {} s ({} control periods of {} s); SINUMERIK's position-control cycle (MD10050 SYSCLOCK_CYCLE_TIME × MD10060 POSCTRL_SYSCLOCK_TIME_RATIO as read) is NOT VERIFIED and not written",
+            super::number(s.position_period_s),
+            (s.position_period_s / s.tc).round(),
+            super::number(s.tc)
+        ));
+    }
     if s.kaff > 0.0 {
         header.push(format!(
             "not written: torque feed-forward Kaff = {} (inertia at the motor Kaff·drive_gain = {} {}); MD32620 = 2/4 and MD32650 AX_INERTIA were not verified: set them by hand",

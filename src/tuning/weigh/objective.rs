@@ -125,7 +125,7 @@ impl Criterion {
 
     /// Below this a difference is noise: 0.5 report units of a deviation, 10 ms,
     /// 1 % of the step, 2 % of today's effort.
-    fn floor(self, today: f64) -> f64 {
+    pub fn floor(self, today: f64) -> f64 {
         match self {
             Criterion::TableSettling => 0.01,
             Criterion::TableOvershoot => 1.0,
@@ -169,23 +169,44 @@ impl Objective {
     /// The weighted mean ratio of `c`'s criteria to `today`'s, over every criterion:
     /// 1 for today's setting, below 1 for a better one.
     pub fn score(self, c: &Criteria, today: &Criteria) -> f64 {
-        let listed = self.weights();
-        let others = ALL
+        self.score_of(&values(c), &values(today))
+    }
+
+    /// [`Objective::score`] of the criteria's values (in the order of [`ALL`]):
+    /// linear in `c`, so the score of an ensemble's mean values is the mean of its
+    /// members' scores.
+    pub fn score_of(self, c: &Values, today: &Values) -> f64 {
+        let (sum, weight) = ALL
             .iter()
-            .filter(|k| !listed.iter().any(|(l, _)| l == *k))
-            .map(|&k| (k, OTHERS));
-        let (sum, weight) =
-            listed
-                .iter()
-                .copied()
-                .chain(others)
-                .fold((0.0, 0.0), |(sum, weight), (k, w)| {
-                    let t = k.value(today);
-                    let floor = k.floor(t);
-                    (sum + w * (k.value(c) + floor) / (t + floor), weight + w)
-                });
+            .enumerate()
+            .fold((0.0, 0.0), |(sum, weight), (i, &k)| {
+                let w = self.weight(k);
+                let floor = k.floor(today[i]);
+                (sum + w * (c[i] + floor) / (today[i] + floor), weight + w)
+            });
         sum / weight
     }
+
+    /// The weight of `k`: the objective's, or [`OTHERS`].
+    pub fn weight(self, k: Criterion) -> f64 {
+        self.weights()
+            .iter()
+            .find(|(l, _)| *l == k)
+            .map_or(OTHERS, |(_, w)| *w)
+    }
+
+    /// Whether the objective lists `k`.
+    pub fn lists(self, k: Criterion) -> bool {
+        self.weights().iter().any(|(l, _)| *l == k)
+    }
+}
+
+/// Every criterion's value, in the order of [`ALL`].
+pub type Values = [f64; ALL.len()];
+
+/// The values of `c`'s criteria ([`Criterion::value`]), in the order of [`ALL`].
+pub fn values(c: &Criteria) -> Values {
+    ALL.map(|k| k.value(c))
 }
 
 impl Objective {
@@ -193,9 +214,7 @@ impl Objective {
     /// (as [`worse`] judges): such a setting is preferred to a better-scoring one
     /// that trades one of them away.
     pub fn keeps(self, c: &Criteria, today: &Criteria) -> bool {
-        worse(c, today)
-            .iter()
-            .all(|w| !self.weights().iter().any(|(k, _)| *k == w.criterion))
+        worse(c, today).iter().all(|w| !self.lists(w.criterion))
     }
 }
 
@@ -207,19 +226,26 @@ pub struct Worse {
     pub after: f64,
 }
 
-/// The criteria `c` makes worse than `today` by more than 2 % and a tenth of the
-/// floor (excursions at the table, settling, overshoot, effort; the table's motion
-/// at rest included).
+/// The criteria `c` makes worse than `today` by more than [`Criterion::tolerance`]
+/// (excursions at the table, settling, overshoot, effort; the table's motion at rest
+/// included).
 pub fn worse(c: &Criteria, today: &Criteria) -> Vec<Worse> {
     ALL.iter()
         .filter_map(|&k| {
             let (before, after) = (k.value(today), k.value(c));
-            let tolerance = 0.02 * before.abs() + 0.1 * k.floor(before);
-            (after > before + tolerance).then_some(Worse {
+            (after > before + k.tolerance(before)).then_some(Worse {
                 criterion: k,
                 before,
                 after,
             })
         })
         .collect()
+}
+
+impl Criterion {
+    /// A change smaller than this from `today`'s value is no change: 2 % of it and a
+    /// tenth of the floor.
+    pub fn tolerance(self, today: f64) -> f64 {
+        0.02 * today.abs() + 0.1 * self.floor(today)
+    }
 }

@@ -10,9 +10,11 @@
 use serde::Serialize;
 
 use crate::controller::Compensation;
+use crate::experiments::positioning::ensemble::{in_member_lanes, Ensemble, MemberRun};
 use crate::experiments::positioning::iso230::ReportUnits;
 use crate::input::{Move, Trajectory};
 use crate::model::idx::{THETA_M, THETA_T};
+use crate::model::rest::{rest_state, Preload};
 use crate::model::{Axis, Params, NSTATE};
 use crate::recorder::Recorder;
 use crate::sim::batch::{in_lanes, LaneRun};
@@ -66,24 +68,73 @@ pub fn responses(p: &Params) -> Result<Responses, SimError> {
 
 /// The same with the controller's compensations `c` on.
 pub fn responses_with(p: &Params, c: &Compensation) -> Result<Responses, SimError> {
-    responses_batch(std::slice::from_ref(p), c)
+    let each = Compensations {
+        servo: c.clone(),
+        table: None,
+    };
+    responses_each(std::slice::from_ref(p), std::slice::from_ref(&each))
         .pop()
         .expect("one set, one result")
 }
 
-/// [`responses_with`] for each of `sets` (of one axis kind), in the kernel's lanes.
-pub fn responses_batch(sets: &[Params], c: &Compensation) -> Vec<Result<Responses, SimError>> {
-    in_lanes(sets, &Runs(c))
+/// The compensations one set's step and move run with.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Compensations {
+    /// The controller's compensation during the step and the move read on the motor
+    /// encoder (the following error, the reversal spike, the effort).
+    pub servo: Compensation,
+    /// The compensation of the axis during a second step, read at the table (its
+    /// settling, overshoot and motion at rest: the axis as the machine runs it, its
+    /// lost motion compensated); `None`: the table is read in the first step.
+    pub table: Option<Compensation>,
 }
 
-/// The step and the move, for `sim::batch`.
-struct Runs<'a>(&'a Compensation);
+/// [`responses_with`] for each of `sets` (of one axis kind) with `each[i]`'s
+/// compensations for `sets[i]`, in the kernel's lanes (a lane's set is found among
+/// `sets` by equality: equal sets get the first one's compensations).
+pub fn responses_each(sets: &[Params], each: &[Compensations]) -> Vec<Result<Responses, SimError>> {
+    in_lanes(sets, &Runs { sets, each })
+}
+
+/// Members `0..ensemble.members` of `p`'s step and move (docs/tuning.md, "The
+/// check"): member k with `base`'s compensations perturbed as the positioning
+/// ensemble perturbs them ([`Ensemble::compensation`]), in the kernel's lanes.
+pub fn responses_members(
+    p: &Params,
+    base: &Compensations,
+    ensemble: &Ensemble,
+) -> Vec<Result<Responses, SimError>> {
+    in_member_lanes(&Members { p, base, ensemble }, ensemble.members)
+}
+
+/// The step and the move of sets found by equality, for `sim::batch`.
+struct Runs<'a> {
+    sets: &'a [Params],
+    each: &'a [Compensations],
+}
+
+impl Runs<'_> {
+    fn of(&self, p: &Params) -> &Compensations {
+        static NONE: Compensations = Compensations {
+            servo: Compensation {
+                backlash: None,
+                table: None,
+                friction: None,
+            },
+            table: None,
+        };
+        self.sets
+            .iter()
+            .position(|s| s == p)
+            .map_or(&NONE, |i| &self.each[i])
+    }
+}
 
 impl LaneRun for Runs<'_> {
     type Out = Responses;
 
     fn lone(&self, p: &Params) -> Result<Responses, SimError> {
-        let [one] = self.lanes(std::array::from_ref(p))?;
+        let [one] = lanes(std::array::from_ref(p), [self.of(p)], [0.0])?;
         one
     }
 
@@ -91,34 +142,97 @@ impl LaneRun for Runs<'_> {
         &self,
         params: &[Params; L],
     ) -> Result<[Result<Responses, SimError>; L], SimError> {
-        let axis = params[0].axis;
-        if params.iter().any(|p| p.axis != axis) {
+        if params.iter().any(|p| p.axis != params[0].axis) {
             return Ok(params.each_ref().map(|p| self.lone(p)));
         }
-        let (step, speed) = match axis {
-            Axis::Rotary => (1f64.to_radians(), 10f64.to_radians()),
-            Axis::Linear => (1e-3, 10e-3),
-        };
-        let steps = run(params, self.0, &[(0.0, step, None, STEP_S)])?;
-        let leg = 5.0 * step / speed;
-        let moves = run(
-            params,
-            self.0,
-            &[
-                (0.0, 5.0 * step, Some(speed), leg),
-                (5.0 * step, 0.0, Some(speed), leg),
-            ],
-        )?;
-        let mut moves = moves.into_iter();
-        Ok(steps.map(|s| {
-            let m = moves.next().expect("one per lane");
-            Ok(figures(&s?, &m?, step, leg, ReportUnits::of(axis)))
-        }))
+        lanes(params, params.each_ref().map(|p| self.of(p)), [0.0; L])
     }
 }
 
-/// The figures of one set's step and move samples.
-fn figures(steps: &[Sample], moves: &[Sample], step: f64, leg: f64, u: ReportUnits) -> Responses {
+/// An ensemble's members of one set, for [`in_member_lanes`].
+struct Members<'a> {
+    p: &'a Params,
+    base: &'a Compensations,
+    ensemble: &'a Ensemble,
+}
+
+impl MemberRun for Members<'_> {
+    type Out = Responses;
+
+    fn lanes<const L: usize>(
+        &self,
+        members: [usize; L],
+    ) -> Result<[Result<Responses, SimError>; L], SimError> {
+        let perturbed = |c: &Compensation, k| self.ensemble.compensation(k, self.p, c);
+        let each = members.map(|k| Compensations {
+            servo: perturbed(&self.base.servo, k),
+            table: self.base.table.as_ref().map(|t| perturbed(t, k)),
+        });
+        let starts = members.map(|k| self.ensemble.perturbation(k, self.p).offset);
+        lanes(
+            &std::array::from_fn(|_| self.p.clone()),
+            each.each_ref(),
+            starts,
+        )
+    }
+}
+
+/// The step and the move of `L` sets of one axis kind, each with its compensations,
+/// from rest at `starts`.
+fn lanes<const L: usize>(
+    params: &[Params; L],
+    each: [&Compensations; L],
+    starts: [f64; L],
+) -> Result<[Result<Responses, SimError>; L], SimError> {
+    let axis = params[0].axis;
+    let (step, speed) = match axis {
+        Axis::Rotary => (1f64.to_radians(), 10f64.to_radians()),
+        Axis::Linear => (1e-3, 10e-3),
+    };
+    let servo = each.map(|c| &c.servo);
+    let stepped = [(0.0, step, None, STEP_S)];
+    let steps = run(params, (servo, starts), &stepped)?;
+    let leg = 5.0 * step / speed;
+    let moves = run(
+        params,
+        (servo, starts),
+        &[
+            (0.0, 5.0 * step, Some(speed), leg),
+            (5.0 * step, 0.0, Some(speed), leg),
+        ],
+    )?;
+    let table_steps = if each.iter().any(|c| c.table.is_some()) {
+        let table = each.map(|c| c.table.as_ref().unwrap_or(&c.servo));
+        Some(run(params, (table, starts), &stepped)?)
+    } else {
+        None
+    };
+    let mut moves = moves.into_iter();
+    let mut table_steps = table_steps.map(|t| t.into_iter());
+    Ok(steps.map(|s| {
+        let m = moves.next().expect("one per lane");
+        let t = table_steps
+            .as_mut()
+            .map(|t| t.next().expect("one per lane"));
+        let s = s?;
+        let t = match t {
+            Some(t) => t?,
+            None => s.clone(),
+        };
+        Ok(figures(&s, &t, &m?, step, leg, ReportUnits::of(axis)))
+    }))
+}
+
+/// The figures of one set's step (on the motor, `steps`; at the table,
+/// `table_steps`) and move samples.
+fn figures(
+    steps: &[Sample],
+    table_steps: &[Sample],
+    moves: &[Sample],
+    step: f64,
+    leg: f64,
+    u: ReportUnits,
+) -> Responses {
     let k = u.deviation_per_si;
     let motor = |s: &Sample| s.1;
     let table = |s: &Sample| s.2;
@@ -128,9 +242,9 @@ fn figures(steps: &[Sample], moves: &[Sample], step: f64, leg: f64, u: ReportUni
         step: step * u.target_per_si,
         step_overshoot_percent: overshoot(steps, step, motor),
         step_settling_s: settling(steps, step, k, motor),
-        table_overshoot_percent: overshoot(steps, step, table),
-        table_settling_s: settling(steps, step, k, table),
-        table_motion_at_rest: motion_after(steps, STEP_S - REST_WINDOW_S, table) * k,
+        table_overshoot_percent: overshoot(table_steps, step, table),
+        table_settling_s: settling(table_steps, step, k, table),
+        table_motion_at_rest: motion_after(table_steps, STEP_S - REST_WINDOW_S, table) * k,
         following_error: following * k,
         reversal_spike: spike * k,
         peak_effort: effort(steps).max(effort(moves)),
@@ -185,16 +299,22 @@ impl Recorder for Positions {
     }
 }
 
-/// Runs the moves (from, to, speed, duration) one after the other from rest, every
-/// set in a lane: each lane's samples, or its error.
+/// Runs the moves (from, to, speed, duration) one after the other from rest at
+/// `starts` (0, or a sub-count offset of an ensemble's member), every set in a lane
+/// with its compensation: each lane's samples, or its error.
 fn run<const L: usize>(
     params: &[Params; L],
-    c: &Compensation,
+    (compensations, starts): ([&Compensation; L], [f64; L]),
     moves: &[(f64, f64, Option<f64>, f64)],
 ) -> Result<[Result<Vec<Sample>, SimError>; L], SimError> {
     let mut sim = LaneSimulation::<L>::of(params, common_step(params)?)?;
+    for (l, (p, &start)) in params.iter().zip(&starts).enumerate() {
+        if start != 0.0 {
+            sim.start(l, rest_state(p, start, Preload::None), 0.0);
+        }
+    }
     let mut controllers = sim.controllers(params)?;
-    for controller in &mut controllers {
+    for (controller, c) in controllers.iter_mut().zip(compensations) {
         controller.set_compensation(c.clone());
     }
     let mut out: [Vec<Sample>; L] = std::array::from_fn(|_| Vec::new());

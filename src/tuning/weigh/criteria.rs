@@ -10,11 +10,13 @@
 //! kernel's lanes; [`check`] weighs the setting proposed and today's on the standard
 //! cycle (`rtid experiment positioning`'s).
 
+use rayon::prelude::*;
 use serde::Serialize;
 
-use super::verify::{self, Responses};
+use super::verify::{self, Compensations, Responses};
 use crate::controller::Compensation;
 use crate::experiments::positioning::compensate::{self, CompensateError};
+use crate::experiments::positioning::ensemble::{Ensemble, EnsembleError};
 use crate::experiments::positioning::iso230::{self, AxisStats, Iso230Error, ReportUnits};
 use crate::experiments::positioning::{self, PositioningTest};
 use crate::model::{Axis, Params};
@@ -60,6 +62,8 @@ pub enum CriteriaError {
     Iso230(#[from] Iso230Error),
     #[error(transparent)]
     Compensate(#[from] CompensateError),
+    #[error(transparent)]
+    Ensemble(#[from] EnsembleError),
     /// Not weighed (a place kept for a setting weighed apart).
     #[error("not weighed")]
     Unscreened,
@@ -87,34 +91,24 @@ pub fn standard_cycle(p: &Params) -> PositioningTest {
 }
 
 /// The figures of each of `sets` (one axis kind) on the short cycle, its
-/// compensation built from a first cycle and run in the controller for a second;
-/// in the kernel's lanes.
+/// compensation built from a first cycle and run in the controller for a second,
+/// the step read at the table on the axis so compensated; in the kernel's lanes.
 pub fn screen(sets: &[Params]) -> Vec<Result<Criteria, CriteriaError>> {
     let Some(first) = sets.first() else {
         return Vec::new();
     };
     let test = short_cycle(first);
-    let servo = verify::responses_batch(sets, &Compensation::default());
-    let built: Vec<Result<(AxisStats, Compensation), CriteriaError>> =
-        positioning::run_batch(sets, &test)
-            .into_iter()
-            .map(|readings| {
-                let readings = readings?;
-                let before = iso230::evaluate(&readings)?.axis;
-                Ok((
-                    before,
-                    compensate::compute(&readings, first.axis, None)?.compensation,
-                ))
-            })
-            .collect();
-    let compensations: Vec<Compensation> = built
+    let built = first_cycles(sets, &test);
+    let compensations = compensations_of(&built);
+    let second = positioning::run_batch_compensated(sets, &test, &compensations);
+    let each: Vec<Compensations> = compensations
         .iter()
-        .map(|b| {
-            b.as_ref()
-                .map_or_else(|_| Compensation::default(), |b| b.1.clone())
+        .map(|c| Compensations {
+            servo: Compensation::default(),
+            table: Some(c.clone()),
         })
         .collect();
-    let second = positioning::run_batch_compensated(sets, &test, &compensations);
+    let servo = verify::responses_each(sets, &each);
     servo
         .into_iter()
         .zip(built)
@@ -130,22 +124,98 @@ pub fn screen(sets: &[Params]) -> Vec<Result<Criteria, CriteriaError>> {
         .collect()
 }
 
-/// The figures of `p` on the standard cycle, compensated in the controller.
-pub fn check(p: &Params) -> Result<Criteria, CriteriaError> {
-    let mut test = standard_cycle(p);
-    let (servo, readings) = rayon::join(
-        || verify::responses(p),
-        || positioning::run(p, &test, |_, _| {}),
+/// Each set's first cycle of `test` (in lanes): its ISO 230-2 values and the
+/// compensation built from it.
+fn first_cycles(
+    sets: &[Params],
+    test: &PositioningTest,
+) -> Vec<Result<(AxisStats, Compensation), CriteriaError>> {
+    positioning::run_batch(sets, test)
+        .into_iter()
+        .zip(sets)
+        .map(|(readings, p)| {
+            let readings = readings?;
+            let before = iso230::evaluate(&readings)?.axis;
+            Ok((
+                before,
+                compensate::compute(&readings, p.axis, None)?.compensation,
+            ))
+        })
+        .collect()
+}
+
+/// The compensations of `built` (none where it failed: that set's error is kept).
+fn compensations_of(
+    built: &[Result<(AxisStats, Compensation), CriteriaError>],
+) -> Vec<Compensation> {
+    built
+        .iter()
+        .map(|b| {
+            b.as_ref()
+                .map_or_else(|_| Compensation::default(), |b| b.1.clone())
+        })
+        .collect()
+}
+
+/// One setting's figures over an ensemble (docs/tuning.md, "The check"): member k's
+/// compensated cycle and step and move perturbed as [`Ensemble`] says, the first
+/// cycle (uncompensated, the compensation built from it) shared by all.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Checked {
+    /// Each member's figures, the unperturbed run first.
+    pub members: Vec<Criteria>,
+}
+
+/// The figures of each of `sets` on the standard cycle, as an ensemble: the first
+/// cycles in lanes across the sets, each set's members in lanes.
+pub fn check(sets: &[Params], ensemble: &Ensemble) -> Vec<Result<Checked, CriteriaError>> {
+    let Some(first) = sets.first() else {
+        return Vec::new();
+    };
+    let test = standard_cycle(first);
+    let built = first_cycles(sets, &test);
+    sets.par_iter()
+        .zip(built)
+        .map(|(p, built)| {
+            let (before, compensation) = built?;
+            check_members(p, &test, &before, compensation, ensemble)
+        })
+        .collect()
+}
+
+/// `p`'s members, its first cycle's values `before` and the compensation built from
+/// it given.
+fn check_members(
+    p: &Params,
+    test: &PositioningTest,
+    before: &AxisStats,
+    compensation: Compensation,
+    ensemble: &Ensemble,
+) -> Result<Checked, CriteriaError> {
+    let compensated = PositioningTest {
+        compensation: compensation.clone(),
+        ..test.clone()
+    };
+    let base = Compensations {
+        servo: Compensation::default(),
+        table: Some(compensation),
+    };
+    let (cycles, servo) = rayon::join(
+        || positioning::ensemble::readings(p, &compensated, ensemble),
+        || verify::responses_members(p, &base, ensemble),
     );
-    let readings = readings?;
-    let before = iso230::evaluate(&readings)?.axis;
-    let computed = compensate::compute(&readings, p.axis, None)?;
-    test.compensation = computed.compensation;
-    let after = iso230::evaluate(&positioning::run(p, &test, |_, _| {})?)?.axis;
-    Ok(Criteria {
-        servo: servo?,
-        positioning: figures(&before, &after, &test, p.axis, "controller"),
-    })
+    let members = cycles?
+        .iter()
+        .zip(servo)
+        .map(|(readings, servo)| {
+            let after = iso230::evaluate(readings)?.axis;
+            Ok(Criteria {
+                servo: servo?,
+                positioning: figures(before, &after, test, p.axis, "controller"),
+            })
+        })
+        .collect::<Result<Vec<_>, CriteriaError>>()?;
+    Ok(Checked { members })
 }
 
 fn figures(
