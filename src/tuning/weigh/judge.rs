@@ -11,7 +11,8 @@
 //! today's mean and a tenth of the criterion's floor, [`Criterion::tolerance`]).
 //! The score of member k is the objective's score of its values against the mean of
 //! today's members; the score is linear in the values, so its mean is the score of
-//! the means, and today's scores 1 on average.
+//! the means, and today's scores 1 on average. A score within [`SCORE_TOLERANCE`] of
+//! today's is no better, however narrow its spread.
 
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, StudentsT};
@@ -19,6 +20,9 @@ use statrs::distribution::{ContinuousCDF, StudentsT};
 use super::criteria::Checked;
 use super::objective::{values, Criterion, Objective, Values, ALL};
 use crate::experiments::positioning::ensemble::Spread;
+
+/// The smallest change of the score that counts: 2 %, as for each criterion.
+pub const SCORE_TOLERANCE: f64 = 0.02;
 
 /// How a setting compares with today's on one criterion or on the score.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -102,7 +106,7 @@ pub fn judge(objective: Objective, today: &Checked, after: &Checked) -> Judgemen
         .collect();
     Judgement {
         members: t.len().min(a.len()),
-        score: compare(&score(&t), &score(&a), 0.0),
+        score: compare(&score(&t), &score(&a), SCORE_TOLERANCE),
         criteria,
     }
 }
