@@ -331,6 +331,20 @@ pub struct Params {
     pub controller: ControllerParams,
     /// Where each value comes from, and which ones are uncertain (free text per name).
     pub notes: BTreeMap<String, String>,
+    /// The held ranges of values that are uncertain or assumed: name → relative
+    /// half-width with its reason. Where such a parameter is held (not fitted), the
+    /// identification's intervals and `rtid predict`'s carry the range.
+    pub ranges: BTreeMap<String, HeldRange>,
+}
+
+/// How far an uncertain or assumed value may be off: value·(1 ± percent/100), and why.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HeldRange {
+    /// The relative half-width, per cent (0 < percent < 100).
+    pub percent: f64,
+    /// Why the value is uncertain ("the column is ambiguous", "assumed").
+    pub reason: String,
 }
 
 /// Standard gravity, m/s².
@@ -394,6 +408,8 @@ pub enum ParamError {
     LinearTopology { topology: Topology },
     #[error(transparent)]
     Filter(#[from] super::setpoint_filter::FilterError),
+    #[error("ranges.{name}: {reason}")]
+    BadRange { name: String, reason: String },
     #[error("parameter {name} = {}: {reason}", Num(*value))]
     Inconsistent {
         name: &'static str,

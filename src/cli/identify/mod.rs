@@ -27,7 +27,7 @@ use rtid::identify::pipeline::comparison;
 use rtid::identify::result::comparison::Comparison;
 use rtid::identify::{
     identify, Bound, Config, ExperimentSpec, FidelityChoice, Identified, IdentifyResult, Method,
-    Monitor, SearchOptions, StartChoice, Warning,
+    Monitor, SearchOptions, Staging, StartChoice, Warning,
 };
 use rtid::io::experiment_file::{self, Kind};
 use rtid::io::params_file;
@@ -184,6 +184,14 @@ pub struct Args {
     /// Tload), else the --preset/--params values; `given` — at those values always.
     #[arg(long, value_enum, default_value = "estimate")]
     pub start: StartArg,
+    /// With several experiments, fit every parameter on all of them at once. By
+    /// default the fit goes by plan: each parameter first from the record that
+    /// carries the most information about it (the others held; closed-loop
+    /// simulations first, then frequency responses), then those whose information
+    /// the records share are refined jointly; the plan is printed and in the result
+    /// as `plan`.
+    #[arg(long)]
+    pub joint: bool,
     /// Profile likelihood of these fitted parameters (comma-separated; `--profile`
     /// alone: every fitted one): each is held at values walking out from the fit both
     /// ways while the others are re-fitted, giving its 95 % likelihood-ratio interval
@@ -369,6 +377,11 @@ impl Args {
             checkpoint: self.checkpoint.clone(),
             resume: self.resume,
             start: self.start.into(),
+            staging: if self.joint {
+                Staging::Joint
+            } else {
+                Staging::ByRecord
+            },
         })
     }
 
@@ -516,6 +529,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         objective,
         settings,
         smoothness,
+        ..
     } = outcome?;
     if let Some(names) = &a.profile {
         let fit = (objective.as_ref(), settings, smoothness);
@@ -631,6 +645,9 @@ fn print_summary(r: &IdentifyResult) {
         let names: Vec<&str> = e.values.keys().map(String::as_str).collect();
         println!("start of {}: {}", names.join(", "), e.method);
     }
+    if let Some(p) = &r.plan {
+        print_plan(p);
+    }
     println!("{}", parameter_table(r));
     if let Some(t) = profile_table(r) {
         println!("{t}");
@@ -669,6 +686,60 @@ fn print_summary(r: &IdentifyResult) {
     for w in &r.warnings {
         println!("warning: {}{}", w.0, hint(&w.0));
     }
+}
+
+/// The plan by record: each stage's record and parameters, each parameter's share of
+/// information by record, what was refined jointly and what is not determined.
+fn print_plan(p: &rtid::identify::result::record_plan::RecordPlan) {
+    println!("plan: each parameter from the record that carries the most information about it, the others held; then refined jointly where the records share it");
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    let records: Vec<String> = p
+        .shares
+        .first()
+        .map(|(_, s)| s.iter().map(|(r, _)| r.clone()).collect())
+        .unwrap_or_default();
+    let mut header = vec!["parameter".to_string(), "determined by".into()];
+    header.extend(records.iter().map(|r| format!("information share: {}", short(r))));
+    t.set_header(header);
+    for (name, shares) in &p.shares {
+        let by = p
+            .stages
+            .iter()
+            .position(|s| s.parameters.contains(name))
+            .map_or_else(String::new, |k| format!("stage {} ({})", k + 1, short(&p.stages[k].record)));
+        let by = match (p.undetermined.contains(name), p.refined.contains(name)) {
+            (true, _) => "not determined".to_string(),
+            (false, true) if by.is_empty() => "the joint refinement".into(),
+            (false, true) => format!("{by}, refined jointly"),
+            (false, false) => by,
+        };
+        let mut row = vec![name.clone(), by];
+        row.extend(shares.iter().map(|(_, s)| format!("{:.1} %", 100.0 * s)));
+        t.add_row(row);
+    }
+    println!("{t}");
+    for (k, s) in p.stages.iter().enumerate() {
+        println!(
+            "stage {}: {} — {} ({} evaluations, {:.1} s, {})",
+            k + 1,
+            s.record,
+            s.parameters.join(", "),
+            s.evaluations,
+            s.wall_time_s,
+            s.termination
+        );
+    }
+    if let Some(r) = &p.refinement {
+        println!("refined jointly: {} ({r})", p.refined.join(", "));
+    }
+}
+
+/// A record's file name without its folder.
+fn short(path: &str) -> String {
+    Path::new(path)
+        .file_name()
+        .map_or(path.to_string(), |f| f.to_string_lossy().into_owned())
 }
 
 /// Parameter, start, identified ± standard error, bounds.
