@@ -14,6 +14,7 @@ use crate::cli::ModelArgs;
 use rtid::experiments::positioning::PositioningTest;
 use rtid::identify::result::IdentifyResult;
 use rtid::io::compensation_file;
+use rtid::identify::intervals::chosen::held_ranges;
 use rtid::model::Params;
 use rtid::names::Num;
 use rtid::prediction::draws::Uncertain;
@@ -193,26 +194,36 @@ fn draws(a: &Args, fit: &IdentifyResult) -> anyhow::Result<(DrawSource, draws::D
     Ok((DrawSource::Covariance, d))
 }
 
-/// The held parameters' ranges: the fit's (`identify --uncertain`, the fitted
-/// parameters moving with them), a range given here replacing its width, and
-/// those given here alone drawn independently of the fit.
+/// The held parameters' ranges: the fit's (`identify`'s refits at their ends, the
+/// fitted parameters moving with them), a range given here replacing its width (0 %
+/// holds it exactly); then the parameter set's own ranges of the parameters neither
+/// fitted nor carried by the fit, and those given here alone, drawn independently
+/// of the fit.
 fn uncertain(
     specs: &[String],
     params: &Params,
     fit: &IdentifyResult,
     drawn: &[String],
 ) -> anyhow::Result<Vec<Uncertain>> {
-    let given = common::uncertain::parse(specs, params, &|n| fit.parameters.contains_key(n))?;
-    if let Some((name, ..)) = given.iter().find(|g| drawn.contains(&g.0)) {
-        bail!("--uncertain {name}: the fit's bootstrap replicates draw it already, within the range `identify --uncertain` gave it");
+    let given = common::uncertain::parse(specs)?;
+    if let Some((name, _)) = given.iter().find(|g| drawn.contains(&g.0)) {
+        bail!("--uncertain {name}: the fit's bootstrap replicates draw it already, within the range `identify` gave it");
     }
-    let width = |name: &str| given.iter().find(|g| g.0 == name).map(|g| g.2);
+    let width = |name: &str| given.iter().find(|g| g.0 == name).map(|g| g.1 / 100.0);
     let mut out: Vec<Uncertain> = (fit.held.iter())
+        .filter(|h| width(&h.name) != Some(0.0))
         .map(|h| Uncertain::of_fit(h, fit, width(&h.name)))
         .collect();
+    let fitted: Vec<String> = fit.parameters.keys().cloned().collect();
+    let carried = |n: &String| fit.held.iter().any(|h| &h.name == n) || drawn.contains(n);
+    let own: Vec<(String, f64)> = (given.iter())
+        .filter(|(n, _)| !fit.held.iter().any(|h| &h.name == n))
+        .cloned()
+        .collect();
+    let independent = held_ranges(params, &fitted, &own)?;
     out.extend(
-        (given.iter())
-            .filter(|(n, ..)| !fit.held.iter().any(|h| &h.name == n))
+        (independent.iter())
+            .filter(|(n, ..)| !carried(n))
             .map(|(n, v, h)| Uncertain::independent(n, *v, *h)),
     );
     Ok(out)

@@ -175,6 +175,7 @@ fn uncertainty(
     let sigma2 = uncertainty::residual_variance(&r0, m, names.len());
     let assessed = uncertainty::from_jacobian(&space, &space.start, &jac, sigma2);
     let mut u = with_undetermined(assessed.uncertainty, &planned.fit);
+    u.lower_bounds = planned.records.iter().any(|r| r.rough);
     for w in &found.warnings {
         if let Warning::CorrectionsNotConverged {
             undetermined,
@@ -184,6 +185,7 @@ fn uncertainty(
         } = w
         {
             widen(&mut u, &found.params, undetermined, widened, moved);
+            u.lower_bounds = true;
         }
     }
     Ok((u, assessed.warnings))
@@ -237,6 +239,7 @@ fn with_undetermined(u: Uncertainty, all: &[String]) -> Uncertainty {
         correlation,
         residual_variance: u.residual_variance,
         conditioning: u.conditioning,
+        lower_bounds: u.lower_bounds,
     }
 }
 
@@ -249,6 +252,7 @@ fn empty(all: &[String]) -> Uncertainty {
         correlation: vec![vec![f64::NAN; n]; n],
         residual_variance: 0.0,
         conditioning: 0.0,
+        lower_bounds: false,
     }
 }
 

@@ -121,6 +121,7 @@ pub(crate) fn from_jacobian(
             correlation: zero_undefined(correlation),
             residual_variance: if sigma2.is_finite() { sigma2 } else { 0.0 },
             conditioning: shape.conditioning,
+            lower_bounds: false,
         },
         warnings,
     }
