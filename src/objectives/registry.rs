@@ -17,6 +17,7 @@ pub static REGISTRY: &[&Definition] = &[
     &super::unbalance_step::DEFINITION,
     &super::servo_trace::DEFINITION,
     &super::friction_map::DEFINITION,
+    &super::speed_loop::DEFINITION,
 ];
 
 impl ObjectiveKind {

@@ -180,7 +180,8 @@ pub fn linear(p: &Params, freqs_hz: &[f64]) -> Result<Vec<(f64, f64)>, crate::mo
     linear_of(p, Response::TableOverMotor, freqs_hz)
 }
 
-/// The gain (dB) and phase (deg) of the linearised model's `response` at `freqs_hz`.
+/// The gain (dB) and phase (deg) of the linearised model's `response` at `freqs_hz`
+/// (a speed loop's: the closed loop of `p`'s controller, exact on the sampled loop).
 pub fn linear_of(
     p: &Params,
     response: Response,
@@ -190,6 +191,17 @@ pub fn linear_of(
     let channel = match response {
         Response::TableOverMotor => Channel::TableOverMotor,
         Response::MotorCompliance => Channel::MotorOverTorque,
+        Response::SpeedLoop => {
+            let t = crate::experiments::speed_loop::model::ClosedSpeedLoop::new(p)?;
+            return Ok(freqs_hz
+                .iter()
+                .map(|&f| {
+                    t.at(f).map_or((f64::NAN, f64::NAN), |h| {
+                        (20.0 * h.norm().log10(), h.arg().to_degrees())
+                    })
+                })
+                .collect());
+        }
     };
     Ok(LinearResponse::new(p, channel)?.gain_phase(freqs_hz))
 }

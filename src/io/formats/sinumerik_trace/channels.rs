@@ -155,8 +155,13 @@ fn describe(m: &Measurement, known: Option<MeasuredLoop>) -> Vec<String> {
     notes.push(excitation(m));
     notes.extend(levels(m, known));
     notes.push(axis(m));
-    if let Ok(r) = response::stored_response(m) {
-        notes.push(frequencies(m, &r));
+    if let (Ok(r), Ok((i, o))) = (response::stored_response(m), response::primary_signals(m)) {
+        let name = format!(
+            "{} / {}",
+            signal_name(m, o, known),
+            signal_name(m, i, known)
+        );
+        notes.push(frequencies(m, &r, &name));
     }
     notes.push(
         "no speed-controller settings (Kp, Tn, filters) in the file: a measurement saved \
@@ -246,7 +251,7 @@ fn axis(m: &Measurement) -> String {
     )
 }
 
-fn frequencies(m: &Measurement, r: &response::StoredResponse) -> String {
+fn frequencies(m: &Measurement, r: &response::StoredResponse, name: &str) -> String {
     let n = r.samples_per_period;
     let dft = 1.0 / (n as f64 * m.sample_time_s);
     let file = match (r.file_frequency_hz.first(), r.lines.first()) {
@@ -255,7 +260,7 @@ fn frequencies(m: &Measurement, r: &response::StoredResponse) -> String {
     };
     format!(
         "the spectra are the DFT lines of one {n}-sample period, k·{} Hz (k/(N·Ts)); the \
-         file's frequency vector steps {} Hz ({:+.3} %): the response `… / …` and rtid's \
+         file's frequency vector steps {} Hz ({:+.3} %): the response `{name}` and rtid's \
          import place the lines at k/(N·Ts)",
         short(dft),
         short(file),
