@@ -197,3 +197,47 @@ fn finite_or_large(r: f64) -> f64 {
         1e3
     }
 }
+
+/// What a speed-loop response shows at a glance.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    pub lines: usize,
+    pub lowest_hz: f64,
+    pub highest_hz: f64,
+    /// The first line where the gain falls 3 dB below its value at the lowest line,
+    /// Hz, and the phase there, deg (`None`: it never does).
+    pub bandwidth_hz: Option<f64>,
+    pub phase_at_bandwidth_deg: Option<f64>,
+    /// The highest gain below the bandwidth, dB, and its line (the loop's overshoot).
+    pub peak_db: f64,
+    pub peak_hz: f64,
+}
+
+impl MeasuredSpeedLoop {
+    /// The summary of the lines as measured.
+    pub fn summary(&self) -> Summary {
+        let (gain, phase) = self.bode();
+        summary(&self.frequency_hz, &gain, &phase)
+    }
+}
+
+/// The summary of gains (dB) and phases (deg) at ascending lines `f`.
+pub fn summary(f: &[f64], gain: &[f64], phase: &[f64]) -> Summary {
+    let first = gain.first().copied().unwrap_or(0.0);
+    let band = gain.iter().position(|g| *g < first - 3.0);
+    let upto = band.unwrap_or(gain.len());
+    let (peak_i, peak_db) = gain[..upto]
+        .iter()
+        .copied()
+        .enumerate()
+        .fold((0, f64::NEG_INFINITY), |a, (i, g)| if g > a.1 { (i, g) } else { a });
+    Summary {
+        lines: f.len(),
+        lowest_hz: f.first().copied().unwrap_or(0.0),
+        highest_hz: f.last().copied().unwrap_or(0.0),
+        bandwidth_hz: band.map(|i| f[i]),
+        phase_at_bandwidth_deg: band.map(|i| phase[i]),
+        peak_db,
+        peak_hz: f.get(peak_i).copied().unwrap_or(0.0),
+    }
+}

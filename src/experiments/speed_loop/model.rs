@@ -46,9 +46,11 @@ impl ClosedSpeedLoop {
     }
 
     /// Whether the loop closed is stable: the closed loop's poles inside the unit
-    /// circle (`None` where they are not found).
+    /// circle (`None` where they are not found) — but for the position's, which no
+    /// speed loop feeds back: a pole at z = 1 exactly, counted as on the circle
+    /// within 1e-9.
     pub fn stable(&self) -> Option<bool> {
-        self.open.spectral_radius(1.0).map(|r| r < 1.0)
+        self.open.spectral_radius(1.0).map(|r| r <= 1.0 + 1e-9)
     }
 }
 
