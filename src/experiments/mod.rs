@@ -13,8 +13,6 @@
 //!   record and evaluation;
 //! - [`servo_trace`]: recorded closed-loop runs of any axis, their replay and virtual
 //!   traces;
-//! - [`speed_loop`]: a drive's measurement of its closed speed loop (actual speed over
-//!   setpoint), the model's and the virtual one;
 //! - [`compare`]: the paper's Table 3 over folders of experiment files;
 //!   [`measurement_noise`]: the noise virtual experiments add.
 
@@ -25,5 +23,4 @@ pub mod friction_map;
 pub mod measurement_noise;
 pub mod positioning;
 pub mod servo_trace;
-pub mod speed_loop;
 pub mod torque_curve;

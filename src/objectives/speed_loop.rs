@@ -1,7 +1,7 @@
 //! The closed speed loop's residual: a drive's measured reference response of its
 //! speed loop (actual speed over speed setpoint, `response: "speed_loop"`) against the
 //! model inside its speed controller, exact on the sampled loop
-//! ([`crate::experiments::speed_loop::model`]), line by line as
+//! ([`crate::tuning::speed_loop::model`]), line by line as
 //! [`super::complex_response`] weighs a complex response: the errors of ln|T| and of
 //! the phase, each over its line's σ (from the coherence and the averages, else 1 %).
 //!
@@ -16,9 +16,9 @@
 
 use super::definition::{Definition, SetupError, Source, Stage};
 use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
-use crate::experiments::speed_loop::measured::{is_speed_loop, MeasuredSpeedLoop};
 use crate::io::experiment_file::{Experiment, Kind};
 use crate::model::{Params, Topology};
+use crate::tuning::speed_loop::measured::{is_speed_loop, MeasuredSpeedLoop};
 
 /// The closed speed loop's whole complex response.
 pub static DEFINITION: Definition = Definition {

@@ -21,7 +21,11 @@ const MAX_POINTS: usize = 1200;
 /// The gain above the phase.
 pub fn bode(title: &str, curves: &[Curve]) -> Figure {
     let series = |c: &Curve, y: &[f64]| {
-        let style = if c.measured { Style::Markers } else { Style::Line };
+        let style = if c.measured {
+            Style::Markers
+        } else {
+            Style::Line
+        };
         let points = c
             .frequency_hz
             .iter()

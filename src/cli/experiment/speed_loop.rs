@@ -4,10 +4,10 @@
 use anyhow::bail;
 
 use super::{Common, Plot};
-use rtid::experiments::speed_loop::measured::MeasuredSpeedLoop;
-use rtid::experiments::speed_loop::{self, SpeedLoopTest};
 use rtid::io::experiment_file::Experiment;
 use rtid::report::speed_loop::{bode, Curve};
+use rtid::tuning::speed_loop::measured::MeasuredSpeedLoop;
+use rtid::tuning::speed_loop::{self, SpeedLoopTest};
 
 pub const LONG_ABOUT: &str = "\
 The speed loop's reference response as a drive's measuring function records it \
@@ -101,7 +101,10 @@ pub fn report(exp: &Experiment, plot: &Plot, json: bool) -> anyhow::Result<()> {
         "",
     )?;
     if json {
-        println!("{}", rtid::io::json::pretty(&serde_json::json!({ "summary": s }))?);
+        println!(
+            "{}",
+            rtid::io::json::pretty(&serde_json::json!({ "summary": s }))?
+        );
         return Ok(());
     }
     println!(

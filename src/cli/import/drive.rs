@@ -9,10 +9,10 @@ use std::path::Path;
 use anyhow::Context;
 use serde_json::json;
 
-use rtid::experiments::speed_loop::time_series;
 use rtid::io::experiment_file::{self, Conditions, Manifest};
 use rtid::io::formats::sinumerik_trace::response;
 use rtid::io::import::{drive_measurement, Imported, Source};
+use rtid::tuning::speed_loop::time_series;
 
 /// The stored coherence above which the two responses are compared.
 const COMPARED_ABOVE: f64 = 0.9;

@@ -181,7 +181,8 @@ pub fn linear(p: &Params, freqs_hz: &[f64]) -> Result<Vec<(f64, f64)>, crate::mo
 }
 
 /// The gain (dB) and phase (deg) of the linearised model's `response` at `freqs_hz`
-/// (a speed loop's: the closed loop of `p`'s controller, exact on the sampled loop).
+/// (none of a speed loop, which is the controller's closed loop and not the
+/// mechanics': `tuning::speed_loop` computes it).
 pub fn linear_of(
     p: &Params,
     response: Response,
@@ -191,17 +192,7 @@ pub fn linear_of(
     let channel = match response {
         Response::TableOverMotor => Channel::TableOverMotor,
         Response::MotorCompliance => Channel::MotorOverTorque,
-        Response::SpeedLoop => {
-            let t = crate::experiments::speed_loop::model::ClosedSpeedLoop::new(p)?;
-            return Ok(freqs_hz
-                .iter()
-                .map(|&f| {
-                    t.at(f).map_or((f64::NAN, f64::NAN), |h| {
-                        (20.0 * h.norm().log10(), h.arg().to_degrees())
-                    })
-                })
-                .collect());
-        }
+        Response::SpeedLoop => return Ok(vec![(f64::NAN, f64::NAN); freqs_hz.len()]),
     };
     Ok(LinearResponse::new(p, channel)?.gain_phase(freqs_hz))
 }

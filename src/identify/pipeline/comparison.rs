@@ -65,7 +65,7 @@ pub fn compare(
 ) -> Result<Vec<Comparison>, ComparisonError> {
     Ok(match &exp.data {
         Data::FrequencyResponse { .. }
-            if crate::experiments::speed_loop::measured::is_speed_loop(exp) =>
+            if crate::tuning::speed_loop::measured::is_speed_loop(exp) =>
         {
             speed_loop::compare(source, exp, start, fitted)
         }

@@ -3,10 +3,10 @@
 //! lines, measured, at the start values and at the identified ones.
 
 use super::curve;
-use crate::experiments::speed_loop::measured::{model_bode, MeasuredSpeedLoop};
 use crate::identify::result::comparison::{Comparison, Role};
 use crate::io::experiment_file::Experiment;
 use crate::model::Params;
+use crate::tuning::speed_loop::measured::{model_bode, MeasuredSpeedLoop};
 
 /// The gain and phase comparisons of one speed-loop response (none where the file
 /// has no valid line with phase).

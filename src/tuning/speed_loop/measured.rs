@@ -226,11 +226,15 @@ pub fn summary(f: &[f64], gain: &[f64], phase: &[f64]) -> Summary {
     let first = gain.first().copied().unwrap_or(0.0);
     let band = gain.iter().position(|g| *g < first - 3.0);
     let upto = band.unwrap_or(gain.len());
-    let (peak_i, peak_db) = gain[..upto]
-        .iter()
-        .copied()
-        .enumerate()
-        .fold((0, f64::NEG_INFINITY), |a, (i, g)| if g > a.1 { (i, g) } else { a });
+    let (peak_i, peak_db) =
+        gain[..upto]
+            .iter()
+            .copied()
+            .enumerate()
+            .fold(
+                (0, f64::NEG_INFINITY),
+                |a, (i, g)| if g > a.1 { (i, g) } else { a },
+            );
     Summary {
         lines: f.len(),
         lowest_hz: f.first().copied().unwrap_or(0.0),
