@@ -4,6 +4,7 @@
 //!
 //! - [`model`]: the model's closed loop, exact on the sampled loop;
 //! - [`measured`]: a measured response against it (residuals, misfit, Bode curves);
+//! - [`overlay`]: a measurement beside the model with today's and proposed settings;
 //! - [`time_series`]: a measurement's response recomputed from its own time series
 //!   with rtid's periodic estimator, and how it agrees with the drive's spectra;
 //! - this file: the virtual measurement — the model's closed loop at the lines a
@@ -13,6 +14,7 @@
 
 pub mod measured;
 pub mod model;
+pub mod overlay;
 pub mod time_series;
 
 use nalgebra::Complex;
