@@ -16,7 +16,8 @@ mod list;
 
 pub const LONG_ABOUT: &str = "\
 Reads the files labs export — MATLAB MAT-files (v5/v7), Beckhoff TwinCAT Scope View CSV, \
-Maxon EPOS Studio data-recorder CSV, UFF datasets 58/58b, delimited text with a header — \
+Maxon EPOS Studio data-recorder CSV, UFF datasets 58/58b, SINUMERIK/SINAMICS \
+measuring-function XML, delimited text with a header — \
 as they are, and writes rtid experiment files (manifest + CSV in SI units) from them \
 (docs/import.md).
 
@@ -57,6 +58,13 @@ per file, the maps applied to each file alike; one file whose speed steps throug
 plateaus gives one run per plateau
 --condition NAME=VALUE sets a manifest condition (docs/experiment-files.md), e.g. \
 drive_gain=35.15, loop_period_s=0.001.
+
+A drive's own measurement (SINUMERIK/SINAMICS measuring-function XML) says what it \
+measured: `rtid import freq_trace.XML --out DIR` writes the closed speed loop's response \
+(actual over setpoint speed, response \"speed_loop\") from the drive's stored spectra as \
+DIR/speed_loop.json and, as a check, recomputed from its time series with rtid's periodic \
+estimator as DIR/speed_loop_time_series.json (--name NAME for another stem); no --kind, \
+no --map.
 
 Nothing is smoothed silently: a sample more than 10 robust deviations from its \
 neighbours is reported with file, line and value (and kept), a gap in the time base \
