@@ -62,7 +62,9 @@ pub fn rows(t: &mut Table, found: &[Option<Found>]) {
 
 /// All folders' speed loops on one Bode plot, each named by its folder.
 pub fn plot(plot: &Plot, found: &[(&PathBuf, Option<&Found>)]) -> anyhow::Result<()> {
-    let bodes: Vec<(String, (Vec<f64>, Vec<f64>), &Found)> = found
+    /// A folder's name, its gains and phases, and its lines.
+    type Named<'a> = (String, (Vec<f64>, Vec<f64>), &'a Found);
+    let bodes: Vec<Named> = found
         .iter()
         .filter_map(|&(dir, f)| Some((dir.display().to_string(), f?.lines.bode(), f?)))
         .collect();
