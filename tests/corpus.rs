@@ -439,13 +439,13 @@ fn absurd_option_values_fail_cleanly() {
 fn malformed_lab_exports_fail_cleanly() {
     let dir = tempfile::tempdir().unwrap();
     let mut sources: Vec<PathBuf> = Vec::new();
-    for folder in ["matlab", "twincat-scope", "epos", "uff"] {
+    for folder in ["matlab", "twincat-scope", "epos", "uff", "sinumerik"] {
         let mut found: Vec<PathBuf> = files_under(&fixture("formats").join(folder))
             .into_iter()
             .filter(|p| {
                 matches!(
                     p.extension().and_then(|e| e.to_str()),
-                    Some("mat" | "csv" | "uff")
+                    Some("mat" | "csv" | "uff" | "XML")
                 )
             })
             .collect();

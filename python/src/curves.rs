@@ -45,6 +45,8 @@ fn gain(
     let channel = match response {
         Response::TableOverMotor => Channel::TableOverMotor,
         Response::MotorCompliance => Channel::MotorOverTorque,
+        // The closed loop is not a channel of the mechanics' linear response.
+        Response::SpeedLoop => return None,
     };
     let model = |p: &Params| -> Option<Vec<f64>> {
         let lin = LinearResponse::new(p, channel).ok()?;
@@ -63,6 +65,7 @@ fn gain(
     let y_label = match response {
         Response::TableOverMotor => "gain, dB",
         Response::MotorCompliance => "motor compliance, dB re 1 rad/(N·m)",
+        Response::SpeedLoop => "closed speed loop, dB",
     };
     Some(Comparison {
         source: source.into(),

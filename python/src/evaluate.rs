@@ -79,6 +79,7 @@ fn frequency_response(exp: &Experiment, source: &str) -> PyResult<Value> {
         let integrators = match form.response {
             Response::TableOverMotor => 0,
             Response::MotorCompliance => 2,
+            Response::SpeedLoop => 0,
         };
         let found = fr::modal::modes(&c, integrators);
         value["modes"] = rtid::io::json::value(&found.modes).map_err(|e| rtid_error(&e))?;

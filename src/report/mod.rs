@@ -12,6 +12,7 @@ pub mod identify;
 pub mod periodic;
 pub mod positioning;
 pub mod servo_trace;
+pub mod speed_loop;
 pub mod sweep;
 pub mod torque_curve;
 pub mod tuning;

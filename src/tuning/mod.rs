@@ -3,7 +3,8 @@
 //! margins ([`margins`]), notch filters at the resonances ([`notches`]), and the
 //! velocity PI and position gain for a target phase margin with a gain-margin floor
 //! ([`search`]). [`tune`] puts them together with the margins before and after;
-//! [`bode`] gives a setting's open loop as a Bode plot draws it.
+//! [`bode`] gives a setting's open loop as a Bode plot draws it; [`speed_loop`] the
+//! closed speed loop's response as a drive measures it, against a measurement.
 //!
 //! Layer: above `model` and `controller` (it reads the linear response, the modes and
 //! the controller's discretised filters), below `experiments` and the command line.
@@ -18,6 +19,7 @@ pub mod open_loop;
 pub mod position;
 pub mod sampled;
 pub mod search;
+pub mod speed_loop;
 pub mod stability;
 pub mod verify;
 
