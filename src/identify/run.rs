@@ -73,7 +73,10 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
 
 /// One identification of all of `config`'s experiments together: its plan's search
 /// (and corrections) on their joint cost.
-pub(crate) fn identify_one(config: &Config, monitor: &Monitor) -> Result<Identified, IdentifyError> {
+pub(crate) fn identify_one(
+    config: &Config,
+    monitor: &Monitor,
+) -> Result<Identified, IdentifyError> {
     let clock = Instant::now();
     let plan = Plan::new(config)?;
     let start = start(config, &plan.fit)?;
@@ -111,7 +114,10 @@ pub(crate) fn identify_one(config: &Config, monitor: &Monitor) -> Result<Identif
         warnings.push(Warning::CheckpointNotWritten { path, error });
     }
     let assessment = assess(&plan, &space, &ran, &best, &params, monitor)?;
-    let report = (plan.stages[ran.stages.clamp(1, plan.stages.len()) - 1].stage, ran.fidelity);
+    let report = (
+        plan.stages[ran.stages.clamp(1, plan.stages.len()) - 1].stage,
+        ran.fidelity,
+    );
     let run = Run {
         values: best.values,
         start_estimates: start.estimates,

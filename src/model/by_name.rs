@@ -52,8 +52,8 @@ impl Params {
         self.check_ranges()
     }
 
-    /// Each held range names a parameter of this drive with a non-zero value, a
-    /// half-width strictly between 0 and 100 % and a reason.
+    /// Each held range names a parameter of this drive, a half-width strictly
+    /// between 0 and 100 % and a reason.
     fn check_ranges(&self) -> Result<(), ParamError> {
         for (name, range) in &self.ranges {
             let bad = |reason: String| ParamError::BadRange {
@@ -64,10 +64,10 @@ impl Params {
             if s.name != name {
                 return Err(bad(format!("write the parameter's name as {}", s.name)));
             }
-            let value = s.get(self).ok_or_else(|| bad(format!("{name} does not apply to this drive")))?;
-            if value == 0.0 {
-                return Err(bad(format!("{name} is 0: a relative range needs a value")));
-            }
+            // A value set to 0 (`--set theta_bg=0` on a preset) carries no range: a
+            // relative range of 0 is 0.
+            s.get(self)
+                .ok_or_else(|| bad(format!("{name} does not apply to this drive")))?;
             if !(range.percent > 0.0 && range.percent < 100.0) {
                 return Err(bad(format!(
                     "percent {} must lie strictly between 0 and 100",

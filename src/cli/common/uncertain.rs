@@ -9,7 +9,8 @@ use anyhow::{bail, Context};
 pub fn parse(specs: &[String]) -> anyhow::Result<Vec<(String, f64)>> {
     let mut out: Vec<(String, f64)> = Vec::new();
     for s in specs {
-        let form = || format!("--uncertain {s}: expected NAME=X%, e.g. Kw=10% (0% holds it exactly)");
+        let form =
+            || format!("--uncertain {s}: expected NAME=X%, e.g. Kw=10% (0% holds it exactly)");
         let (name, range) = s.split_once('=').with_context(form)?;
         let percent = range
             .trim()

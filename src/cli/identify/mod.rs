@@ -17,13 +17,13 @@ use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::common::uncertain;
-use rtid::identify::intervals::chosen::{self, held_ranges, Chosen};
 use crate::cli::identify::held::{add_held, held_table};
 use crate::cli::identify::profile::{
     add_profiles, profile_table, surface_notes, write_profile_plots,
 };
 use crate::cli::identify::resample::{add_resampling, resample_table};
 use crate::cli::ModelArgs;
+use rtid::identify::intervals::chosen::{self, held_ranges, Chosen};
 use rtid::identify::pipeline::comparison;
 use rtid::identify::result::comparison::Comparison;
 use rtid::identify::{
@@ -723,14 +723,20 @@ fn print_plan(p: &rtid::identify::result::record_plan::RecordPlan) {
         .map(|(_, s)| s.iter().map(|(r, _)| r.clone()).collect())
         .unwrap_or_default();
     let mut header = vec!["parameter".to_string(), "determined by".into()];
-    header.extend(records.iter().map(|r| format!("information share: {}", short(r))));
+    header.extend(
+        records
+            .iter()
+            .map(|r| format!("information share: {}", short(r))),
+    );
     t.set_header(header);
     for (name, shares) in &p.shares {
         let by = p
             .stages
             .iter()
             .position(|s| s.parameters.contains(name))
-            .map_or_else(String::new, |k| format!("stage {} ({})", k + 1, short(&p.stages[k].record)));
+            .map_or_else(String::new, |k| {
+                format!("stage {} ({})", k + 1, short(&p.stages[k].record))
+            });
         let by = match (p.undetermined.contains(name), p.refined.contains(name)) {
             (true, _) => "not determined".to_string(),
             (false, true) if by.is_empty() => "the joint refinement".into(),
@@ -807,7 +813,10 @@ fn interval_of(r: &IdentifyResult, name: &str, v: f64) -> (String, String) {
         let rel = |x: f64| 100.0 * (x - v) / v.abs();
         format!("{lo:.4e} … {hi:.4e} ({:+.2} / {:+.2} %)", rel(lo), rel(hi))
     };
-    let undetermined = r.plan.as_ref().is_some_and(|p| p.undetermined.iter().any(|n| n == name));
+    let undetermined = r
+        .plan
+        .as_ref()
+        .is_some_and(|p| p.undetermined.iter().any(|n| n == name));
     if undetermined {
         return ("not determined".into(), "no record determines it".into());
     }
@@ -826,9 +835,15 @@ fn interval_of(r: &IdentifyResult, name: &str, v: f64) -> (String, String) {
         Some(se) if !r.held.is_empty() => {
             let held: f64 = r.held.iter().map(|h| h.spread(name).powi(2)).sum();
             let s = (se * se + held).sqrt();
-            (cell(v - 1.96 * s, v + 1.96 * s), "standard error and held ranges".into())
+            (
+                cell(v - 1.96 * s, v + 1.96 * s),
+                "standard error and held ranges".into(),
+            )
         }
-        Some(se) => (cell(v - 1.96 * se, v + 1.96 * se), "±1.96 standard errors".into()),
+        Some(se) => (
+            cell(v - 1.96 * se, v + 1.96 * se),
+            "±1.96 standard errors".into(),
+        ),
     }
 }
 

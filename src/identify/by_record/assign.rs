@@ -70,7 +70,11 @@ pub fn assign(n: usize, records: &[RecordInformation]) -> Assignment {
         .filter(|&p| blind.contains(&p) || vif(&total, &seen, p) > UNDETERMINED_VIF)
         .collect();
     let mut owner: Vec<Option<usize>> = (0..n)
-        .map(|p| (!undetermined.contains(&p)).then(|| argmax(&shares[p])).flatten())
+        .map(|p| {
+            (!undetermined.contains(&p))
+                .then(|| argmax(&shares[p]))
+                .flatten()
+        })
         .collect();
     // Each pass moves one parameter out of a record that cannot determine its set;
     // a parameter moves at most once per record, so n · records passes end it.
@@ -224,7 +228,8 @@ fn next_owner(
     candidates.into_iter().find(|&e| {
         let mut set: Vec<usize> = (0..owner.len()).filter(|&q| owner[q] == Some(e)).collect();
         set.push(p);
-        set.iter().all(|&q| vif(&records[e].fisher, &set, q) <= VIF_LIMIT)
+        set.iter()
+            .all(|&q| vif(&records[e].fisher, &set, q) <= VIF_LIMIT)
     })
 }
 
@@ -247,7 +252,12 @@ mod tests {
     fn separate_records_each_determine_their_own() {
         let frf = record(
             "frf",
-            &[&[100.0, 20.0, 0.0, 0.0], &[20.0, 50.0, 0.0, 0.0], &[0.0; 4], &[0.0; 4]],
+            &[
+                &[100.0, 20.0, 0.0, 0.0],
+                &[20.0, 50.0, 0.0, 0.0],
+                &[0.0; 4],
+                &[0.0; 4],
+            ],
         );
         let torque = record(
             "torque",

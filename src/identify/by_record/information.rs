@@ -21,7 +21,10 @@ use crate::objectives::{Fidelity, Stage};
 
 /// Each of `config`'s experiments' information about the parameters of `space`, at
 /// its start.
-pub fn measure(config: &Config, space: &ParamSpace) -> Result<Vec<RecordInformation>, IdentifyError> {
+pub fn measure(
+    config: &Config,
+    space: &ParamSpace,
+) -> Result<Vec<RecordInformation>, IdentifyError> {
     config
         .experiments
         .par_iter()

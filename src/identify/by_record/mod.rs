@@ -83,7 +83,11 @@ struct StageRun {
 
 /// Runs `planned`: the records' stages, then the joint refinement, then the
 /// assessment of the whole.
-pub fn run(config: &Config, planned: Planned, monitor: &Monitor) -> Result<Identified, IdentifyError> {
+pub fn run(
+    config: &Config,
+    planned: Planned,
+    monitor: &Monitor,
+) -> Result<Identified, IdentifyError> {
     let clock = Instant::now();
     let mut current = planned.space.base.clone();
     let mut stages: Vec<StageRun> = Vec::new();
@@ -107,7 +111,8 @@ pub fn run(config: &Config, planned: Planned, monitor: &Monitor) -> Result<Ident
     let mut reports = Vec::with_capacity(config.experiments.len());
     let mut stage_records: Vec<RecordStage> = Vec::new();
     let mut warnings: Vec<Warning> = planned.start.warnings.clone();
-    let mut by_record: Vec<Option<StageRun>> = (0..config.experiments.len()).map(|_| None).collect();
+    let mut by_record: Vec<Option<StageRun>> =
+        (0..config.experiments.len()).map(|_| None).collect();
     for s in stages {
         let e = s.record;
         by_record[e] = Some(s);
@@ -300,6 +305,7 @@ impl Planned {
             },
             max_evaluations: o.max_evaluations,
             simplex_step: SIMPLEX_STEP_NEAR,
+            random_simplex: false,
         }
     }
 
@@ -323,8 +329,12 @@ impl Planned {
 
 /// Stage `k`'s checkpoint beside the whole's: `fit.ckpt.json` → `fit.ckpt.stage-1.json`.
 fn stage_checkpoint(path: &Path, k: usize) -> PathBuf {
-    let stem = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-    let ext = path.extension().map_or_else(String::new, |e| format!(".{}", e.to_string_lossy()));
+    let stem = path
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let ext = path
+        .extension()
+        .map_or_else(String::new, |e| format!(".{}", e.to_string_lossy()));
     path.with_file_name(format!("{stem}.stage-{}{ext}", k + 1))
 }
 

@@ -82,7 +82,12 @@ pub(super) fn assemble(
     let named = |get: &dyn Fn(&str) -> f64| -> BTreeMap<String, f64> {
         planned.fit.iter().map(|n| (n.clone(), get(n))).collect()
     };
-    let value = |n: &str| crate::model::spec(n).ok().and_then(|s| s.get(p)).unwrap_or(f64::NAN);
+    let value = |n: &str| {
+        crate::model::spec(n)
+            .ok()
+            .and_then(|s| s.get(p))
+            .unwrap_or(f64::NAN)
+    };
     let initial = |n: &str| {
         let i = planned.fit.iter().position(|f| f == n).unwrap_or(0);
         planned.space.start[i]
@@ -97,7 +102,11 @@ pub(super) fn assemble(
     };
     let result = IdentifyResult {
         mechanism: config.base.name.clone(),
-        experiments: config.experiments.iter().map(|e| e.source.clone()).collect(),
+        experiments: config
+            .experiments
+            .iter()
+            .map(|e| e.source.clone())
+            .collect(),
         parameters: named(&value),
         initial: named(&initial),
         start_estimates: planned.start.estimates.clone(),
@@ -159,7 +168,10 @@ fn uncertainty(
     for (part, record) in found.objective.parts.iter().zip(&planned.records) {
         let step = uncertainty_step(record.rough, Fidelity::Linear);
         blocks.push(jacobian(&space, part.as_ref(), &space.start, step)?);
-        r0.extend(part.residuals(&found.params).map_err(ObjectiveError::from)?);
+        r0.extend(
+            part.residuals(&found.params)
+                .map_err(ObjectiveError::from)?,
+        );
     }
     let m = r0.len();
     let jac = DMatrix::from_fn(m, names.len(), |i, j| {
@@ -205,7 +217,10 @@ fn widen(
             *se = None;
         } else if widened.contains(name) {
             let step = moved.iter().find(|(n, _)| n == name).map_or(0.0, |m| m.1);
-            let value = crate::model::spec(name).ok().and_then(|s| s.get(p)).unwrap_or(0.0);
+            let value = crate::model::spec(name)
+                .ok()
+                .and_then(|s| s.get(p))
+                .unwrap_or(0.0);
             *se = se.map(|s| s.max(step * value.abs()));
         }
     }
@@ -229,7 +244,11 @@ fn with_undetermined(u: Uncertainty, all: &[String]) -> Uncertainty {
     let standard_errors = all
         .iter()
         .map(|n| {
-            let se = u.standard_errors.iter().find(|(x, _)| x == n).and_then(|s| s.1);
+            let se = u
+                .standard_errors
+                .iter()
+                .find(|(x, _)| x == n)
+                .and_then(|s| s.1);
             (n.clone(), se)
         })
         .collect();

@@ -193,7 +193,11 @@ fn search_warnings(
 }
 
 /// Each part's residuals at the result, with their details in the measurement's units.
-pub(crate) fn residual_report(joint: &Joint, p: &Params, parts: Vec<Vec<f64>>) -> Vec<ExperimentResidual> {
+pub(crate) fn residual_report(
+    joint: &Joint,
+    p: &Params,
+    parts: Vec<Vec<f64>>,
+) -> Vec<ExperimentResidual> {
     joint
         .parts
         .iter()
