@@ -106,8 +106,13 @@ pub fn identify<'py>(
     )?;
     // Ctrl-C ends the search with its best point (or the intervals with what they
     // finished): the result, marked as stopped, not the exception.
-    let stopped = finished.interrupted.is_some();
-    let (Identified { result, params, .. }, curves) = finished.value?;
+    // Stopped before a single evaluation: nothing to keep, the interrupt itself.
+    let (fit, stopped) = match (finished.value, finished.interrupted) {
+        (Ok(fit), signal) => (fit, signal.is_some()),
+        (Err(_), Some(signal)) => return Err(signal),
+        (Err(e), None) => return Err(e),
+    };
+    let (Identified { result, params, .. }, curves) = fit;
     let json = rtid::io::json::pretty(&result).map_err(|e| rtid_error(&e))?;
     let curves = curves::to_python(py, curves)?;
     let statistics = statistics(py, &result)?;

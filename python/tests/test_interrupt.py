@@ -14,6 +14,7 @@ import subprocess
 import sys
 import threading
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -149,3 +150,18 @@ def test_an_interrupt_of_a_fresh_process_is_a_keyboard_interrupt_not_a_panic():
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert run.stdout.strip() == "KeyboardInterrupt", run.stderr
     assert "PanicException" not in run.stderr and "panicked" not in run.stderr, run.stderr
+
+
+def test_ctrl_c_at_the_start_of_a_search_is_a_keyboard_interrupt_or_its_first_point(root):
+    # Stopped before the first evaluation there is nothing to keep: the interrupt
+    # itself, never an RtidError ("stopped before any evaluation").
+    def ctrl_c(*counts):
+        raise KeyboardInterrupt
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            fit = rtid.identify(root / EMPS, rtid.params(path=root / AXIS), progress=ctrl_c)
+    except KeyboardInterrupt:
+        return
+    assert fit.interrupted

@@ -59,7 +59,7 @@ pub enum SimError {
     #[error("lane {lane} is integrated with dt = {dt} s, lane 0 with {dt0} s: lanes of one batch share the step")]
     LaneStep { lane: usize, dt: f64, dt0: f64 },
     /// A sine the step cannot resolve: above the Nyquist frequency 1/(2·dt).
-    #[error("a sine of {} Hz on an integration step of {dt:e} s, above its Nyquist frequency {} Hz: the run would alias it to another frequency (lower freq_hz, or give a shorter dt)", crate::names::Num(*freq_hz), crate::names::Num(0.5 / *dt))]
+    #[error("a sine of {} Hz on an integration step of {dt:e} s, above its Nyquist frequency {} Hz: the run would alias it to another frequency (lower freq_hz, or give a shorter dt)", crate::names::Num(*freq_hz), crate::names::Num((0.5e6 / *dt).round() / 1e6))]
     AboveNyquist { freq_hz: f64, dt: f64 },
     /// A control period the model cannot run: longer than its slowest mode's period.
     #[error("control period Tc = {} s is longer than the period of the drive's slowest mode ({} Hz, {:.3e} s): a servo sampled that slowly does not control the drive (a unit slip? Tc is in seconds, e.g. 1e-3)", crate::names::Num(*tc), crate::names::Num(*mode_hz), 1.0 / *mode_hz)]
