@@ -717,12 +717,13 @@ def _flag(value, name: str) -> bool:
     return bool(value)
 
 
-def _choice(value, name: str, choices) -> str:
-    """A string argument among `choices`, named in the error with the closest."""
+def _choice(value, name: str, choices, what: str | None = None) -> str:
+    """A string argument among `choices` (each a `what`, default the argument's
+    name), named in the error with the closest."""
     if not isinstance(value, str):
         raise TypeError(f"{name}: expected a string ({', '.join(choices)}), got {type(value).__name__}")
     if value not in choices:
-        raise _names.unknown(name, name, value, choices)
+        raise _names.unknown(name, what or name, value, choices)
     return value
 
 
@@ -845,7 +846,7 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
         _check_parameter_name(name, "bounds")
     if method is not None:
         _choice(method.replace("_", "-") if isinstance(method, str) else method, "method",
-                ("lsq", "lm", "nelder-mead", "pso"))
+                _names.OPTIONS["method"])
     options = {
         "fit": fit,
         "bounds": [(n, *_bound(n, b)) for n, b in (bounds or {}).items()],
@@ -856,7 +857,9 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
         "max_iters": _whole(max_iters, "max_iters"),
         "start": _choice(start, "start", ("estimate", "given")),
         "weights": None if weights is None else [_finite_number(w, "weights") for w in weights],
-        "objectives": None if objectives is None else _names_list(objectives, "objectives"),
+        "objectives": None if objectives is None else [
+            _choice(o.replace("-", "_"), "objectives", _names.OPTIONS["objectives"], what="objective")
+            for o in _names_list(objectives, "objectives")],
         "profile": _profile_names(profile),
         "resample": None if resample is None else _whole(resample, "resample"),
         "uncertain": _uncertain(uncertain),
@@ -920,6 +923,7 @@ def sweep(params: Params, vary, outputs, *, method: str = "grid", samples: int =
         if name:
             _check_parameter_name(name, "vary")
     outputs = [outputs] if isinstance(outputs, str) else _names_list(outputs, "outputs", allow_empty=True)
+    outputs = [_choice(o.strip(), "outputs", _names.OPTIONS["outputs"], what="output") for o in outputs]
     options = dict(vary=vary, outputs=outputs,
                    method=_choice(method, "method", ("grid", "local", "morris", "sobol")),
                    samples=_whole(samples, "samples"), bootstrap=_whole(bootstrap, "bootstrap", 0),

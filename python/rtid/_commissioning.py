@@ -19,6 +19,7 @@ from . import (
     _check_parameter_name,
     _choice,
     _finite_number,
+    _names,
     _names_list,
     _params_arg,
     _progress,
@@ -223,9 +224,9 @@ def tune(params: Params, *, phase_margin_deg: float = 50.0, gain_margin_db: floa
         raise RtidError(f"torque_reserve: {reserve}: a fraction of the limit in 0..0.9")
     options = {
         "phase_margin_deg": pm, "gain_margin_db": gm,
-        "objective": _choice(objective, "objective", ("positioning", "following", "settling")),
+        "objective": _choice(objective, "objective", _names.OPTIONS["objective"]),
         "loop": None if loop is None else _choice(loop.replace("-", "_") if isinstance(loop, str) else loop,
-                                                  "loop", ("semi_closed", "full_closed")),
+                                                  "loop", _names.OPTIONS["loop"]),
         "max_kpp": _positive_or_none(max_kpp, "max_kpp"),
         "max_bandwidth_hz": _positive_or_none(max_bandwidth_hz, "max_bandwidth_hz"),
         "notch_depth_db": depth, "notch_min_width": width, "torque_reserve": reserve,

@@ -95,8 +95,8 @@ SETTINGS = {
 }
 
 _CHOICES = {
-    "loop": ("semi_closed", "full_closed"),
-    "response": ("table_over_motor", "motor_compliance"),
+    "loop": _names.OPTIONS["loop"],
+    "response": _names.OPTIONS["response"],
     "excitation": ("stepped_sine", "noise", "chirp", "multisine"),
     "lines": ("full", "odd", "random_odd"),
 }

@@ -1,9 +1,10 @@
 """The names the module's arguments take, and the closest one to a misspelt name.
 
-The condition keys and each kind's columns are the library's own (``Conditions::KEYS``
-and ``Kind::columns`` in src/io/experiment_file/), read from the extension once: the
-names the reader and the evaluators read, so that a misspelling is caught before a
-file is written.
+The condition keys, each kind's columns and the options' values are the library's own
+(``Conditions::KEYS`` and ``Kind::columns`` in src/io/experiment_file/, the loop modes,
+the search's methods, the objectives, the sweep's outputs, the tuning's objectives),
+read from the extension once: a misspelling is caught before any work, with the
+closest name.
 """
 
 from __future__ import annotations
@@ -21,6 +22,11 @@ CONDITIONS = tuple(_rtid.condition_keys())
 #: The columns each kind's reader and evaluators read (docs/experiment-files.md's
 #: table), every position under each of its unit suffixes.
 COLUMNS = {kind: list(columns) for kind, columns in _rtid.kind_columns()}
+
+#: The options' values as the library spells them: ``loop``, ``method`` (the search's),
+#: ``objectives`` (the identification's), ``outputs`` (the sweep's), ``objective``
+#: (the tuning's), ``response``.
+OPTIONS = {name: tuple(values) for name, values in _rtid.option_names()}
 
 #: How close (difflib's ratio, case ignored) an unknown column must be to a known one
 #: to be taken for a misspelling of it rather than an extra column.

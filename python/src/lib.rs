@@ -56,6 +56,7 @@ fn _rtid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(commissioning::select, m)?)?;
     m.add_function(wrap_pyfunction!(names::condition_keys, m)?)?;
     m.add_function(wrap_pyfunction!(names::kind_columns, m)?)?;
+    m.add_function(wrap_pyfunction!(names::option_names, m)?)?;
     m.add_function(wrap_pyfunction!(names::misspelling_of, m)?)?;
     Ok(())
 }
