@@ -6,6 +6,7 @@ interrupted with a checkpoint and resumed."""
 
 import json
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -74,6 +75,9 @@ def test_the_positioning_test_is_the_cli_s_to_the_bit(positioning):
     for key, value in iso["axis"].items():
         assert mine["axis"][key] == pytest.approx(value, rel=1e-9, abs=1e-12), key
     close(iso["targets"], mine["targets"])
+    # The record from its arrays (the directions as words): the same evaluation.
+    again = rtid.experiment("positioning", **exp.columns)
+    assert rtid.evaluate(again) == dict(mine, source=again.name)
 
 
 def test_compensate_gives_the_cli_s_compensation_and_it_runs_in_the_controller(cli, positioning, drive, tmp_path):
@@ -89,6 +93,8 @@ def test_compensate_gives_the_cli_s_compensation_and_it_runs_in_the_controller(c
     mine.pop("source")
     close(summary, mine, rel=1e-12)
     assert c.summary["build_runs"] == [1, 2] and c.summary["check_runs"] == [3, 4]
+    twin = pickle.loads(pickle.dumps(c))
+    assert twin.text == c.text and twin.summary == c.summary and repr(twin) == repr(c)
     # Its effect on the record, and run in the model's controller.
     shown = cli("evaluate", out / "positioning.json", "--runs", "3-4", "--compensation", comp_file, "--json",
                 json_out=True)
