@@ -76,6 +76,22 @@ pub fn work(amount: f64, limit: f64, what: &str, options: &str) -> Result<(), Li
     })
 }
 
+/// The frequencies `from`, `from + step`, … up to `to` (Hz), their number checked
+/// against [`MAX_POINTS`] before the list is made (`options` naming from, to and step
+/// as the caller does).
+pub fn frequency_grid(
+    from: f64,
+    to: f64,
+    step: f64,
+    options: &str,
+) -> Result<Vec<f64>, LimitError> {
+    let count = ((to - from) / step + 1e-9).floor();
+    work(count + 1.0, MAX_POINTS, "frequencies", options)?;
+    Ok((0..=count as usize)
+        .map(|i| from + step * i as f64)
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

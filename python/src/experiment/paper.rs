@@ -71,13 +71,8 @@ fn frequency_test(s: &Settings) -> PyResult<FrequencyTest> {
             format!("{from}: below {shortest} Hz, where a cycle no longer fits the test's time at one frequency"),
         ));
     }
-    let count = ((to - from) / step + 1e-9).floor();
-    limit(
-        count + 1.0,
-        limits::MAX_POINTS,
-        "frequencies",
-        "from_hz, to_hz, step_hz",
-    )?;
+    let frequencies_hz = limits::frequency_grid(from, to, step, "from_hz, to_hz, step_hz")
+        .map_err(|e| rtid_error(&e))?;
     let refine: f64 = s.get("refine_step_hz")?;
     if refine > 0.0 {
         let around = 2.0 * FrequencyTest::default().refine_half_width_hz / refine;
@@ -89,9 +84,7 @@ fn frequency_test(s: &Settings) -> PyResult<FrequencyTest> {
         )?;
     }
     Ok(FrequencyTest {
-        frequencies_hz: (0..=count as usize)
-            .map(|i| from + step * i as f64)
-            .collect(),
+        frequencies_hz,
         amplitude_nm: s.get("amplitude_nm")?,
         preload_nm: s.get("preload_nm")?,
         refine_step_hz: s.get("refine_step_hz")?,

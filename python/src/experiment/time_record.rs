@@ -68,17 +68,9 @@ fn excitation(s: &Settings, from: f64, to: f64) -> PyResult<Excitation> {
             if from <= 0.0 {
                 return Err(bad_argument("from_hz", "a stepped sine starts above 0 Hz"));
             }
-            let count = ((to - from) / step + 1e-9).floor();
-            limit(
-                count + 1.0,
-                limits::MAX_POINTS,
-                "frequencies",
-                "from_hz, to_hz, step_hz",
-            )?;
+            let grid = limits::frequency_grid(from, to, step, "from_hz, to_hz, step_hz");
             Excitation::SteppedSine {
-                frequencies_hz: (0..=count as usize)
-                    .map(|i| from + step * i as f64)
-                    .collect(),
+                frequencies_hz: grid.map_err(|e| rtid_error(&e))?,
                 dwell_s: s.get("dwell_s")?,
             }
         }

@@ -72,14 +72,10 @@ pub fn work(amount: f64, limit: f64, what: &str, options: &str) -> anyhow::Resul
 /// The frequencies `from`, `from + step`, … up to `to` (Hz), their number checked
 /// against [`MAX_POINTS`] before the list is made.
 pub fn frequency_grid(from: f64, to: f64, step: f64) -> anyhow::Result<Vec<f64>> {
-    let count = ((to - from) / step + 1e-9).floor();
-    work(
-        count + 1.0,
-        MAX_POINTS,
-        "frequencies",
+    Ok(rtid::limits::frequency_grid(
+        from,
+        to,
+        step,
         "--from-hz, --to-hz, --step-hz",
-    )?;
-    Ok((0..=count as usize)
-        .map(|i| from + step * i as f64)
-        .collect())
+    )?)
 }
