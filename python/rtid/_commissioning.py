@@ -355,7 +355,7 @@ def predict(fit, params: Params | None = None, *, compensation=None, tune=None,
     tests = [tests] if isinstance(tests, str) and "," not in tests else _names_list(tests, "tests")
     for t in tests:
         _choice(t.strip(), "tests", ("positioning", "servo"))
-    held = _names_list(list(hold), "hold", allow_empty=True)
+    held = _names_list(hold, "hold", allow_empty=True)
     for name in held:
         _check_parameter_name(name, "hold")
     if uncertain is not None and not isinstance(uncertain, Mapping):
