@@ -127,12 +127,16 @@ def test_bad_options_raise_value_error_naming_them(root, kwargs, argument):
 @pytest.mark.parametrize("columns, argument", [
     (dict(force_n=np.array([1.0, np.nan, 3.0])), r"force_n\[1\]"),
     (dict(force_n=np.zeros(3), time_s=np.zeros(4)), "time_s"),
-    (dict(force_n=np.array(["1", "2"])), "force_n: dtype"),
     (dict(force_n=[[1.0, 2.0]]), "force_n: 2-dimensional"),
 ])
 def test_bad_arrays_raise_value_error_naming_the_column(columns, argument):
     with pytest.raises(ValueError, match=argument):
         rtid.experiment("servo_trace", conditions=CONDITIONS, **columns)
+
+
+def test_a_column_of_strings_raises_type_error_naming_it():
+    with pytest.raises(TypeError, match="force_n: dtype"):
+        rtid.experiment("servo_trace", conditions=CONDITIONS, force_n=np.array(["1", "2"]))
 
 
 def test_a_missing_column_is_named_by_rtid_reader():

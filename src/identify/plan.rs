@@ -116,7 +116,6 @@ impl Plan {
                 },
                 max_evaluations: o.max_evaluations,
                 simplex_step: SIMPLEX_STEP,
-                random_simplex: false,
             },
             escalation: false,
         }];
@@ -132,7 +131,6 @@ impl Plan {
                     fd_step: if rough { FD_ROUGH } else { FD_SMOOTH },
                     max_evaluations: o.max_evaluations,
                     simplex_step: SIMPLEX_STEP,
-                    random_simplex: false,
                 },
                 escalation: auto,
             });

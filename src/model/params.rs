@@ -424,4 +424,27 @@ impl Params {
     pub fn ratio(&self) -> f64 {
         self.rg.unwrap_or(1.0) * self.rw
     }
+
+    /// The controller settings of `tuned` (a tuned set, `rtid tune -o`) for this
+    /// model: a drive of another topology or axis has settings of other units and
+    /// meanings, and is refused.
+    pub fn controller_for(&self, tuned: &Params) -> Result<ControllerParams, OtherDrive> {
+        if tuned.topology != self.topology || tuned.axis != self.axis {
+            return Err(OtherDrive {
+                tuned: format!("{:?} {:?}", tuned.topology, tuned.axis),
+                model: format!("{:?} {:?}", self.topology, self.axis),
+            });
+        }
+        Ok(tuned.controller.clone())
+    }
+}
+
+/// Controller settings of another drive ([`Params::controller_for`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("a {tuned} drive's settings for a {model} model")]
+pub struct OtherDrive {
+    /// The tuned set's topology and axis.
+    pub tuned: String,
+    /// The model's.
+    pub model: String,
 }

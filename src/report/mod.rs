@@ -1,6 +1,7 @@
 //! Presentation: figures (SVG charts) of the tests, identifications and sweeps. The
 //! domain modules compute; this module only draws what they computed.
 
+pub mod compensation;
 pub mod evaluation;
 pub mod figure;
 pub mod fluctuation;

@@ -18,7 +18,7 @@ pub fn parse(specs: &[String]) -> anyhow::Result<Vec<(String, f64)>> {
             .strip_suffix('%')
             .with_context(form)?;
         let percent: f64 = percent.trim().parse().ok().with_context(form)?;
-        if !(percent >= 0.0 && percent < 100.0) {
+        if !(0.0..100.0).contains(&percent) {
             bail!("--uncertain {s}: the range must lie from 0 % (held exactly) to below 100 % of the value");
         }
         let spec =

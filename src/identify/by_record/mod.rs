@@ -305,7 +305,6 @@ impl Planned {
             },
             max_evaluations: o.max_evaluations,
             simplex_step: SIMPLEX_STEP_NEAR,
-            random_simplex: false,
         }
     }
 

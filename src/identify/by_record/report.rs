@@ -24,7 +24,7 @@ use crate::identify::search::settings::Settings;
 use crate::identify::setup;
 use crate::identify::space::ParamSpace;
 use crate::model::Params;
-use crate::objectives::{sum_of_squares, Fidelity, Objective, ObjectiveError, Stage};
+use crate::objectives::{sum_of_squares, Fidelity, Objective, Stage};
 
 /// What the stages and the refinement found.
 pub(super) struct Found {
@@ -168,10 +168,7 @@ fn uncertainty(
     for (part, record) in found.objective.parts.iter().zip(&planned.records) {
         let step = uncertainty_step(record.rough, Fidelity::Linear);
         blocks.push(jacobian(&space, part.as_ref(), &space.start, step)?);
-        r0.extend(
-            part.residuals(&found.params)
-                .map_err(ObjectiveError::from)?,
-        );
+        r0.extend(part.residuals(&found.params)?);
     }
     let m = r0.len();
     let jac = DMatrix::from_fn(m, names.len(), |i, j| {

@@ -21,7 +21,7 @@
 
 use crate::identify::result::warning::Warning;
 use crate::identify::result::IdentifyResult;
-use crate::identify::search::settings::{Method, Settings};
+use crate::identify::search::settings::{Method, Settings, SIMPLEX_STEP_NEAR};
 use crate::model::Params;
 use crate::objectives::Smoothness;
 
@@ -78,17 +78,14 @@ pub fn rough(result: &IdentifyResult, smoothness: Smoothness) -> bool {
 }
 
 /// How a bootstrap replicate is refitted: from the fit (not from the fit's start),
-/// by the fit's solver; Nelder–Mead with a simplex of [`REPLICATE_SIMPLEX`] (about
-/// 23 % of a parameter within its default bounds), each vertex up or down at random
-/// (a search of a few iterations leans the way its simplex points first), and at
-/// most [`REPLICATE_ITERATIONS`] iterations — a replicate's data differ from the
-/// record by its noise and its held draws, so its optimum lies near the fit's
-/// interval, not across the bounds.
+/// by the fit's solver; Nelder–Mead with a small simplex (about 5 % of a parameter
+/// within its default bounds) and at most [`REPLICATE_ITERATIONS`] iterations — a
+/// replicate's data differ from the record by its noise, so its optimum lies within
+/// the fit's interval, not across the bounds.
 pub fn replicate_settings(fit: Settings) -> Settings {
     match fit.method {
         Method::NelderMead => Settings {
-            simplex_step: REPLICATE_SIMPLEX,
-            random_simplex: true,
+            simplex_step: SIMPLEX_STEP_NEAR,
             max_iters: fit.max_iters.min(REPLICATE_ITERATIONS),
             starts: 1,
             ..fit
@@ -98,9 +95,7 @@ pub fn replicate_settings(fit: Settings) -> Settings {
 }
 
 /// Iterations of a replicate's Nelder–Mead search from the fit.
-pub const REPLICATE_ITERATIONS: u64 = 20;
-/// A replicate's Nelder–Mead simplex step, solver units.
-pub const REPLICATE_SIMPLEX: f64 = 0.1;
+pub const REPLICATE_ITERATIONS: u64 = 15;
 
 /// Why a held range cannot be taken.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

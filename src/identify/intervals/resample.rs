@@ -192,7 +192,7 @@ impl Problem<'_> {
             let offset: Vec<f64> = draw.iter().zip(&r0).map(|(d, r)| d - r).collect();
             let held = self.held_draw(seed);
             let fitted = self
-                .refit(objective, offset, &held, seed)
+                .refit(objective, offset, &held)
                 .map(|mut f| {
                     f.extend(held);
                     f
@@ -286,7 +286,6 @@ impl Problem<'_> {
         objective: &dyn Objective,
         offset: Vec<f64>,
         held: &[f64],
-        seed: u64,
     ) -> Result<Vec<f64>, IdentifyError> {
         let mut base = self.params.clone();
         let held = self.held.iter().map(|h| &h.0).zip(held);
@@ -300,7 +299,6 @@ impl Problem<'_> {
         };
         let settings = Settings {
             max_evaluations: None,
-            seed,
             ..self.settings
         };
         let monitor = Monitor::default();

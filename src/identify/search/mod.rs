@@ -88,7 +88,6 @@ fn one_start(
     let limits = Limits {
         max_iters: settings.max_iters,
         simplex_step: settings.simplex_step,
-        random_simplex: settings.random_simplex,
         seed: settings.seed.wrapping_add(index as u64),
     };
     let out = solvers::run(settings.method, problem, space.to_solver(&from), limits);

@@ -16,12 +16,6 @@ pub struct Settings {
     /// Nelder–Mead's initial simplex: each vertex this far from the start along one
     /// solver coordinate (≈ 2.3× as much in ln p for the default ×100 range).
     pub simplex_step: f64,
-    /// Whether each vertex of Nelder–Mead's initial simplex steps up or down at
-    /// random (seeded by `seed` and the start), not towards the middle of its
-    /// coordinate's range: a bootstrap replicate refitted from the fit in a few
-    /// iterations would otherwise explore one side of it first, and its values lean
-    /// that way.
-    pub random_simplex: bool,
 }
 
 /// The default simplex step: 0.4 solver units, a factor ≈ 2.5 in a positive
@@ -43,7 +37,6 @@ impl Default for Settings {
             fd_step: 1e-5,
             max_evaluations: None,
             simplex_step: SIMPLEX_STEP,
-            random_simplex: false,
         }
     }
 }

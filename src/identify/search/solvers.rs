@@ -32,9 +32,7 @@ pub struct Limits {
     pub max_iters: u64,
     /// Nelder–Mead's initial simplex step, solver coordinates.
     pub simplex_step: f64,
-    /// Whether the simplex's vertices step up or down at random (seeded by `seed`).
-    pub random_simplex: bool,
-    /// Seed of the particle swarm (and of a random simplex).
+    /// Seed of the particle swarm.
     pub seed: u64,
 }
 
@@ -75,17 +73,11 @@ pub fn run(method: Method, problem: Problem<'_>, x0: DVector<f64>, limits: Limit
             .map_err(argmin::core::Error::from),
         Method::NelderMead => {
             let mut simplex = vec![x0.clone()];
-            let mut rng = StdRng::seed_from_u64(limits.seed ^ 0x7369_6d70);
             for j in 0..n {
                 let mut v = x0.clone();
+                // Towards the middle of the solver coordinate's range.
                 let step = limits.simplex_step;
-                // Towards the middle of the solver coordinate's range, or either way.
-                let down = if limits.random_simplex {
-                    rand::Rng::random_bool(&mut rng, 0.5)
-                } else {
-                    x0[j] > 0.0
-                };
-                v[j] += if down { -step } else { step };
+                v[j] += if x0[j] > 0.0 { -step } else { step };
                 simplex.push(v);
             }
             let solver = NelderMead::new(simplex)

@@ -196,7 +196,7 @@ pub struct Conditions {
 
 impl Conditions {
     /// The JSON keys of the typed fields.
-    pub(super) const KEYS: [&'static str; 25] = [
+    pub const KEYS: [&'static str; 25] = [
         "torque_amplitude_nm",
         "preload_nm",
         "amplitude_deg",
