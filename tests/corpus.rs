@@ -1007,7 +1007,7 @@ fn misspellings_and_ranges_through_zero_are_refused_naming_them() {
     let cases = cases.into_iter().chain([
         (
             predict("Kw=150%"),
-            "--uncertain Kw=150%: the range must lie between 0 and 100 %",
+            "--uncertain Kw=150%: the range must lie from 0 % (held exactly) to below 100 %",
         ),
         (predict("fm=10%"), "fm is fitted"),
         (predict("Kww=10%"), "did you mean `Kw`?"),

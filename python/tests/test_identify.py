@@ -172,12 +172,18 @@ def test_held_ranges_give_the_cli_shifts(cli, root, tmp_path):
     expected = json.loads(out.read_text())["held"]
     r = rtid.identify(worm, rtid.params("worm-gear"), fit="Kw,Kg", model="linear",
                       uncertain={"Jt": 0.1})
-    assert [h["name"] for h in r.held] == ["Jt"]
-    for name, shift in expected[0]["shifts"].items():
-        assert r.held[0]["shifts"][name] == pytest.approx(shift, rel=1e-12, abs=0)
-    torque = root / "fixtures/worm-gear/torque_curve.json"
-    with pytest.raises(ValueError, match="uncertain.*resample"):
-        rtid.identify(torque, rtid.params("worm-gear"), fit="fm", uncertain={"Kw": 0.1})
+    # The preset's own held ranges are carried beside Jt's, by both.
+    assert [h["name"] for h in r.held] == [h["name"] for h in expected]
+    assert "Jw" in [h["name"] for h in r.held]
+    for mine, theirs in zip(r.held, expected):
+        assert mine["half_width"] == theirs["half_width"]
+        for name, shift in theirs["shifts"].items():
+            assert mine["shifts"][name] == pytest.approx(shift, rel=1e-12, abs=0)
+    jt = next(h for h in r.held if h["name"] == "Jt")
+    assert jt["half_width"] == 0.1
+    exact = rtid.identify(worm, rtid.params("worm-gear"), fit="Kw,Kg", model="linear",
+                          uncertain={"Jt": 0})
+    assert "Jt" not in [h["name"] for h in exact.held]
 
 
 @pytest.mark.parametrize("kwargs, argument", [

@@ -29,13 +29,14 @@ interval of the draws: \"A after 3.6 [3.4 … 3.9]″\".
 
 The model is the base the fit started from (--preset or --params, as given to identify) \
 with the fit's values set. The interval carries the fitted parameters' uncertainty and \
-that of the held parameters: those `identify --uncertain` gave ranges (drawn with the \
-fitted parameters moving as the fit said, or as the replicates drew them) and those \
-given here with --uncertain NAME=X% (drawn uniformly within value·(1 ± X %)); it is \
+that of the held parameters: the parameter set's held ranges (`rtid params` shows a \
+preset's) — those `identify` carried drawn with the fitted parameters moving as the \
+fit said, or as the replicates drew them; the others, and those given here with \
+--uncertain NAME=X%, uniformly within value·(1 ± X %); 0 % holds one exactly. It is \
 extended to the value at the fit where the draws' interval misses it. Every other \
 parameter keeps its value, and the output names them. On six worm gears that are not \
-the preset, 69 of 72 intervals from `identify --resample 24 --uncertain …` held the \
-machine's value (docs/validation.md). A fitted parameter \
+the preset, 57 of 72 intervals of the default chain held the machine's value, 69 of 72 \
+with 24 replicates and three ranges given by hand (docs/validation.md). A fitted parameter \
 the data did not determine (no standard error) cannot be drawn: the command refuses \
 until it is held at its value (--hold NAME), and then says so.
 
@@ -78,11 +79,11 @@ pub struct Args {
     /// Hold a fitted parameter at its value instead of drawing it; repeatable.
     #[arg(long, value_name = "NAME")]
     pub hold: Vec<String>,
-    /// A parameter the fit held at an assumed value, with its uncertainty as a
-    /// relative half-range: drawn uniformly within value·(1 ± X %) beside the fit's
-    /// draws (e.g. --uncertain Kw=10% for a stiffness taken from a catalogue);
-    /// repeatable. For one `identify --uncertain` carried, this width replaces its
-    /// own (the fitted parameters still move with it).
+    /// A held parameter's relative half-range in place of the parameter set's own
+    /// (or beside it, for one without): drawn uniformly within value·(1 ± X %)
+    /// beside the fit's draws (e.g. --uncertain Kw=10% for a stiffness taken from a
+    /// catalogue); 0% holds it exactly; repeatable. For one `identify` carried, this
+    /// width replaces its own (the fitted parameters still move with it).
     #[arg(long, value_name = "NAME=X%")]
     pub uncertain: Vec<String>,
     /// Positioning test: runs per direction.
