@@ -164,6 +164,11 @@ fn bench(c: &mut Criterion) {
         ("uff58", Format::parse("uff").unwrap(), uff(dir.path())),
         ("mat", Format::parse("mat").unwrap(), mat(dir.path())),
         (
+            "sinumerik-trace",
+            Format::parse("sinumerik-trace").unwrap(),
+            fixture("sinumerik/freq_trace.XML"),
+        ),
+        (
             "delimited",
             Format::parse("delimited").unwrap(),
             delimited(dir.path()),

@@ -70,7 +70,15 @@ impl InputSpec {
                 freq_hz,
                 amp_nm,
                 offset_nm,
-            } => sim.run_open_loop(&mut Sine::new(freq_hz, amp_nm, offset_nm), duration, rec),
+            } => {
+                if freq_hz > 0.5 / sim.dt() {
+                    return Err(SimError::AboveNyquist {
+                        freq_hz,
+                        dt: sim.dt(),
+                    });
+                }
+                sim.run_open_loop(&mut Sine::new(freq_hz, amp_nm, offset_nm), duration, rec)
+            }
             InputSpec::Step { torque_nm, at_s } => {
                 sim.run_open_loop(&mut Step { torque_nm, at_s }, duration, rec)
             }

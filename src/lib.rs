@@ -76,8 +76,10 @@ pub mod identify;
 pub mod input;
 #[doc(hidden)]
 pub mod input_spec;
+pub mod interrupt;
 #[doc(hidden)]
 pub mod io;
+pub mod limits;
 #[doc(hidden)]
 pub mod model;
 #[doc(hidden)]

@@ -523,6 +523,40 @@ mod errors {
         assert!(!err.contains("panicked"), "{err}");
     }
 
+    /// A sine the integration step cannot resolve and a control period longer than
+    /// the drive's slowest mode are refused (issue 59), naming what is wrong.
+    #[test]
+    fn inputs_the_model_cannot_resolve_are_refused() {
+        let dir = tempdir();
+        let out = simulate_worm(
+            &[
+                "--input",
+                "sine:freq_hz=1e9,amp_nm=5",
+                "--duration-s",
+                "0.01",
+                "--out",
+                "x.csv",
+            ],
+            dir.path(),
+        );
+        assert_one_line_error(&out, &["a sine of 1e9 Hz", "Nyquist frequency 50000 Hz"]);
+        let out = simulate_worm(
+            &[
+                "--set",
+                "Tc=10",
+                "--input",
+                "move:target_deg=1",
+                "--duration-s",
+                "0.01",
+                "--out",
+                "x.csv",
+            ],
+            dir.path(),
+        );
+        assert_one_line_error(&out, &["control period Tc = 10 s", "slowest mode"]);
+        assert!(!dir.path().join("x.csv").exists());
+    }
+
     #[test]
     fn negative_duration_is_rejected() {
         let dir = tempdir();

@@ -439,13 +439,13 @@ fn absurd_option_values_fail_cleanly() {
 fn malformed_lab_exports_fail_cleanly() {
     let dir = tempfile::tempdir().unwrap();
     let mut sources: Vec<PathBuf> = Vec::new();
-    for folder in ["matlab", "twincat-scope", "epos", "uff"] {
+    for folder in ["matlab", "twincat-scope", "epos", "uff", "sinumerik"] {
         let mut found: Vec<PathBuf> = files_under(&fixture("formats").join(folder))
             .into_iter()
             .filter(|p| {
                 matches!(
                     p.extension().and_then(|e| e.to_str()),
-                    Some("mat" | "csv" | "uff")
+                    Some("mat" | "csv" | "uff" | "XML")
                 )
             })
             .collect();
@@ -1007,7 +1007,7 @@ fn misspellings_and_ranges_through_zero_are_refused_naming_them() {
     let cases = cases.into_iter().chain([
         (
             predict("Kw=150%"),
-            "--uncertain Kw=150%: the range must lie between 0 and 100 %",
+            "--uncertain Kw=150%: the range must lie from 0 % (held exactly) to below 100 %",
         ),
         (predict("fm=10%"), "fm is fitted"),
         (predict("Kww=10%"), "did you mean `Kw`?"),

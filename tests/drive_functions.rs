@@ -147,6 +147,7 @@ fn a_trace_recorded_with_feed_forward_replays_from_its_stated_functions() {
             frequency_hz: 1200.0,
             damping: 0.7,
         }]),
+        ..Default::default()
     };
     functions.apply(&mut drive.controller);
     let recorded = virtual_trace(&drive, &Default::default(), None).unwrap();

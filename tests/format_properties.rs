@@ -37,7 +37,7 @@ fn fixture(relative: &str) -> PathBuf {
 
 /// The real files the readers are fuzzed on: every format, both byte orders, both
 /// MAT-file versions, ASCII and binary UFF.
-const SEEDS: [&str; 14] = [
+const SEEDS: [&str; 15] = [
     "formats/matlab/DATA_EMPS.mat",
     "formats/matlab/arrays_be.mat",
     "formats/matlab/arrays_v7_compressed.mat",
@@ -52,6 +52,7 @@ const SEEDS: [&str; 14] = [
     "formats/uff/pyuff_58b.uff",
     "formats/uff/time-history-not-all-columns-filled.uff",
     "frf/worm_frf.uff",
+    "formats/sinumerik/freq_trace.XML",
 ];
 
 /// A change to a file's bytes, picked at random by [`mutation`]; positions are taken

@@ -482,9 +482,10 @@ fn identify_tune_and_predict_a_tuning_in_a_chain() {
 
 /// `identify --uncertain`: on a smooth cost the fit is repeated at each end of the
 /// held parameter's range, its shifts half the difference of what separate fits
-/// with the held value set give; on a rough cost it needs --resample. `predict`
-/// draws the fit's held parameters beside the fitted ones, and refuses a range the
-/// fit's replicates draw already.
+/// with the held value set give; the preset's own ranges are carried beside it
+/// unless held exactly (0 %). `predict` draws the fit's held parameters beside the
+/// fitted ones and the preset's other ranges independently, and refuses a range
+/// the fit's replicates draw already.
 #[test]
 fn held_ranges_go_from_the_identification_into_the_prediction() {
     let dir = tempfile::tempdir().unwrap();
@@ -505,9 +506,22 @@ fn held_ranges_go_from_the_identification_into_the_prediction() {
         args.extend_from_slice(extra);
         json(&rtid(&args, dir.path()))
     };
+    let by_default = identify(&[]);
+    let names: Vec<&str> = (by_default["held"].as_array().unwrap().iter())
+        .map(|h| h["name"].as_str().unwrap())
+        .collect();
+    assert!(
+        names.contains(&"Jt") && names.contains(&"Jw") && !names.contains(&"Kw"),
+        "the preset's ranges of the held parameters, not of the fitted: {names:?}"
+    );
     let fit = identify(&["--uncertain", "Jt=10%"]);
-    let held = &fit["held"][0];
-    assert_eq!(held["name"], "Jt");
+    let held = (fit["held"].as_array().unwrap().iter())
+        .find(|h| h["name"] == "Jt")
+        .unwrap();
+    assert_eq!(
+        held["half_width"], 0.1,
+        "--uncertain replaces the preset's 25 %"
+    );
     let at = |name: &str| fit["parameters"][name].as_f64().unwrap().to_string();
     let (kw, kg) = (format!("Kw={}", at("Kw")), format!("Kg={}", at("Kg")));
     let ends: Vec<serde_json::Value> = ["Jt=0.1188", "Jt=0.0972"]
@@ -542,25 +556,6 @@ fn held_ranges_go_from_the_identification_into_the_prediction() {
         dir.path(),
     ));
     assert!(e.contains("--uncertain Kw=10%: Kw is fitted"), "{e}");
-    let torque = root().join("fixtures/worm-gear/torque_curve.json");
-    let e = err(&rtid(
-        &[
-            "identify",
-            torque.to_str().unwrap(),
-            "--preset",
-            "worm-gear",
-            "--fit",
-            "fm",
-            "--uncertain",
-            "Kw=10%",
-        ],
-        dir.path(),
-    ));
-    assert!(
-        e.contains("--uncertain") && e.contains("needs --resample"),
-        "{e}"
-    );
-
     let mut shipped: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(fit_file()).unwrap()).unwrap();
     shipped["held"] = serde_json::json!([{"name": "theta_bg", "value": 3e-4,

@@ -61,6 +61,13 @@ __all__ = [
     "frequency_response",
     "StateSpace",
     "state_space",
+    "Compensation",
+    "compensate",
+    "Tuning",
+    "tune",
+    "Prediction",
+    "predict",
+    "select",
 ]
 
 
@@ -149,6 +156,47 @@ class Params(Mapping):
         """An independent copy."""
         return Params(self._inner.copy())
 
+    @property
+    def loop(self) -> str:
+        """The servo's loop, ``semi_closed`` or ``full_closed`` (settable: the
+        parameter file's ``controller.loop``)."""
+        return self._inner.loop_mode
+
+    @loop.setter
+    def loop(self, mode: str) -> None:
+        if not isinstance(mode, str):
+            raise TypeError(f"loop: expected semi_closed or full_closed, got {type(mode).__name__}")
+        self._inner.loop_mode = mode.replace("-", "_")
+
+    @property
+    def filters(self) -> list:
+        """The torque-setpoint filters, in series, as the parameter file holds them:
+        ``{"type": "notch", "centre_hz", "width_hz", "depth_db"}`` (``depth_db``
+        absent: a full notch) or ``{"type": "low_pass", "frequency_hz", "damping"}``
+        (settable with such a list; checked against the control period)."""
+        return json.loads(self._inner.filters_json())
+
+    @filters.setter
+    def filters(self, filters) -> None:
+        if isinstance(filters, (str, bytes, Mapping)) or not hasattr(filters, "__iter__"):
+            raise TypeError(f"filters: expected a list of filters (dicts), got {type(filters).__name__}")
+        filters = list(filters)
+        for i, f in enumerate(filters):
+            if not isinstance(f, Mapping):
+                raise TypeError(f"filters[{i}]: expected a dict such as "
+                                f"{{'type': 'notch', 'centre_hz': 480.0, 'width_hz': 96.0}}, got {type(f).__name__}")
+        self._inner.set_filters_json(json.dumps([dict(f) for f in filters]))
+
+    def with_controller(self, tuned) -> "Params":
+        """A copy with the controller settings (gains, filters, loop, feed-forward) of
+        `tuned` — an :class:`rtid.Tuning` or its ``params``, a ``rtid tune -o`` file
+        read by :func:`params` — as ``--tune`` applies them; refused for another
+        topology or axis."""
+        tuned = getattr(tuned, "params", tuned)
+        if not isinstance(tuned, Params):
+            raise TypeError(f"tuned: expected an rtid.Tuning or an rtid.Params, got {type(tuned).__name__}")
+        return Params(self._inner.with_controller(tuned._inner))
+
     def __repr__(self) -> str:
         return f"<rtid.Params {self.name!r}: {self.topology}, {self.axis}, {len(self)} parameters>"
 
@@ -219,9 +267,13 @@ def modes(params: Params) -> dict:
 
 def _real_array(values, argument: str, allow_nan: bool = False) -> np.ndarray:
     """A 1-D contiguous float64 copy of `values`, or a ValueError naming `argument`."""
+    if isinstance(values, (str, bytes, Mapping)):
+        raise TypeError(f"{argument}: expected numbers (an array), got {type(values).__name__}")
     a = np.asarray(values)
-    if a.dtype == object or a.dtype.kind not in "iuf":
-        raise RtidError(f"{argument}: dtype {a.dtype} is not a real number type (give float64)")
+    if a.dtype == object or a.dtype.kind not in "iufb":
+        raise TypeError(f"{argument}: dtype {a.dtype} is not a real number type (give float64)")
+    if a.dtype.kind == "b":
+        raise TypeError(f"{argument}: booleans are not numbers (give float64)")
     if a.ndim != 1:
         raise RtidError(f"{argument}: {a.ndim}-dimensional, shape {a.shape}: give a 1-D array")
     if a.size == 0:
@@ -272,15 +324,31 @@ def simulate(
         dt_s = _finite_number(dt_s, "dt_s")
     p = _params_arg(params)
     if isinstance(input, (str, os.PathLike)):
-        return dict(_rtid.simulate(p, duration_s, os.fspath(input), None, None, dt_s, sample_s, load_nm))
-    torque = _real_array(input, "input")
-    if time_s is None:
-        t = np.arange(torque.size, dtype=np.float64) * sample_s
+        spec, torque, t = os.fspath(input), None, None
     else:
-        t = _real_array(time_s, "time_s")
-        if t.size != torque.size:
-            raise RtidError(f"input: {torque.size} torques for {t.size} times in time_s: give one torque per time")
-    return dict(_rtid.simulate(p, duration_s, None, torque, t, dt_s, sample_s, load_nm))
+        spec, torque = None, _real_array(input, "input")
+        if time_s is None:
+            t = np.arange(torque.size, dtype=np.float64) * sample_s
+        else:
+            t = _real_array(time_s, "time_s")
+            if t.size != torque.size:
+                raise RtidError(f"input: {torque.size} torques for {t.size} times in time_s: give one torque per time")
+    with _partial_on_interrupt(dict):
+        return dict(_rtid.simulate(p, duration_s, spec, torque, t, dt_s, sample_s, load_nm))
+
+
+@contextlib.contextmanager
+def _partial_on_interrupt(convert):
+    """A KeyboardInterrupt out of a long call carries what the call finished (the
+    extension's ``partial``) as ``result``, converted by `convert`."""
+    try:
+        yield
+    except KeyboardInterrupt as e:
+        partial = getattr(e, "partial", None)
+        if partial is not None:
+            e.result = convert(partial)
+            del e.partial
+        raise
 
 
 # --- files labs export --------------------------------------------------------------
@@ -369,8 +437,13 @@ class Experiment:
         base = os.path.join(folder, f"experiment-{id(self)}")
         _WRITTEN[base] = self.name
         names = list(self.columns)
-        table = np.column_stack([self.columns[n] for n in names])
-        np.savetxt(base + ".csv", table, fmt="%.17g", delimiter=",", header=",".join(names), comments="")
+        # Numbers at full precision; text columns (a positioning record's direction)
+        # as they are.
+        cells = [[f"{v:.17g}" for v in c.tolist()] if c.dtype.kind in "iuf" else [str(v) for v in c]
+                 for c in (self.columns[n] for n in names)]
+        with open(base + ".csv", "w", encoding="utf-8") as f:
+            f.write(",".join(names) + "\n")
+            f.writelines(",".join(row) + "\n" for row in zip(*cells))
         manifest = dict(self.manifest, data=os.path.basename(base) + ".csv")
         with open(base + ".json", "w", encoding="utf-8") as f:
             json.dump(manifest, f)
@@ -417,8 +490,24 @@ def _without_folder(text: str, folder: str) -> str:
 
     text, rows = re.subn(pattern, named, text)
     if rows:
-        text = re.sub(r"\(previous row (\d+)\)", lambda m: f"(previous: row {int(m.group(1)) - 2})", text)
+        # The reader's "(previous row X)" gives the previous row's value, not its number.
+        text = re.sub(r"\(previous row ([^)]+)\)", r"(the previous row's value: \1)", text)
     return text.replace(folder, "a temporary folder")
+
+
+#: Columns of words, not numbers: a positioning record's approach direction (``up``,
+#: ``down``; ``ccw``, ``cw``).
+_TEXT_COLUMNS = ("direction",)
+
+
+def _text_array(values, argument: str) -> np.ndarray:
+    """A 1-D array of words (rtid's reader checks them)."""
+    a = np.asarray(values)
+    if a.ndim != 1 or a.size == 0:
+        raise RtidError(f"{argument}: give a 1-D array of words (up, down), shape {a.shape}")
+    if a.dtype.kind not in "US":
+        raise TypeError(f"{argument}: expected words (up, down), got dtype {a.dtype}")
+    return a.astype(str)
 
 
 def experiment(kind: str, *, conditions: dict | None = None, mechanism: str | None = None,
@@ -443,8 +532,8 @@ def experiment(kind: str, *, conditions: dict | None = None, mechanism: str | No
     """
     if not isinstance(kind, str):
         raise TypeError(f"kind: expected a name such as 'servo_trace', got {kind!r}")
-    if kind not in _names.COLUMNS and kind != "resonance":
-        raise _names.unknown("kind", "kind", kind, list(_names.COLUMNS) + ["resonance"])
+    if kind not in _names.COLUMNS:
+        raise _names.unknown("kind", "kind", kind, list(_names.COLUMNS))
     if conditions is not None:
         if not isinstance(conditions, Mapping):
             raise TypeError(f"conditions: expected a dict, got {type(conditions).__name__}")
@@ -456,7 +545,7 @@ def experiment(kind: str, *, conditions: dict | None = None, mechanism: str | No
     if not columns:
         raise RtidError("columns: no data column given (e.g. time_s=..., force_n=...)")
     _names.check_columns(kind, columns)
-    arrays = {n: _real_array(v, n) for n, v in columns.items()}
+    arrays = {n: _text_array(v, n) if n in _TEXT_COLUMNS else _real_array(v, n) for n, v in columns.items()}
     lengths = {n: a.size for n, a in arrays.items()}
     first = next(iter(arrays))
     for n, size in lengths.items():
@@ -482,13 +571,16 @@ def read_experiment(path) -> Experiment:
 
 
 def run_experiment(kind: str, params: Params, **settings) -> Experiment:
-    """One of the paper's tests run on the model: the experiment ``rtid experiment
-    KIND`` writes (the same manifest and columns, every number to the bit).
+    """A test run on the model: the experiment ``rtid experiment KIND`` writes (the
+    same manifest and columns, every number to the bit).
 
     Args:
-        kind: ``frequency_response``, ``torque_curve``, ``fluctuation`` or
-            ``unbalance`` (``frequency-response`` … as on the command line).
-        params: the drive (:func:`params`; an identified one: ``fit.params``).
+        kind: ``frequency_response``, ``torque_curve``, ``fluctuation``,
+            ``unbalance``, ``positioning``, ``friction_map``, ``servo_trace`` or
+            ``frequency_response_time`` (``frequency-response`` … as on the command
+            line).
+        params: the drive (:func:`params`; an identified one: ``fit.params``; with a
+            tuned controller, ``--tune``: ``p.with_controller(tuning)``).
         **settings: the test's flags, ``-`` as ``_``, with the flags' defaults:
 
             - frequency_response: ``amplitude_nm`` (5), ``preload_nm`` (0),
@@ -505,11 +597,32 @@ def run_experiment(kind: str, params: Params, **settings) -> Experiment:
               ``run_in_deg`` (10), ``sample_period_s`` (0.004), ``noise_arcsec`` (0),
               ``seed`` (1), ``speed_deg_per_min`` (180; unbalance 360); unbalance
               also ``mass_kg``, ``radius_m`` (the set's unbalance, else 10 kg at
-              0.1 m).
+              0.1 m);
+            - positioning (ISO 230-2): ``loop`` (the set's), ``runs`` (5),
+              ``dwell_s`` (1), ``seed`` (0), on a rotary axis ``target_step_deg``
+              (30), ``speed_deg_per_min`` (3600), ``noise_arcsec`` (0), on a linear
+              one ``target_step_mm`` (50), ``travel_mm`` (500), ``speed_mm_per_min``
+              (3000), ``noise_um`` (0); ``compensation`` (a :class:`Compensation`,
+              its dict or a compensation.json path) run in the controller;
+            - friction_map: ``speeds_rpm`` (or on a linear axis ``speeds_mm_s``; a
+              list, each positive speed run both ways; default ±0.2 … ±50 % of the
+              speed limit), ``settle_s`` (0.5), ``average_s`` (1), ``noise_percent``,
+              ``scatter_percent`` (0), ``seed`` (1);
+            - servo_trace: ``moves`` (``[(target, speed), …]`` or ``"0.1@0.2,…"``,
+              rad and rad/s or m and m/s; default ``0.1@0.2, -0.1@0.1, 0@0.05``),
+              ``acceleration`` (2), ``dwell_s`` (0.2);
+            - frequency_response_time: ``excitation`` (``noise``, ``stepped_sine``,
+              ``chirp``, ``multisine``), ``amplitude_nm`` (5), ``preload_nm`` (0),
+              ``from_hz`` (10), ``to_hz`` (600), ``step_hz`` (10), ``dwell_s`` (0.5),
+              ``duration_s`` (16), ``period_s`` (1), ``periods`` (8), ``lines``
+              (``random_odd``, ``odd``, ``full``), ``sample_rate_hz`` (5000),
+              ``noise_arcsec`` (0), ``seed`` (1).
 
     Returns:
         An :class:`Experiment` holding the manifest and the columns as arrays, for
-        :func:`evaluate` and :func:`identify`. The test runs with the GIL released.
+        :func:`evaluate` and :func:`identify`. The test runs with the GIL released;
+        Ctrl-C stops it (KeyboardInterrupt), and a request beyond the command line's
+        work limits (an hour simulated, 10⁵ points) is refused before it starts.
 
     Raises:
         RtidError: an unknown test or setting (with the closest known name), a bad
@@ -534,19 +647,40 @@ def _as_experiment(e, argument: str) -> Experiment:
     raise TypeError(f"{argument}: expected an rtid.Experiment or a manifest path, got {type(e).__name__}")
 
 
-def evaluate(experiment, params: Params | None = None) -> dict:
-    """The statistics ``rtid evaluate --json`` gives of an experiment, as a dict: the
-    resonances (and with the phase the modes) of a frequency response, a torque
-    curve's friction and reversals, a positioning record's ISO 230-2 values, the
-    friction laws of a friction map, a servo trace's friction law by IDIM-LS (with
-    ``params``, at the motor of a geared model, and the trace replayed on the model:
-    ``simulation_error``, as ``--params``), a fluctuation or unbalance test's
-    deviations in arc-seconds. (Raw time records and the paper's resonance lists:
-    the command line for now.)"""
+def evaluate(experiment, params: Params | None = None, *, runs: str | None = None, compensation=None,
+             segment_s: float | None = None, min_coherence: float | None = None,
+             settle_fraction: float | None = None, cutoff_hz: float | None = None,
+             decimation: int | None = None, trim_s: float | None = None,
+             min_speed: float | None = None) -> dict:
+    """The statistics ``rtid evaluate --json`` gives of an experiment, as a dict.
+
+    By kind: the resonances (and with the phase the modes) of a frequency response; a
+    torque curve's friction and reversals; a positioning record's ISO 230-2 values
+    (``runs="4-5"``: those runs; ``compensation=``: a :class:`Compensation`, its dict
+    or a compensation.json path — the values as the compensated axis would show them,
+    beside the uncompensated); the friction laws of a friction map; a servo trace's
+    friction law by IDIM-LS (``cutoff_hz``, ``decimation``, ``trim_s``, ``min_speed``
+    as the flags; with ``params``, at the motor of a geared model, and the trace
+    replayed on the model: ``simulation_error``); a fluctuation or unbalance test's
+    deviations in arc-seconds; a raw time record's gain curve (stepped-sine
+    demodulation, or H1 with coherence: ``segment_s``, ``min_coherence``,
+    ``settle_fraction``) or a periodic multisine's two channels, noise, modes and
+    distortion (docs/multisine.md)."""
     exp = _as_experiment(experiment, "experiment")
     p = None if params is None else _params_arg(params)
+    options = {
+        "runs": None if runs is None else (runs if isinstance(runs, str) else str(_whole(runs, "runs"))),
+        "compensation": None if compensation is None else _experiments._compensation_text(compensation),
+        "segment_s": None if segment_s is None else _finite_number(segment_s, "segment_s"),
+        "min_coherence": None if min_coherence is None else _finite_number(min_coherence, "min_coherence"),
+        "settle_fraction": None if settle_fraction is None else _finite_number(settle_fraction, "settle_fraction"),
+        "cutoff_hz": None if cutoff_hz is None else _finite_number(cutoff_hz, "cutoff_hz"),
+        "decimation": None if decimation is None else _whole(decimation, "decimation", 0),
+        "trim_s": None if trim_s is None else _finite_number(trim_s, "trim_s"),
+        "min_speed": None if min_speed is None else _finite_number(min_speed, "min_speed"),
+    }
     with _temporary_folder() as d:
-        return json.loads(_rtid.evaluate(exp._written(d), exp.name, p))
+        return json.loads(_rtid.evaluate(exp._written(d), exp.name, p, options))
 
 
 # --- identification ---------------------------------------------------------------
@@ -576,12 +710,20 @@ def _whole(n, name: str, least: int = 1) -> int:
     return int(n)
 
 
-def _choice(value, name: str, choices) -> str:
-    """A string argument among `choices`, named in the error with the closest."""
+def _flag(value, name: str) -> bool:
+    """A True/False argument: a TypeError naming it otherwise."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name}: expected True or False, got {type(value).__name__}")
+    return bool(value)
+
+
+def _choice(value, name: str, choices, what: str | None = None) -> str:
+    """A string argument among `choices` (each a `what`, default the argument's
+    name), named in the error with the closest."""
     if not isinstance(value, str):
         raise TypeError(f"{name}: expected a string ({', '.join(choices)}), got {type(value).__name__}")
     if value not in choices:
-        raise _names.unknown(name, name, value, choices)
+        raise _names.unknown(name, what or name, value, choices)
     return value
 
 
@@ -598,6 +740,14 @@ def _names_list(value, name: str, allow_empty: bool = False) -> list:
     if not names and not allow_empty:
         raise RtidError(f"{name}: an empty list: name at least one, or leave {name} out (None)")
     return names
+
+
+def _bound(name: str, bound) -> tuple:
+    """``bounds[name]`` as (low, high): a TypeError if it is not a pair of numbers."""
+    if isinstance(bound, (str, bytes, Mapping)) or not hasattr(bound, "__len__") or len(bound) != 2:
+        raise TypeError(f"bounds[{name}]: expected a pair (low, high) of numbers, got {bound!r}")
+    lo, hi = bound
+    return _finite_number(lo, f"bounds[{name}]"), _finite_number(hi, f"bounds[{name}]")
 
 
 def _uncertain(uncertain) -> list:
@@ -619,7 +769,8 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
              seed: int = 1, max_iters: int = 50, start: str = "estimate",
              weights=None, objectives=None, profile=None,
              resample: int | None = None, uncertain: dict | None = None,
-             progress=None) -> IdentifyResult:
+             intervals: str = "auto", joint: bool = False,
+             checkpoint=None, resume: bool = False, progress=None) -> IdentifyResult:
     """Identifies parameters from experiments (``rtid identify``).
 
     Args:
@@ -653,13 +804,25 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
             at each run's speed).
         profile: names to profile (``True``: every fitted parameter), for intervals
             that hold where the cost is not a bowl (``--profile``).
-        resample: bootstrap replicates of the residuals' blocks (``--resample``).
-        uncertain: parameters the fit holds at assumed values, with their relative
-            half-ranges, e.g. ``{"Kw": 0.1, "theta_bg": 0.5}`` (``--uncertain
-            Kw=10%``): the fit is repeated at each end of each range and the result's
-            ``held`` says how the fitted parameters follow; with ``resample`` each
-            replicate draws them instead (required on a torque curve's, an
-            unbalance test's or a servo trace's rough cost).
+        resample: bootstrap replicates of the residuals' blocks (``--resample``;
+            default: 12 where the intervals are the bootstrap's).
+        uncertain: held parameters' relative half-ranges in place of or beside the
+            parameter set's own (``params.ranges``, a preset's held ranges, carried by
+            default), e.g. ``{"Kw": 0.1, "theta_bg": 0}`` (``--uncertain Kw=10%``; 0
+            holds it exactly): on a smooth cost the fit is repeated at each end of
+            each range and the result's ``held`` says how the fitted parameters
+            follow; in a bootstrap each replicate draws them instead.
+        intervals: ``"auto"`` (default: the bootstrap where the cost is rough — a
+            torque curve, an unbalance test, a servo trace — or the corrections did
+            not converge, else the standard errors), ``"standard-errors"`` or
+            ``"bootstrap"`` (``--intervals``).
+        joint: fit every parameter on the joint cost of every experiment at once
+            (``--joint``); by default several experiments are fitted by plan — each
+            parameter first from the record that carries the most information about
+            it, the others held, then the shared ones refined jointly.
+        checkpoint: a file the search's state is written to as it goes
+            (``--checkpoint``); with ``resume=True`` the search continues from it to
+            the result it would have reached (``--resume``).
         progress: a progress bar of the searches' iterations: None (default) shows
             a tqdm bar where tqdm is installed and the output is watched (a notebook,
             a terminal), True always (tqdm required), False never; or a function
@@ -693,11 +856,10 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
         _check_parameter_name(name, "bounds")
     if method is not None:
         _choice(method.replace("_", "-") if isinstance(method, str) else method, "method",
-                ("lsq", "lm", "nelder-mead", "pso"))
+                _names.OPTIONS["method"])
     options = {
         "fit": fit,
-        "bounds": [(n, _finite_number(lo, f"bounds[{n}]"), _finite_number(hi, f"bounds[{n}]"))
-                   for n, (lo, hi) in (bounds or {}).items()],
+        "bounds": [(n, *_bound(n, b)) for n, b in (bounds or {}).items()],
         "method": method,
         "fidelity": _choice(model, "model", ("auto", "linear", "nonlinear")),
         "starts": None if starts is None else _whole(starts, "starts"),
@@ -705,20 +867,31 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
         "max_iters": _whole(max_iters, "max_iters"),
         "start": _choice(start, "start", ("estimate", "given")),
         "weights": None if weights is None else [_finite_number(w, "weights") for w in weights],
-        "objectives": None if objectives is None else _names_list(objectives, "objectives"),
+        "objectives": None if objectives is None else [
+            _choice(o.replace("-", "_"), "objectives", _names.OPTIONS["objectives"], what="objective")
+            for o in _names_list(objectives, "objectives")],
         "profile": _profile_names(profile),
         "resample": None if resample is None else _whole(resample, "resample"),
         "uncertain": _uncertain(uncertain),
+        "intervals": _choice(intervals, "intervals", ("auto", "standard-errors", "bootstrap")),
+        "joint": _flag(joint, "joint"),
+        "checkpoint": None if checkpoint is None else os.fspath(checkpoint),
+        "resume": _flag(resume, "resume"),
     }
     exps = [_as_experiment(e, f"experiments[{i}]") for i, e in enumerate(experiments)]
+    if options["checkpoint"] is not None:
+        inputs = [os.path.realpath(e.path) for e in exps if e.path is not None]
+        if os.path.realpath(options["checkpoint"]) in inputs:
+            raise RtidError(f"checkpoint: {options['checkpoint']} is an input of the fit: give a file of its own")
     callback, close = _progress.reporter(progress, "identify", "it")
     try:
         with _temporary_folder() as d:
             paths = [(e._written(d), e.name) for e in exps]
-            text, identified, comparisons = _rtid.identify(paths, _params_arg(params), options, callback)
+            text, identified, comparisons, stopped, statistics = _rtid.identify(
+                paths, _params_arg(params), options, callback)
     finally:
         close()
-    result = IdentifyResult(json.loads(text), Params(identified), comparisons)
+    result = IdentifyResult(json.loads(text), Params(identified), comparisons, stopped, statistics)
     if result.interrupted:
         warnings.warn("rtid.identify: interrupted; the result is the best point so far", RuntimeWarning, stacklevel=2)
     return result
@@ -729,7 +902,8 @@ def identify(experiments, params: Params, fit=None, *, bounds: dict | None = Non
 
 def sweep(params: Params, vary, outputs, *, method: str = "grid", samples: int = 256,
           bootstrap: int = 500, trajectories: int = 20, levels: int = 4, step: float = 0.01,
-          seed: int = 0, tests: str = "short", out=None, progress=None) -> SweepResult:
+          seed: int = 0, tests: str = "short", out=None, resume: bool = False,
+          progress=None) -> SweepResult:
     """A sensitivity sweep (``rtid sweep``).
 
     Args:
@@ -740,29 +914,49 @@ def sweep(params: Params, vary, outputs, *, method: str = "grid", samples: int =
         method: ``grid``, ``local``, ``morris`` or ``sobol``, with ``samples``,
             ``bootstrap``, ``trajectories``, ``levels``, ``step``, ``seed``,
             ``tests`` as the flags of the same names.
-        out: the sweep CSV to keep (default: a temporary file, removed).
+        out: the sweep CSV to keep (default: a temporary file, removed); each row is
+            written to it as it is computed.
+        resume: continue the sweep file ``out`` an earlier call left unfinished
+            (interrupted): only its missing rows are computed (``--resume``).
         progress: a progress bar of the design's points, as :func:`identify`'s (a
             function is called as ``progress(done, total)``).
 
     Returns:
         A :class:`SweepResult`: ``design``, ``outputs``, ``indices``, and as pandas
         tables ``to_pandas()`` and ``indices_to_pandas()``.
+
+    Ctrl-C stops the sweep within a fraction of a second and raises
+    KeyboardInterrupt; its ``result`` attribute is a :class:`SweepResult` of the rows
+    finished (no indices), which ``out`` also holds for ``resume=True``.
     """
     vary = [vary] if isinstance(vary, str) else _names_list(vary, "vary", allow_empty=True)
+    for spec in vary:
+        name = re.split(r"[=:]", spec, maxsplit=1)[0].strip()
+        if name:
+            _check_parameter_name(name, "vary")
     outputs = [outputs] if isinstance(outputs, str) else _names_list(outputs, "outputs", allow_empty=True)
+    outputs = [_choice(o.strip(), "outputs", _names.OPTIONS["outputs"], what="output") for o in outputs]
     options = dict(vary=vary, outputs=outputs,
                    method=_choice(method, "method", ("grid", "local", "morris", "sobol")),
                    samples=_whole(samples, "samples"), bootstrap=_whole(bootstrap, "bootstrap", 0),
                    trajectories=_whole(trajectories, "trajectories"), levels=_whole(levels, "levels"),
                    step=_finite_number(step, "step"), seed=_whole(seed, "seed", 0),
                    tests=_choice(tests, "tests", ("short", "full")))
+    if not isinstance(resume, (bool, np.bool_)):
+        raise TypeError(f"resume: expected True or False, got {type(resume).__name__}")
+    if resume and out is None:
+        raise RtidError("resume: give out=, the sweep file to resume")
     callback, close = _progress.reporter(progress, "sweep", "point")
     try:
-        with tempfile.TemporaryDirectory(prefix="rtid-") as d:
+        with tempfile.TemporaryDirectory(prefix="rtid-") as d, _partial_on_interrupt(_sweep_result):
             path = os.fspath(out) if out is not None else os.path.join(d, "sweep.csv")
-            r = _rtid.sweep(_params_arg(params), options, path, callback)
+            r = _rtid.sweep(_params_arg(params), options, path, callback, bool(resume))
     finally:
         close()
+    return _sweep_result(r)
+
+
+def _sweep_result(r: dict) -> SweepResult:
     return SweepResult(list(r["factors"]), r["design"], list(r["output_columns"]), r["outputs"],
                        r["index"], json.loads(r["indices_json"]))
 
@@ -845,3 +1039,8 @@ def frequency_response(params: Params, freqs_hz, *, input: str = "motor_torque",
         raise TypeError(f"output: expected a name (table_over_motor, …), got {type(output).__name__}")
     h = _rtid.frequency_response(_params_arg(params), f, input, output)
     return h[0] if scalar else h
+
+
+# --- after an identification: compensate, tune, predict, select ----------------------
+
+from ._commissioning import Compensation, Prediction, Tuning, compensate, predict, select, tune  # noqa: E402

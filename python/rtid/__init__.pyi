@@ -33,6 +33,15 @@ class Params(Mapping[str, float]):
     def to_json(self) -> str: ...
     def save(self, path: _Path) -> None: ...
     def copy(self) -> Params: ...
+    @property
+    def loop(self) -> Literal["semi_closed", "full_closed"]: ...
+    @loop.setter
+    def loop(self, mode: Literal["semi_closed", "full_closed"]) -> None: ...
+    @property
+    def filters(self) -> list[dict[str, Any]]: ...
+    @filters.setter
+    def filters(self, filters: Sequence[Mapping[str, Any]]) -> None: ...
+    def with_controller(self, tuned: Params | Tuning) -> Params: ...
     def __copy__(self) -> Params: ...
     def __deepcopy__(self, memo: Any) -> Params: ...
 
@@ -49,6 +58,8 @@ def simulate(
     sample_s: float = 1e-4,
     load_nm: float = 0.0,
 ) -> dict[str, npt.NDArray[np.float64]]: ...
+
+_Compensation = Union["Compensation", Mapping[str, Any], _Path]
 
 @dataclass
 class Channel:
@@ -86,11 +97,25 @@ def experiment(
 def read_experiment(path: _Path) -> Experiment: ...
 def run_experiment(
     kind: Literal["frequency_response", "frequency-response", "torque_curve", "torque-curve",
-                  "fluctuation", "unbalance"],
+                  "fluctuation", "unbalance", "positioning", "friction_map", "friction-map",
+                  "servo_trace", "servo-trace", "frequency_response_time", "frequency-response-time"],
     params: Params,
     **settings: Any,
 ) -> Experiment: ...
-def evaluate(experiment: Experiment | _Path, params: Params | None = None) -> dict[str, Any]: ...
+def evaluate(
+    experiment: Experiment | _Path,
+    params: Params | None = None,
+    *,
+    runs: str | int | None = None,
+    compensation: _Compensation | None = None,
+    segment_s: float | None = None,
+    min_coherence: float | None = None,
+    settle_fraction: float | None = None,
+    cutoff_hz: float | None = None,
+    decimation: int | None = None,
+    trim_s: float | None = None,
+    min_speed: float | None = None,
+) -> dict[str, Any]: ...
 
 @dataclass
 class Curve:
@@ -121,15 +146,24 @@ class IdentifyResult:
     warnings: list[dict[str, str]]
     interrupted: bool
     cost: float | None
+    ndata: int | None
+    nvarys: int
+    chisqr: float | None
+    redchi: float | None
+    aic: float | None
+    aicc: float | None
+    bic: float | None
+    nfev: int | None
+    held: list[dict[str, Any]]
     termination: dict[str, Any]
     success: bool
     message: str
     curves: list[Curve]
     params: Params
     def to_dict(self) -> dict[str, Any]: ...
-    def correlations(self, threshold: float = 0.8) -> list[tuple[str, str, float]]: ...
-    def report(self, min_correl: float = 0.8) -> str: ...
-    def to_pandas(self) -> Any: ...
+    def correlations(self, threshold: float = 0.1) -> list[tuple[str, str, float]]: ...
+    def report(self, min_correl: float = 0.1) -> str: ...
+    def to_pandas(self, table: Literal["parameters", "covariance", "correlation"] = "parameters") -> Any: ...
     def _repr_html_(self) -> str: ...
 
 def identify(
@@ -148,6 +182,11 @@ def identify(
     objectives: Sequence[str] | None = None,
     profile: bool | str | Sequence[str] | None = None,
     resample: int | None = None,
+    uncertain: Mapping[str, float] | None = None,
+    intervals: Literal["auto", "standard-errors", "bootstrap"] = "auto",
+    joint: bool = False,
+    checkpoint: _Path | None = None,
+    resume: bool = False,
     progress: bool | Callable[..., object] | None = None,
 ) -> IdentifyResult: ...
 
@@ -177,6 +216,7 @@ def sweep(
     seed: int = 0,
     tests: Literal["short", "full"] = "short",
     out: _Path | None = None,
+    resume: bool = False,
     progress: bool | Callable[..., object] | None = None,
 ) -> SweepResult: ...
 
@@ -199,3 +239,86 @@ def frequency_response(
     input: Literal["motor_torque", "table_torque"] = "motor_torque",
     output: str = "table_over_motor",
 ) -> complex | npt.NDArray[np.complex128]: ...
+
+class Compensation:
+    summary: dict[str, Any]
+    text: str
+    warnings: list[str]
+    @property
+    def axis(self) -> Literal["rotary", "linear"]: ...
+    @property
+    def backlash(self) -> float: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def save(self, path: _Path) -> None: ...
+    def sinumerik(self, axis_number: int, *, reference: float | None = None) -> str: ...
+    def csv(self) -> str: ...
+
+def compensate(
+    source: Experiment | _Path | Params,
+    *,
+    runs: str | int | None = None,
+    friction_map: Experiment | _Path | None = None,
+    friction: bool = False,
+) -> Compensation: ...
+
+class Tuning:
+    summary: dict[str, Any]
+    params: Params
+    before: dict[str, Any] | None
+    after: dict[str, Any] | None
+    proposes: bool
+    check: dict[str, Any] | None
+    warnings: list[Any]
+    def to_dict(self) -> dict[str, Any]: ...
+    def sinamics(self) -> str: ...
+    def sinumerik(self, axis_number: int, *, gear_ratio: tuple[int, int] | None = None) -> str: ...
+
+def tune(
+    params: Params,
+    *,
+    phase_margin_deg: float = 50.0,
+    gain_margin_db: float = 6.0,
+    objective: Literal["positioning", "following", "settling"] = "positioning",
+    loop: Literal["semi_closed", "full_closed"] | None = None,
+    max_kpp: float | None = None,
+    max_bandwidth_hz: float | None = None,
+    notch_depth_db: float = -20.0,
+    notch_min_width: float = 0.2,
+    torque_reserve: float = 0.2,
+    progress: bool | Callable[..., object] | None = None,
+) -> Tuning: ...
+
+class Prediction:
+    summary: dict[str, Any]
+    cases: list[dict[str, Any]]
+    source: str | None
+    drawn: list[str]
+    completed: int | None
+    asked: int | None
+    notes: list[str]
+    interrupted: bool
+    def to_dict(self) -> dict[str, Any]: ...
+    def value(self, test: str, case: str, name: str) -> dict[str, Any]: ...
+    def to_pandas(self) -> Any: ...
+
+def predict(
+    fit: IdentifyResult | Mapping[str, Any] | _Path,
+    params: Params | None = None,
+    *,
+    compensation: _Compensation | None = None,
+    tune: Tuning | Params | None = None,
+    tests: str | Sequence[str] = "positioning",
+    draws: int = 50,
+    from_: Literal["covariance", "bootstrap"] | None = None,
+    hold: Sequence[str] = (),
+    uncertain: Mapping[str, float] | None = None,
+    runs: int = 5,
+    level: float = 0.95,
+    seed: int = 1,
+    progress: bool | Callable[..., object] | None = None,
+) -> Prediction: ...
+
+def select(
+    *fits: IdentifyResult | Mapping[str, Any] | _Path,
+    labels: Sequence[str] | None = None,
+) -> dict[str, Any]: ...

@@ -1,10 +1,10 @@
 """The names the module's arguments take, and the closest one to a misspelt name.
 
-The condition keys and each kind's column names are rtid's reader's (not exported by
-the library): copied here, and to be kept in step with
-src/io/experiment_file/conditions.rs (``Conditions::KEYS``, and ``controller``) and
-src/io/experiment_file/table/kinds.rs (each kind's reserved columns) and
-docs/experiment-files.md's optional columns.
+The condition keys, each kind's columns and the options' values are the library's own
+(``Conditions::KEYS`` and ``Kind::columns`` in src/io/experiment_file/, the loop modes,
+the search's methods, the objectives, the sweep's outputs, the tuning's objectives),
+read from the extension once: a misspelling is caught before any work, with the
+closest name.
 """
 
 from __future__ import annotations
@@ -13,46 +13,20 @@ import difflib
 import math
 import numbers
 
+from . import _rtid
 from ._rtid import RtidError
 
 #: A manifest's ``conditions`` keys (docs/experiment-files.md).
-CONDITIONS = (
-    "torque_amplitude_nm", "preload_nm", "amplitude_deg", "amplitude_m", "period_s", "loop",
-    "dwell_s", "speed_deg_per_min", "ratio", "mass_kg", "radius_m", "excitation",
-    "frequencies_hz", "first_line_hz", "last_line_hz", "line_step_hz", "transient_periods",
-    "drive_gain", "loop_period_s", "controller", "band_hz", "response", "reference", "delay_s",
-    "averages",
-)
+CONDITIONS = tuple(_rtid.condition_keys())
 
-_ANGLE = ("deg", "rad", "arcsec")
-_POSITION = _ANGLE + ("m", "mm", "um")
-_SPEED = ("rad_s", "rpm", "deg_s", "m_s", "mm_s")
-_COMMAND = ("v", "a", "nm", "n")
+#: The columns each kind's reader and evaluators read (docs/experiment-files.md's
+#: table), every position under each of its unit suffixes.
+COLUMNS = {kind: list(columns) for kind, columns in _rtid.kind_columns()}
 
-
-def _with(bases, suffixes) -> list:
-    return [f"{b}_{s}" for b in bases for s in suffixes]
-
-
-_MOTION = ["time_s"] + _with(["motor_angle", "table_angle"], _ANGLE)
-
-#: The columns each kind's reader interprets (docs/experiment-files.md's table).
-COLUMNS = {
-    "frequency_response": ["frequency_hz", "gain_db", "gain_sigma_db", "coherence"]
-    + _with(["phase", "phase_sigma"], _ANGLE),
-    "torque_curve": ["time_s", "motor_torque_nm", "force_n"] + _with(["table_angle"], _ANGLE)
-    + _with(["table_position"], _POSITION),
-    "positioning": ["direction", "run"] + _with(["target", "deviation", "measured"], _POSITION),
-    "fluctuation": _MOTION,
-    "unbalance": _MOTION,
-    "frequency_response_time": ["time_s", "motor_torque_nm", "motor_current_a"]
-    + _with(["motor_angle", "table_angle", "load_angle"], _ANGLE),
-    "servo_trace": ["time_s", "torque_nm", "force_n"]
-    + _with(["reference_position", "position", "motor_position", "table_position"], _POSITION)
-    + _with(["controller_output", "controller_added"], _COMMAND),
-    "friction_map": ["torque_nm", "force_n", "torque_std_nm", "force_std_n", "samples", "dropped",
-                     "transient"] + _with(["speed", "speed_std"], _SPEED),
-}
+#: The options' values as the library spells them: ``loop``, ``method`` (the search's),
+#: ``objectives`` (the identification's), ``outputs`` (the sweep's), ``objective``
+#: (the tuning's), ``response``.
+OPTIONS = {name: tuple(values) for name, values in _rtid.option_names()}
 
 #: How close (difflib's ratio, case ignored) an unknown column must be to a known one
 #: to be taken for a misspelling of it rather than an extra column.

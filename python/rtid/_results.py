@@ -96,13 +96,19 @@ def _curves(comparisons: list) -> list:
 class IdentifyResult:
     """An identification's result.
 
+    Every per-parameter structure — ``names``, ``values``, ``initial``,
+    ``standard_errors``, ``intervals``, ``bounds``, the rows and columns of
+    ``correlation`` and ``covariance``, ``to_pandas()``'s rows — is in one order, the
+    fit's (``names``).
+
     Attributes:
+        names: the fitted parameters, in the fit's order.
         values: identified value of each fitted parameter (SI).
         initial: where the search started.
-        standard_errors: each fitted parameter's standard error (SI), where the
-            Jacobian gives one.
-        names: the order of ``correlation``'s and ``covariance``'s rows.
-        correlation: the fitted parameters' correlation matrix (float64 array).
+        standard_errors: each fitted parameter's standard error (SI); NaN where the
+            data do not determine it (rtid then warns).
+        correlation: the fitted parameters' correlation matrix (float64 array, rows
+            and columns in ``names``' order; NaN for an undetermined parameter).
         covariance: their covariance matrix, SI (standard errors × correlation; NaN
             where a standard error is undefined).
         intervals: ``(low, high)`` of each at 95 %: the profile's where ``profile``
@@ -115,48 +121,78 @@ class IdentifyResult:
         held: each held parameter's range and the fitted parameters' shift across it
             (``uncertain`` without ``resample``), as the result file holds them.
         warnings: each ``{"code", "message"}`` rtid raised (what the data cannot tell).
-        cost: the cost at the result (half the sum of the scaled residuals' squares).
+        cost: the cost at the result, Σ weight · mean(scaled residual²) over the
+            experiments (docs/identification.md): the sum of squares of the residual
+            vector the search minimises, each experiment's scaled residuals times
+            √(weight / count) — lmfit's ``chisqr``.
+        ndata, nvarys: the number of residuals (data points: a line with phase
+            counts twice) and of fitted parameters.
+        chisqr, redchi: the cost, and the cost over ``ndata − nvarys``.
+        aic, aicc, bic: ndata·ln(chisqr/ndata) + 2·nvarys, its small-sample
+            correction (``None`` where ndata ≤ nvarys + 1), ndata·ln(chisqr/ndata) +
+            nvarys·ln(ndata) — lmfit's definitions and ``rtid select``'s numbers.
+        nfev: the cost evaluations.
         termination: how the search ended, ``{"code", "message", …}``.
         success: whether the search converged — the solver's test met (or its
             target cost reached), or the nonlinear corrections settled — and was
             not interrupted; an iteration limit is not a success.
         message: the termination's message.
-        interrupted: whether Ctrl-C ended the search (the best point so far).
+        interrupted: whether Ctrl-C ended the work: the search (the best point so
+            far; no intervals) or the intervals after it (those finished).
         curves: each experiment's data beside the model (:class:`Curve`).
         params: the complete identified parameter set.
     """
 
-    def __init__(self, result: dict, identified, comparisons: list | None = None):
+    def __init__(self, result: dict, identified, comparisons: list | None = None,
+                 stopped: bool = False, statistics: dict | None = None):
         self._result = result
-        self.values = dict(result["parameters"])
-        self.initial = dict(result.get("initial", {}))
-        self.bounds = {n: tuple(b) for n, b in result.get("bounds", {}).items()}
         u = result.get("uncertainty") or {}
-        self.standard_errors = dict((n, v) for n, v in u.get("standard_errors", []) if v is not None)
-        self.names = list(u.get("names", []))
+        self.names = list(u.get("names") or result["parameters"])
+        self.names += [n for n in result["parameters"] if n not in self.names]
+        ordered = lambda d: {n: d[n] for n in self.names if n in d}  # noqa: E731
+        self.values = ordered(result["parameters"])
+        self.initial = ordered(result.get("initial", {}))
+        self.bounds = ordered({n: tuple(b) for n, b in result.get("bounds", {}).items()})
+        given = {n: v for n, v in u.get("standard_errors", [])}
+        self.standard_errors = {n: math.nan if given.get(n) is None else given[n] for n in self.names}
         n = len(self.names)
-        self.correlation = np.array(u.get("correlation", []), dtype=np.float64).reshape(n, n)
-        se = np.array([self.standard_errors.get(name, math.nan) for name in self.names])
+        in_result = list(u.get("names", []))
+        correlation = np.full((n, n), math.nan)
+        if in_result:
+            c = np.array(u.get("correlation", []), dtype=np.float64).reshape(len(in_result), len(in_result))
+            at = [self.names.index(name) for name in in_result]
+            correlation[np.ix_(at, at)] = c
+        self.correlation = correlation
+        se = np.array([self.standard_errors[name] for name in self.names])
         self.covariance = self.correlation * np.outer(se, se)
         self.profiles = result.get("profiles")
         self.resampling = result.get("resampling")
         self.held = list(result.get("held", []))
         if self.profiles:
             self.interval_method = "profile"
-            self.intervals = {n: (p.get("lower"), p.get("upper")) for n, p in self.profiles.items()}
+            intervals = {n: (p.get("lower"), p.get("upper")) for n, p in self.profiles.items()}
         elif self.resampling and self.resampling.get("intervals"):
             self.interval_method = "bootstrap"
-            self.intervals = {n: (i["lower"], i["upper"])
-                              for n, i in self.resampling["intervals"].items()}
+            intervals = {n: (i["lower"], i["upper"]) for n, i in self.resampling["intervals"].items()}
         else:
             self.interval_method = "standard errors"
-            self.intervals = {
+            intervals = {
                 n: (self.values[n] - _Z95 * se, self.values[n] + _Z95 * se)
-                for n, se in self.standard_errors.items()
+                for n, se in self.standard_errors.items() if math.isfinite(se)
             }
+        self.intervals = ordered(intervals)
         self.warnings = list(result.get("warnings", []))
-        self.interrupted = bool(result.get("interrupted", False))
+        self.interrupted = bool(result.get("interrupted", False) or stopped)
         self.cost = result.get("cost")
+        statistics = dict(statistics or {})
+        self.ndata = statistics.get("ndata")
+        self.nvarys = statistics.get("nvarys", len(self.names))
+        self.chisqr = statistics.get("chisqr", self.cost)
+        self.redchi = statistics.get("redchi")
+        self.aic = statistics.get("aic")
+        self.aicc = statistics.get("aicc")
+        self.bic = statistics.get("bic")
+        self.nfev = result.get("evaluations")
         self.termination = dict(result.get("termination") or {})
         self.message = self.termination.get("message", "")
         code = self.termination.get("code")
@@ -182,13 +218,13 @@ class IdentifyResult:
             lo, hi = self.intervals.get(name, (None, None))
             b_lo, b_hi = self.bounds.get(name, (None, None))
             rows.append({
-                "name": name, "value": value, "stderr": self.standard_errors.get(name),
+                "name": name, "value": value, "stderr": self.standard_errors[name],
                 "lower": lo, "upper": hi, "min": b_lo, "max": b_hi,
                 "initial": self.initial.get(name), "unit": units.get(name, ""),
             })
         return rows
 
-    def correlations(self, threshold: float = 0.8) -> list:
+    def correlations(self, threshold: float = 0.1) -> list:
         """The pairs ``(a, b, r)`` whose correlation's size is above `threshold`,
         largest first."""
         pairs = []
@@ -199,31 +235,41 @@ class IdentifyResult:
                     pairs.append((a, self.names[j], float(r)))
         return sorted(pairs, key=lambda p: -abs(p[2]))
 
-    def report(self, min_correl: float = 0.8) -> str:
-        """A text report: the fit's statistics, each parameter with its value,
+    def report(self, min_correl: float = 0.1) -> str:
+        """A text report, as lmfit's ``fit_report``: the fit's statistics (data
+        points, variables, χ², reduced χ², AIC, BIC), each parameter with its value,
         standard error, interval, bounds and start, the correlations above
-        `min_correl` in size, and the warnings."""
+        `min_correl` in size (lmfit's default 0.1), and the warnings."""
         r = self._result
-        fmt = lambda v: "—" if v is None else f"{v:.6g}"  # noqa: E731
+        fmt = lambda v: "—" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.6g}"  # noqa: E731
         lines = ["[[Fit]]"]
         for key, value in (
             ("experiments", ", ".join(r.get("experiments", []))),
             ("method", f"{r.get('method', '')}, {r.get('fidelity', '')} model"),
-            ("evaluations", r.get("evaluations")),
-            ("cost", fmt(self.cost)),
+            ("evaluations", self.nfev),
             ("termination", f"{self.termination.get('code', '')}: {self.message}"),
             ("success", self.success),
         ):
             lines.append(f"    {key:<13}{value}")
         if self.interrupted:
             lines.append("    interrupted  the best point so far (Ctrl-C)")
+        lines.append("[[Fit Statistics]]")
+        for key, value in (
+            ("data points", self.ndata), ("variables", self.nvarys),
+            ("chi-square", fmt(self.chisqr)), ("reduced chi-square", fmt(self.redchi)),
+            ("Akaike info crit", fmt(self.aic)), ("AICc", fmt(self.aicc)),
+            ("Bayesian info crit", fmt(self.bic)),
+        ):
+            lines.append(f"    {key:<19}= {value}")
         lines.append(f"[[Parameters]] (intervals 95 %, from {self.interval_method})")
         width = max((len(n) for n in self.values), default=4)
         for row in self._rows():
             se = row["stderr"]
-            relative = f" ({100 * se / abs(row['value']):.2f}%)" if se is not None and row["value"] else ""
+            relative = (f" ({100 * se / abs(row['value']):.2f}%)"
+                        if math.isfinite(se) and row["value"] else "")
+            shown = fmt(se) if math.isfinite(se) else "(not determined)"
             lines.append(
-                f"    {row['name']:<{width}} = {row['value']:.6g} ± {fmt(se)}{relative} {row['unit']}"
+                f"    {row['name']:<{width}} = {row['value']:.6g} ± {shown}{relative} {row['unit']}"
                 f"  [{fmt(row['lower'])}, {fmt(row['upper'])}]"
                 f"  bounds [{fmt(row['min'])}, {fmt(row['max'])}]  init {fmt(row['initial'])}"
             )
@@ -234,24 +280,35 @@ class IdentifyResult:
         lines += [f"    {w.get('code')}: {w.get('message', '')}" for w in self.warnings] or ["    none"]
         return "\n".join(lines)
 
-    def to_pandas(self):
-        """The parameter table as a pandas DataFrame, one row per fitted parameter
-        (index ``name``): value, stderr, lower, upper (the 95 % interval), min, max
-        (the bounds), initial, unit. Needs pandas (imported only here)."""
+    def to_pandas(self, table: str = "parameters"):
+        """A pandas DataFrame: ``"parameters"`` (default) — one row per fitted
+        parameter in ``names``' order (index ``name``): value, stderr, lower, upper
+        (the 95 % interval), min, max (the bounds), initial, unit; ``"covariance"``
+        or ``"correlation"`` — the matrix with rows and columns labelled by
+        ``names``. Needs pandas (imported only here)."""
         pd = _pandas("IdentifyResult.to_pandas()")
-        return pd.DataFrame(self._rows()).set_index("name")
+        if table == "parameters":
+            return pd.DataFrame(self._rows()).set_index("name")
+        if table in ("covariance", "correlation"):
+            labels = pd.Index(self.names, name="parameter")
+            return pd.DataFrame(getattr(self, table), index=labels, columns=list(self.names))
+        if not isinstance(table, str):
+            raise TypeError(f"table: expected a string, got {type(table).__name__}")
+        from ._names import unknown
+        raise unknown("table", "table", table, ["parameters", "covariance", "correlation"])
 
     def _repr_html_(self) -> str:
         head = ("<table><thead><tr><th>parameter</th><th>value</th><th>std. error</th>"
                 "<th>95 % interval</th><th>bounds</th><th>initial</th><th>unit</th></tr></thead><tbody>")
-        fmt = lambda v: "—" if v is None else f"{v:.6g}"  # noqa: E731
+        fmt = lambda v: "—" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.6g}"  # noqa: E731
         body = "".join(
             f"<tr><td>{html.escape(r['name'])}</td><td>{fmt(r['value'])}</td><td>{fmt(r['stderr'])}</td>"
             f"<td>[{fmt(r['lower'])}, {fmt(r['upper'])}]</td><td>[{fmt(r['min'])}, {fmt(r['max'])}]</td>"
             f"<td>{fmt(r['initial'])}</td><td>{html.escape(r['unit'])}</td></tr>"
             for r in self._rows()
         )
-        caption = (f"<p>rtid identification: cost {fmt(self.cost)}, "
+        caption = (f"<p>rtid identification: χ² {fmt(self.chisqr)}, reduced χ² {fmt(self.redchi)}, "
+                   f"AIC {fmt(self.aic)}, BIC {fmt(self.bic)}, "
                    f"{html.escape(self.termination.get('code', ''))}"
                    f"{', interrupted' if self.interrupted else ''}; "
                    f"{len(self.warnings)} warning(s)</p>")

@@ -1,8 +1,8 @@
 //! An identification's curves: each experiment's measured data beside the model at
 //! the start and the identified values, in the experiment's axes — the command
 //! line's comparisons (`rtid::identify::pipeline::comparison`), unthinned, and for a
-//! frequency response the linear model's gain at the measured frequencies, so that
-//! each curve has a residual.
+//! frequency response the linear model's gain — and where the file has one, its
+//! phase — at the measured frequencies, so that each curve has a residual.
 
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -23,6 +23,7 @@ pub fn compute(experiments: &[ExperimentSpec], start: &Params, fitted: &Params) 
     for e in experiments {
         if let Data::FrequencyResponse { .. } = &e.experiment.data {
             all.extend(gain(&e.source, &e.experiment, start, fitted));
+            all.extend(phase(&e.source, &e.experiment, start, fitted));
         } else if let Ok(c) = comparison::compare(&e.source, &e.experiment, start, fitted) {
             all.extend(c);
         }
@@ -45,6 +46,8 @@ fn gain(
     let channel = match response {
         Response::TableOverMotor => Channel::TableOverMotor,
         Response::MotorCompliance => Channel::MotorOverTorque,
+        // The closed loop is not a channel of the mechanics' linear response.
+        Response::SpeedLoop => return None,
     };
     let model = |p: &Params| -> Option<Vec<f64>> {
         let lin = LinearResponse::new(p, channel).ok()?;
@@ -63,11 +66,57 @@ fn gain(
     let y_label = match response {
         Response::TableOverMotor => "gain, dB",
         Response::MotorCompliance => "motor compliance, dB re 1 rad/(N·m)",
+        Response::SpeedLoop => "closed speed loop, dB",
     };
     Some(Comparison {
         source: source.into(),
         x_label: "frequency, Hz".into(),
         y_label: y_label.into(),
+        curves,
+    })
+}
+
+/// The measured phase, degrees (the drive's: the file's stated delay taken out), and
+/// the linear model's at the measured frequencies, each model value the turn nearest
+/// the measured one (a phase is known modulo 360°).
+fn phase(
+    source: &str,
+    exp: &rtid::Experiment,
+    start: &Params,
+    fitted: &Params,
+) -> Option<Comparison> {
+    let c = measured::complex_points(exp, |_| true).filter(|c| !c.frequency_hz.is_empty())?;
+    let f = &c.frequency_hz;
+    let m: Vec<f64> = c.phase_rad.iter().map(|p| p.to_degrees()).collect();
+    let channel = match measured::form(exp).response {
+        Response::TableOverMotor => Channel::TableOverMotor,
+        Response::MotorCompliance => Channel::MotorOverTorque,
+        // The closed speed loop's model is the controller's, not an open channel's:
+        // `rtid compare` draws it.
+        Response::SpeedLoop => return None,
+    };
+    let model = |p: &Params| -> Option<Vec<f64>> {
+        let lin = LinearResponse::new(p, channel).ok()?;
+        let near = |hz: f64, measured: f64| {
+            let deg = lin.at(hz)?.arg().to_degrees();
+            Some(deg + 360.0 * ((measured - deg) / 360.0).round())
+        };
+        f.iter().zip(&m).map(|(&hz, &y)| near(hz, y)).collect()
+    };
+    let mut curves = vec![curve("measured", Role::Measured, f, &m)];
+    if let Some(y) = model(start) {
+        curves.push(curve("linear model, start", Role::Start, f, &y));
+    }
+    curves.push(curve(
+        "linear model, identified",
+        Role::Fitted,
+        f,
+        &model(fitted)?,
+    ));
+    Some(Comparison {
+        source: source.into(),
+        x_label: "frequency, Hz".into(),
+        y_label: "phase, deg".into(),
         curves,
     })
 }

@@ -1,16 +1,21 @@
-//! `rtid.evaluate`: the statistics `rtid evaluate --json` prints for an experiment, for
-//! the kinds whose evaluation is the library's alone (frequency response, torque
-//! curve, servo trace without a model to replay it on).
+//! `rtid.evaluate`: the statistics `rtid evaluate --json` prints for an experiment of
+//! every kind with a table — frequency responses, torque curves, positioning records
+//! (some runs, a compensation), friction maps, servo traces (with their IDIM-LS
+//! options, replayed on a model), fluctuation and unbalance tests, raw time records
+//! (H1, stepped sine, multisine) — with the command line's options.
 
 use std::path::PathBuf;
 
 use pyo3::prelude::*;
 use serde_json::{json, Value};
 
+use crate::compensate;
 use crate::errors::{bad_argument, rtid_error, with_context};
+use crate::interruptible;
 use crate::params::PyParams;
-use rtid::estimation::inverse_dynamics::IdimSettings;
+use rtid::estimation::inverse_dynamics::{IdimOverrides, IdimSettings};
 use rtid::experiments::frequency_response as fr;
+use rtid::experiments::frequency_response::time_evaluation::{self, EstimateOptions};
 use rtid::experiments::positioning as pos;
 use rtid::experiments::positioning::iso230::{self, ReportUnits};
 use rtid::experiments::servo_trace::ServoTrace;
@@ -18,30 +23,107 @@ use rtid::experiments::torque_curve::{self, TorqueTest};
 use rtid::io::experiment_file::{Data, Experiment, Kind, Response};
 use rtid::report::evaluation::{self, TraceReport};
 
+/// How an experiment is evaluated: `rtid evaluate`'s options (each `None` where not
+/// given: the command line's default).
+#[derive(FromPyObject, Default)]
+#[pyo3(from_item_all)]
+pub struct Options {
+    /// Positioning: these runs (`4-5`).
+    runs: Option<String>,
+    /// Positioning: the values as the axis compensated by this compensation.json text
+    /// would show them.
+    compensation: Option<String>,
+    /// Raw time records: `--segment-s`, `--min-coherence`, `--settle-fraction`.
+    segment_s: Option<f64>,
+    min_coherence: Option<f64>,
+    settle_fraction: Option<f64>,
+    /// Servo traces: `--cutoff-hz`, `--decimation`, `--trim-s`, `--min-speed`.
+    cutoff_hz: Option<f64>,
+    decimation: Option<usize>,
+    trim_s: Option<f64>,
+    min_speed: Option<f64>,
+}
+
 /// The evaluation of the experiment at `path` as JSON, `source` naming it.
 #[pyfunction]
-#[pyo3(signature = (path, source, params=None))]
+#[pyo3(signature = (path, source, params=None, options=None))]
 pub fn evaluate(
     py: Python<'_>,
     path: PathBuf,
     source: String,
     params: Option<PyRef<'_, PyParams>>,
+    options: Option<Options>,
 ) -> PyResult<String> {
     let exp = rtid::read_experiment(&path).map_err(|e| with_context("experiment", &e))?;
     let model = params.map(|p| p.inner.clone());
-    let value = py.detach(|| match exp.manifest.kind {
+    let o = options.unwrap_or_default();
+    let positioning_only = o.runs.is_some() || o.compensation.is_some();
+    if positioning_only && exp.manifest.kind != Kind::Positioning {
+        return Err(bad_argument(
+            "runs, compensation",
+            format!(
+                "for positioning records; {source} is a `{}` experiment",
+                exp.manifest.kind.name()
+            ),
+        ));
+    }
+    let work = || {
+        match exp.manifest.kind {
         Kind::FrequencyResponse => frequency_response(&exp, &source),
         Kind::TorqueCurve => torque(&exp, &source),
-        Kind::ServoTrace => servo_trace(&exp, &source, model.as_ref()),
-        Kind::Positioning => positioning(&exp, &source),
+        Kind::ServoTrace => servo_trace(&exp, &source, model.as_ref(), &o),
+        Kind::Positioning => match (&o.compensation, &o.runs) {
+            (Some(c), runs) => compensate::evaluate_compensated(&exp, &source, c, runs.as_deref()),
+            (None, Some(runs)) => compensate::evaluate_runs(&exp, &source, runs),
+            (None, None) => positioning(&exp, &source),
+        },
         Kind::FrictionMap => friction(&exp, &source),
         Kind::Fluctuation | Kind::Unbalance => fluctuation(&exp, &source),
+        Kind::FrequencyResponseTime => time_record(&exp, &source, &o),
         other => Err(bad_argument(
             "experiment",
-            format!("evaluating a `{}` experiment from Python is not part of this version yet: run `rtid evaluate`", other.name()),
+            format!("{source}: a `{}` experiment lists its resonances in its manifest: there is nothing to evaluate", other.name()),
         )),
-    })?;
+    }
+    };
+    let value = interruptible::simple(py, work)??;
     rtid::io::json::pretty(&value).map_err(|e| rtid_error(&e))
+}
+
+/// The gain curve of a raw time record (stepped-sine demodulation or H1/Welch), or a
+/// periodic multisine's two channels, with `rtid evaluate`'s options.
+fn time_record(exp: &Experiment, source: &str, o: &Options) -> PyResult<Value> {
+    let mut opts = EstimateOptions::default();
+    if let Some(s) = o.segment_s {
+        if !(s > 0.0 && s.is_finite()) {
+            return Err(bad_argument(
+                "segment_s",
+                format!("{s}: must be a positive number of seconds"),
+            ));
+        }
+        opts.segment_s = Some(s);
+    }
+    if let Some(g) = o.min_coherence {
+        if !(0.0..=1.0).contains(&g) {
+            return Err(bad_argument(
+                "min_coherence",
+                format!("{g}: a coherence γ² lies in 0..1"),
+            ));
+        }
+        opts.min_coherence = g;
+    }
+    if let Some(f) = o.settle_fraction {
+        if !(0.0..1.0).contains(&f) {
+            return Err(bad_argument(
+                "settle_fraction",
+                format!("{f}: the fraction of each dwell discarded lies in 0..1 (below 1: some must be kept)"),
+            ));
+        }
+        opts.settle_fraction = f;
+    }
+    let e =
+        time_evaluation::evaluate_experiment(exp, &opts).map_err(|e| with_context(source, &e))?;
+    evaluation::frequency_response_time(&e, exp.manifest.kind, source).map_err(|e| rtid_error(&e))
 }
 
 /// Reads the experiment at `path` as `rtid` reads it: its kind and number of rows.
@@ -79,6 +161,7 @@ fn frequency_response(exp: &Experiment, source: &str) -> PyResult<Value> {
         let integrators = match form.response {
             Response::TableOverMotor => 0,
             Response::MotorCompliance => 2,
+            Response::SpeedLoop => 0,
         };
         let found = fr::modal::modes(&c, integrators);
         value["modes"] = rtid::io::json::value(&found.modes).map_err(|e| rtid_error(&e))?;
@@ -138,7 +221,12 @@ fn friction(exp: &Experiment, source: &str) -> PyResult<Value> {
 
 /// The friction law of a servo trace by IDIM-LS (the default settings), and on
 /// `model` its replay's simulation error.
-fn servo_trace(exp: &Experiment, source: &str, model: Option<&rtid::Params>) -> PyResult<Value> {
+fn servo_trace(
+    exp: &Experiment,
+    source: &str,
+    model: Option<&rtid::Params>,
+    o: &Options,
+) -> PyResult<Value> {
     let (Data::ServoTrace(file), Some(trace)) = (&exp.data, ServoTrace::from_experiment(exp))
     else {
         return Err(bad_argument(
@@ -147,9 +235,21 @@ fn servo_trace(exp: &Experiment, source: &str, model: Option<&rtid::Params>) -> 
         ));
     };
     let period = trace.check().map_err(|e| with_context(source, &e))?;
-    let settings = IdimSettings::for_sample_period(period);
+    let settings = idim_settings(o, period)?;
     let e = rtid::servo_trace::evaluate(exp, (&trace, file.axis), &settings, model)
         .map_err(|e| with_context(source, &e))?;
     let report = TraceReport::new(source.to_string(), file.axis, (trace.len(), period), e);
     rtid::io::json::value(&report).map_err(|e| rtid_error(&e))
+}
+
+/// The IDIM-LS settings for a record sampled every `period_s`: the defaults with what
+/// was given (`rtid evaluate --cutoff-hz …`).
+fn idim_settings(o: &Options, period_s: f64) -> PyResult<IdimSettings> {
+    let overrides = IdimOverrides {
+        cutoff_hz: o.cutoff_hz,
+        decimation: o.decimation,
+        trim_s: o.trim_s,
+        min_speed: o.min_speed,
+    };
+    overrides.settings(period_s).map_err(|e| rtid_error(&e))
 }

@@ -3,19 +3,29 @@
 //! looks for Ctrl-C (which stops the search: the best point so far is the result).
 
 use std::path::PathBuf;
-use std::time::Duration;
 
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyDict, PyList};
 
 use crate::curves;
 use crate::errors::{bad_argument, rtid_error, with_context};
+use crate::interruptible;
 use crate::params::PyParams;
 use rtid::identify::{
     Bound, Config, ExperimentSpec, FidelityChoice, Identified, Method, Monitor, SearchOptions,
-    StartChoice,
+    Staging, StartChoice,
 };
 use rtid::objectives::ObjectiveKind;
+
+/// The result file's JSON, the identified set, the curves, whether Ctrl-C stopped
+/// the work, and the fit's statistics.
+type Identification<'py> = (
+    String,
+    PyParams,
+    pyo3::Bound<'py, PyList>,
+    bool,
+    pyo3::Bound<'py, PyDict>,
+);
 
 /// Options of the search, as `rtid identify`'s flags give them.
 #[derive(FromPyObject)]
@@ -35,15 +45,26 @@ pub struct Options {
     profile: Option<Vec<String>>,
     /// `--resample`: bootstrap replicates.
     resample: Option<usize>,
-    /// `--uncertain`: held parameters and their relative half-ranges.
+    /// `--uncertain`: held parameters and their relative half-ranges (0: exact), in
+    /// place of or beside the parameter set's own ranges.
     uncertain: Vec<(String, f64)>,
+    /// `--intervals`: `auto` (by the cost), `standard-errors` or `bootstrap`.
+    intervals: String,
+    /// `--joint`: every fitted parameter on the joint cost at once, not by plan.
+    joint: bool,
+    /// `--checkpoint`: the search's state, written as it goes.
+    checkpoint: Option<PathBuf>,
+    /// `--resume`: continue the search `checkpoint` holds.
+    resume: bool,
 }
 
 /// Identifies the parameters of `options.fit` from the experiment manifests
 /// `experiments` (path, name to report it by); returns the result file's JSON, the
-/// identified parameter set and the curves. `progress(done, budget, evaluations)`,
-/// if given, is called as the searches' iterations advance (an exception from it
-/// stops the search and is raised).
+/// identified parameter set, the curves and whether Ctrl-C stopped the work (the
+/// search: its best point; the intervals: what they finished). `progress(done,
+/// budget, evaluations)`, if given, is called as the searches' iterations advance
+/// (an exception from it stops the search and is raised; a `KeyboardInterrupt` from
+/// it is Ctrl-C).
 #[pyfunction]
 #[pyo3(signature = (experiments, params, options, progress=None))]
 pub fn identify<'py>(
@@ -52,7 +73,7 @@ pub fn identify<'py>(
     params: PyRef<'_, PyParams>,
     options: Options,
     progress: Option<Py<PyAny>>,
-) -> PyResult<(String, PyParams, pyo3::Bound<'py, PyList>)> {
+) -> PyResult<Identification<'py>> {
     let base = params.inner.clone();
     drop(params);
     let config = config(&experiments, base, &options)?;
@@ -62,18 +83,11 @@ pub fn identify<'py>(
             "0: at least one replicate is needed",
         ));
     }
-    let rough = || rtid::identify::plan::Plan::new(&config).is_ok_and(|p| p.declared.rough);
-    if !options.uncertain.is_empty() && options.resample.is_none() && rough() {
-        return Err(bad_argument(
-            "uncertain",
-            "on a closed-loop simulation's rough cost (torque curve, unbalance test, servo trace) it needs resample=N: each replicate draws the held parameters and is fitted again",
-        ));
-    }
     let monitor = Monitor::default();
-    let mut failed = None;
-    let mut shown = None;
-    let outcome = std::thread::scope(|s| {
-        let search = s.spawn(|| {
+    let finished = interruptible::run(
+        py,
+        &|| monitor.stop(),
+        || {
             let fit = rtid::identify(&config, &monitor).map_err(|e| rtid_error(&e))?;
             let fit = with_intervals(fit, &options, &monitor)?;
             let curves = curves::compute(
@@ -82,43 +96,47 @@ pub fn identify<'py>(
                 &fit.params,
             );
             Ok::<_, PyErr>((fit, curves))
-        });
-        loop {
-            let finished = search.is_finished();
-            if !finished {
-                py.detach(|| std::thread::sleep(Duration::from_millis(20)));
-                if py.check_signals().is_err() {
-                    // Ctrl-C (KeyboardInterrupt): end the search, keep its best point.
-                    monitor.stop();
-                }
-            }
-            // Once more when finished: a bar ends at the end.
-            if let (Some(callback), None) = (&progress, &failed) {
-                let now = monitor.progress().iterations();
-                if shown != Some(now) {
-                    shown = Some(now);
-                    if let Err(e) = callback.call1(py, (now.0, now.1, monitor.evaluations())) {
-                        monitor.stop();
-                        failed = Some(e);
-                    }
-                }
-            }
-            if finished {
-                break;
-            }
-        }
-        search.join()
-    });
-    if let Some(e) = failed {
-        return Err(e);
-    }
-    let (Identified { result, params, .. }, curves) = match outcome {
-        Ok(r) => r?,
-        Err(_) => return Err(bad_argument("identify", "the search panicked")),
+        },
+        interruptible::progress(&progress, || {
+            let (done, budget) = monitor.progress().iterations();
+            (done, budget, monitor.evaluations())
+        }),
+    )?;
+    // Ctrl-C ends the search with its best point (or the intervals with what they
+    // finished): the result, marked as stopped, not the exception.
+    // Stopped before a single evaluation: nothing to keep, the interrupt itself.
+    let (fit, stopped) = match (finished.value, finished.interrupted) {
+        (Ok(fit), signal) => (fit, signal.is_some()),
+        (Err(_), Some(signal)) => return Err(signal),
+        (Err(e), None) => return Err(e),
     };
+    let (Identified { result, params, .. }, curves) = fit;
     let json = rtid::io::json::pretty(&result).map_err(|e| rtid_error(&e))?;
     let curves = curves::to_python(py, curves)?;
-    Ok((json, PyParams { inner: params }, curves))
+    let statistics = statistics(py, &result)?;
+    let params = PyParams { inner: params };
+    Ok((json, params, curves, stopped, statistics))
+}
+
+/// The fit's statistics under lmfit's names, as `rtid select` computes them:
+/// `ndata` residuals, `nvarys` fitted parameters, `chisqr` the cost (the sum of
+/// squares the search minimises), `redchi` = chisqr/(ndata − nvarys), `aic`, `aicc`
+/// (None where ndata ≤ nvarys + 1), `bic`.
+fn statistics<'py>(
+    py: Python<'py>,
+    r: &rtid::identify::IdentifyResult,
+) -> PyResult<pyo3::Bound<'py, PyDict>> {
+    let c = rtid::identify::selection::statistics("", r);
+    let d = PyDict::new(py);
+    d.set_item("ndata", c.n)?;
+    d.set_item("nvarys", c.k)?;
+    d.set_item("chisqr", c.cost)?;
+    let dof = c.n as f64 - c.k as f64;
+    d.set_item("redchi", if dof > 0.0 { c.cost / dof } else { f64::NAN })?;
+    d.set_item("aic", c.aic)?;
+    d.set_item("aicc", c.aicc)?;
+    d.set_item("bic", c.bic)?;
+    Ok(d)
 }
 
 /// The parameters the search started from: the base set with the recorded start
@@ -143,8 +161,12 @@ fn with_intervals(
     options: &Options,
     monitor: &Monitor,
 ) -> PyResult<Identified> {
-    use rtid::identify::intervals::{profile, resample};
+    use rtid::identify::intervals::{chosen, profile, resample};
     use rtid::identify::result::warning::Coded;
+    if fit.result.interrupted {
+        // A search stopped early: no intervals about a point that is not its end.
+        return Ok(fit);
+    }
     if let Some(names) = &options.profile {
         let names = if names.is_empty() {
             fit.result.parameters.keys().cloned().collect()
@@ -165,68 +187,53 @@ fn with_intervals(
         fit.result.warnings.extend(warnings.into_iter().map(Coded));
         profile::attach(&mut fit.result, profiles);
     }
-    let held = held_ranges(&fit, &options.uncertain)?;
-    if let Some(replicates) = options.resample {
-        let request = resample::Request {
-            result: &fit.result,
-            params: &fit.params,
-            objective: fit.objective.as_ref(),
-            settings: fit.settings,
-            replicates,
-            held: &held,
-            stop: &|| monitor.stopped(),
-            on_replicate: &|| {},
-        };
-        let resampling = resample::resample(&request).map_err(|e| rtid_error(&e))?;
-        resample::attach(&mut fit.result, resampling);
-    } else if !held.is_empty() {
-        let shifts = rtid::identify::intervals::held::shifts(
-            &rtid::identify::intervals::held::Fit {
+    let fitted: Vec<String> = fit.result.parameters.keys().cloned().collect();
+    let overrides = crate::params::overrides(&options.uncertain)?;
+    let held = chosen::held_ranges(&fit.params, &fitted, &overrides)
+        .map_err(|e| bad_argument("uncertain", e))?;
+    let choice = match options.intervals.as_str() {
+        "auto" => chosen::Choice::Auto,
+        "standard-errors" => chosen::Choice::StandardErrors,
+        "bootstrap" => chosen::Choice::Bootstrap,
+        other => {
+            return Err(bad_argument(
+                "intervals",
+                format!("{other}: auto, standard-errors or bootstrap"),
+            ))
+        }
+    };
+    match chosen::decide(&fit.result, fit.smoothness, choice, options.resample) {
+        chosen::Chosen::Bootstrap(replicates) => {
+            let request = resample::Request {
                 result: &fit.result,
                 params: &fit.params,
                 objective: fit.objective.as_ref(),
                 settings: fit.settings,
-            },
-            &held,
-        );
-        fit.result.held = shifts.map_err(|e| rtid_error(&e))?;
+                replicates,
+                held: &held,
+                stop: &|| monitor.stopped(),
+                on_replicate: &|| {},
+            };
+            let resampling = resample::resample(&request).map_err(|e| rtid_error(&e))?;
+            resample::attach(&mut fit.result, resampling);
+        }
+        chosen::Chosen::StandardErrors
+            if !held.is_empty() && !chosen::rough(&fit.result, fit.smoothness) =>
+        {
+            let shifts = rtid::identify::intervals::held::shifts(
+                &rtid::identify::intervals::held::Fit {
+                    result: &fit.result,
+                    params: &fit.params,
+                    objective: fit.objective.as_ref(),
+                    settings: fit.settings,
+                },
+                &held,
+            );
+            fit.result.held = shifts.map_err(|e| rtid_error(&e))?;
+        }
+        chosen::Chosen::StandardErrors => {}
     }
     Ok(fit)
-}
-
-/// `uncertain` as (name, value, relative half-range), each a parameter the fit held
-/// at a nonzero value.
-fn held_ranges(fit: &Identified, uncertain: &[(String, f64)]) -> PyResult<Vec<(String, f64, f64)>> {
-    let mut out = Vec::new();
-    for (name, half) in uncertain {
-        let spec = rtid::model::spec(name).map_err(|e| bad_argument("uncertain", e))?;
-        if fit.result.parameters.contains_key(spec.name) {
-            return Err(bad_argument(
-                "uncertain",
-                format!("{}: fitted; its uncertainty is the fit's", spec.name),
-            ));
-        }
-        if !(*half > 0.0 && *half < 1.0) {
-            return Err(bad_argument(
-                "uncertain",
-                format!(
-                    "{}: {half}: the relative half-range must lie between 0 and 1",
-                    spec.name
-                ),
-            ));
-        }
-        let value = spec.get(&fit.params).filter(|v| *v != 0.0).ok_or_else(|| {
-            bad_argument(
-                "uncertain",
-                format!(
-                    "{}: zero or not a parameter of this model: a relative range needs a value",
-                    spec.name
-                ),
-            )
-        })?;
-        out.push((spec.name.to_string(), value, *half));
-    }
-    Ok(out)
 }
 
 /// The configuration, checked before any work as the command line checks it.
@@ -276,6 +283,12 @@ fn config(experiments: &[(PathBuf, String)], base: rtid::Params, o: &Options) ->
     if o.starts == Some(0) {
         return Err(bad_argument("starts", "0: at least one start is needed"));
     }
+    if o.resume && o.checkpoint.is_none() {
+        return Err(bad_argument(
+            "resume",
+            "give checkpoint=, the file of the search to continue",
+        ));
+    }
     if o.max_iters == 0 {
         return Err(bad_argument(
             "max_iters",
@@ -299,9 +312,14 @@ fn config(experiments: &[(PathBuf, String)], base: rtid::Params, o: &Options) ->
             max_iters: o.max_iters,
             max_evaluations: None,
         },
-        checkpoint: None,
-        resume: false,
+        checkpoint: o.checkpoint.clone(),
+        resume: o.resume,
         start: start(&o.start)?,
+        staging: if o.joint {
+            Staging::Joint
+        } else {
+            Staging::ByRecord
+        },
     })
 }
 

@@ -91,6 +91,9 @@ pub fn frequency_response<'py>(
     output: &str,
 ) -> PyResult<Bound<'py, PyArray1<Complex<f64>>>> {
     let freqs = freqs_hz.as_slice()?;
+    let limit = rtid::limits::MAX_POINTS;
+    rtid::limits::work(freqs.len() as f64, limit, "frequencies", "freqs_hz")
+        .map_err(|e| rtid_error(&e))?;
     let model = model_of(&params)?;
     let i = input_dof(&model, input)?;
     let ratio = |channel| -> PyResult<Vec<Complex<f64>>> {

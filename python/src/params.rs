@@ -95,6 +95,47 @@ impl PyParams {
     fn copy(&self) -> PyParams {
         self.clone()
     }
+
+    /// The servo's loop: `semi_closed` or `full_closed`.
+    #[getter(loop_mode)]
+    fn get_loop_mode(&self) -> String {
+        self.inner.controller.loop_mode.to_string()
+    }
+
+    /// Sets the servo's loop (`semi_closed` or `full_closed`).
+    #[setter(loop_mode)]
+    fn set_loop_mode(&mut self, mode: &str) -> PyResult<()> {
+        self.inner.controller.loop_mode = mode.parse().map_err(|e| with_context("loop", &e))?;
+        Ok(())
+    }
+
+    /// The torque-setpoint filters as the parameter file holds them (JSON).
+    fn filters_json(&self) -> PyResult<String> {
+        serde_json::to_string(&self.inner.controller.filters)
+            .map_err(|e| bad_argument("filters", e))
+    }
+
+    /// Sets the torque-setpoint filters from their JSON (the parameter file's form),
+    /// checked as the parameter file's are.
+    fn set_filters_json(&mut self, text: &str) -> PyResult<()> {
+        let filters = serde_json::from_str(text).map_err(|e| bad_argument("filters", e))?;
+        let mut p = self.inner.clone();
+        p.controller.filters = filters;
+        p.validate().map_err(|e| with_context("filters", &e))?;
+        self.inner = p;
+        Ok(())
+    }
+
+    /// A copy with the controller settings of `tuned` (a tuned set: `rtid.tune`'s
+    /// `params`, a `rtid tune -o` file): refused for a drive of another topology or
+    /// axis (`--tune`).
+    fn with_controller(&self, tuned: PyRef<'_, PyParams>) -> PyResult<PyParams> {
+        let mut p = self.inner.clone();
+        p.controller = p
+            .controller_for(&tuned.inner)
+            .map_err(|e| with_context("tuned", &e))?;
+        Ok(PyParams { inner: p })
+    }
 }
 
 /// The set `preset` names or the file `path` holds, with `overrides` set in it.
@@ -178,4 +219,25 @@ pub fn matrix<'py>(
 ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
     let flat: Vec<f64> = rows.iter().flatten().copied().collect();
     PyArray1::from_vec(py, flat).reshape([rows.len(), columns])
+}
+
+/// `given` (name, relative half-range; 0: held exactly) as the library's overrides
+/// (registry name, per cent) of the parameter set's own held ranges (`uncertain=` of
+/// identify and predict, `--uncertain NAME=X%`).
+pub fn overrides(given: &[(String, f64)]) -> PyResult<Vec<(String, f64)>> {
+    let mut out: Vec<(String, f64)> = Vec::new();
+    for (name, half) in given {
+        let spec = rtid::model::spec(name).map_err(|e| bad_argument("uncertain", e))?;
+        if !(*half >= 0.0 && *half < 1.0) {
+            return Err(bad_argument(
+                "uncertain",
+                format!(
+                    "{}: {half}: the relative half-range must lie from 0 (held exactly) to below 1",
+                    spec.name
+                ),
+            ));
+        }
+        out.push((spec.name.to_string(), half * 100.0));
+    }
+    Ok(out)
 }

@@ -5,6 +5,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{bad_argument, rtid_error, with_context};
+use crate::interruptible;
 use crate::params::PyParams;
 use rtid::input::{Move, Samples, Trajectory};
 use rtid::input_spec::{self, InputSpec};
@@ -12,12 +13,6 @@ use rtid::io::torque_file;
 use rtid::model::{Params, NSTATE};
 use rtid::recorder::Recorder;
 use rtid::sim::{SimError, Simulation, STATE_NAMES};
-
-/// Integration steps of one run (the command line's limit).
-const MAX_STEPS: f64 = 1e9;
-
-/// Samples of the output (the command line's limit on CSV rows).
-const MAX_ROWS: f64 = 2e7;
 
 /// Every `every`-th sample, column by column: time, torque, the states, the reference.
 struct Columns {
@@ -96,13 +91,29 @@ pub fn simulate<'py>(
         columns: vec![Vec::with_capacity(rows); 2 + NSTATE + usize::from(closed)],
         reference: None,
     };
-    py.detach(|| run(&mut sim, &p, drive, duration_s, &mut rec))
-        .map_err(|e| with_context("the run of input", &e))?;
+    let done = interruptible::run(
+        py,
+        &interruptible::request_stop,
+        || run(&mut sim, &p, drive, duration_s, &mut rec),
+        |_| Ok(()),
+    )?;
+    let stopped = done.interrupted.is_some();
+    let outcome =
+        done.or_interrupted(py, |_| Ok(Some(columns(py, &mut rec)?.into_any().unbind())))?;
+    if !stopped {
+        outcome.map_err(|e| with_context("the run of input", &e))?;
+    }
+    columns(py, &mut rec)
+}
+
+/// The recorded columns by the CSV's names (those of a run stopped early: up to
+/// where it stopped).
+fn columns<'py>(py: Python<'py>, rec: &mut Columns) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     let mut names = vec!["time_s", "motor_torque_nm"];
     names.extend(STATE_NAMES);
     names.push("reference_rad");
-    for (name, column) in names.into_iter().zip(rec.columns) {
+    for (name, column) in names.into_iter().zip(std::mem::take(&mut rec.columns)) {
         out.set_item(name, PyArray1::from_vec(py, column))?;
     }
     Ok(out)
@@ -139,16 +150,22 @@ fn check_numbers(duration_s: f64, sample_s: f64, dt_s: Option<f64>, load_nm: f64
 
 /// The command line's limits on the work (`RTID_ALLOW_LARGE=1` lifts them).
 fn check_work(steps: f64, every: u64) -> PyResult<()> {
-    if std::env::var("RTID_ALLOW_LARGE").is_ok_and(|v| v == "1") {
-        return Ok(());
-    }
-    if steps > MAX_STEPS {
-        return Err(bad_argument("duration_s", format!("{steps:.3e} integration steps, above the limit of {MAX_STEPS:.0e}: shorten duration_s or lengthen dt_s (RTID_ALLOW_LARGE=1 runs it anyway)")));
-    }
-    if steps / every as f64 > MAX_ROWS {
-        return Err(bad_argument("sample_s", format!("{:.3e} samples, above the limit of {MAX_ROWS:.0e}: lengthen sample_s (RTID_ALLOW_LARGE=1 runs it anyway)", steps / every as f64)));
-    }
-    Ok(())
+    use rtid::limits::{work, MAX_ROWS, MAX_STEPS};
+    work(
+        steps,
+        MAX_STEPS,
+        "integration steps",
+        "duration_s over dt_s (or the default step)",
+    )
+    .and_then(|()| {
+        work(
+            steps / every as f64,
+            MAX_ROWS,
+            "samples",
+            "duration_s over sample_s",
+        )
+    })
+    .map_err(|e| rtid_error(&e))
 }
 
 /// A specification, a `file:` one read as the command line reads it.

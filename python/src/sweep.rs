@@ -1,15 +1,16 @@
 //! `rtid.sweep`: the sweep `rtid sweep` runs — design, rows streamed to a CSV, the
 //! complete file read back, the indices — with the design and outputs as arrays.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::Duration;
 
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{bad_argument, rtid_error, with_context};
+use crate::interruptible;
 use crate::params::{matrix, PyParams};
 use rtid::sweep as sw;
 use rtid::sweep::{Method, Output, RunOptions, Sweep, TestLength};
@@ -30,79 +31,83 @@ pub struct Options {
     tests: String,
 }
 
-/// Runs the sweep into the CSV `out` and returns its arrays and indices, on a
-/// thread of its own while this one waits with the GIL released; `progress(done,
-/// total)`, if given, is called as rows are computed (an exception from it is raised
-/// once the sweep ends).
+/// Runs (or with `resume` continues) the sweep into the CSV `out` and returns its
+/// arrays and indices, on a thread of its own while this one waits with the GIL
+/// released; `progress(done, total)`, if given, is called as rows are computed (an
+/// exception from it stops the sweep and is raised). Ctrl-C stops it: the
+/// `KeyboardInterrupt` carries the rows done as `partial`.
 #[pyfunction]
-#[pyo3(signature = (params, options, out, progress=None))]
+#[pyo3(signature = (params, options, out, progress=None, resume=false))]
 pub fn sweep<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
     options: Options,
     out: PathBuf,
     progress: Option<Py<PyAny>>,
+    resume: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let base = params.inner.clone();
     drop(params);
     let s = build(base, &options)?;
-    let design = py.detach(|| s.design()).map_err(|e| rtid_error(&e))?;
+    let design = interruptible::simple(py, || s.design())?.map_err(|e| rtid_error(&e))?;
     let total = design.values.nrows();
     let done = AtomicUsize::new(0);
     let on_row = || {
         done.fetch_add(1, Ordering::Relaxed);
     };
-    let mut failed = None;
-    let mut shown = None;
-    let outcome = std::thread::scope(|scope| {
-        let run = scope.spawn(|| -> PyResult<_> {
+    let finished = interruptible::run(
+        py,
+        &interruptible::request_stop,
+        || -> PyResult<_> {
             let opts = RunOptions {
-                overwrite: true,
+                overwrite: !resume,
+                resume,
                 on_row: &on_row,
                 ..RunOptions::default()
             };
-            sw::run(&s, &out, &opts).map_err(|e| rtid_error(&e))?;
+            let report = sw::run(&s, &out, &opts).map_err(|e| rtid_error(&e))?;
+            if !report.complete {
+                // Stopped: the rows written so far, no indices.
+                let (file, _) = sw::stream::read(&out).map_err(|e| rtid_error(&e))?;
+                return Ok((file.rows, None));
+            }
             let (_, rows) =
                 sw::load_complete(std::slice::from_ref(&out)).map_err(|e| rtid_error(&e))?;
             let indices = sw::analysis::analyse(&s, &rows).map_err(|e| rtid_error(&e))?;
-            Ok((rows, indices))
-        });
-        loop {
-            let finished = run.is_finished();
-            if !finished {
-                py.detach(|| std::thread::sleep(Duration::from_millis(20)));
-            }
-            // Once more when finished: a bar ends at the end.
-            let now = done.load(Ordering::Relaxed);
-            if let (Some(callback), None) = (&progress, &failed) {
-                if shown != Some(now) {
-                    shown = Some(now);
-                    failed = callback.call1(py, (now, total)).err();
-                }
-            }
-            if finished {
-                break;
-            }
-        }
-        run.join()
-    });
-    if let Some(e) = failed {
-        return Err(e);
-    }
-    let (rows, indices) = match outcome {
-        Ok(r) => r?,
-        Err(_) => return Err(bad_argument("sweep", "the sweep panicked")),
-    };
-    let y = sw::output_matrix(&s, &rows);
-    let rows_of = |a: &rtid::sweep::Design| -> Vec<Vec<f64>> {
-        a.values.rows().into_iter().map(|r| r.to_vec()).collect()
-    };
+            let json = rtid::io::json::pretty(&indices).map_err(|e| rtid_error(&e))?;
+            Ok((rows, Some(json)))
+        },
+        interruptible::progress(&progress, || (done.load(Ordering::Relaxed), total)),
+    )?;
+    let (rows, indices) = finished.or_interrupted(py, |value| {
+        Ok(match value {
+            Ok((rows, _)) => Some(result(py, &s, &design, &rows, None)?.into_any().unbind()),
+            Err(_) => None,
+        })
+    })??;
+    result(py, &s, &design, &rows, indices)
+}
+
+/// The sweep's arrays: the design points of `rows` (all of them, or those done
+/// before a stop) with their outputs, and the indices' JSON where there are any.
+fn result<'py>(
+    py: Python<'py>,
+    s: &Sweep,
+    design: &rtid::sweep::Design,
+    rows: &BTreeMap<usize, Vec<String>>,
+    indices: Option<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let y = sw::output_matrix(s, rows);
+    let points: Vec<Vec<f64>> = rows
+        .keys()
+        .map(|&i| design.values.row(i).to_vec())
+        .collect();
     let result = PyDict::new(py);
     result.set_item(
         "factors",
         s.factors.iter().map(|f| f.name.clone()).collect::<Vec<_>>(),
     )?;
-    result.set_item("design", matrix(py, &rows_of(&design), s.factors.len())?)?;
+    result.set_item("design", matrix(py, &points, s.factors.len())?)?;
     let columns = s.output_columns();
     let outputs: Vec<Vec<f64>> = y.rows().into_iter().map(|r| r.to_vec()).collect();
     result.set_item("outputs", matrix(py, &outputs, columns.len())?)?;
@@ -111,10 +116,7 @@ pub fn sweep<'py>(
         "index",
         PyArray1::from_vec(py, rows.keys().map(|&i| i as u64).collect()),
     )?;
-    result.set_item(
-        "indices_json",
-        rtid::io::json::pretty(&indices).map_err(|e| rtid_error(&e))?,
-    )?;
+    result.set_item("indices_json", indices.unwrap_or_else(|| "{}".into()))?;
     Ok(result)
 }
 

@@ -68,3 +68,50 @@ def test_messages_name_the_experiment_not_a_temporary_file(kwargs, expected):
     text = str(e.value)
     assert expected in text
     assert "rtid-" not in text and ".json" not in text and ".csv" not in text, text
+
+
+def test_inputs_the_model_cannot_resolve_are_refused():
+    # A sine above the Nyquist frequency of the step, a control period longer than the
+    # drive's slowest mode (10 s for 10 ms): refused, as on the command line.
+    p = rtid.params("worm-gear")
+    with pytest.raises(ValueError, match="a sine of 1e9 Hz.*Nyquist frequency 50000 Hz"):
+        rtid.simulate(p, "sine:freq_hz=1e9,amp_nm=5", duration_s=0.01)
+    slow = rtid.params("worm-gear", Tc=10.0)
+    with pytest.raises(ValueError, match="control period Tc = 10 s.*slowest mode"):
+        rtid.simulate(slow, "move:target_deg=1", duration_s=0.01)
+    with pytest.raises(ValueError, match="control period Tc = 10 s"):
+        rtid.run_experiment("torque-curve", slow)
+
+
+@pytest.mark.parametrize("call, error, message", [
+    (lambda: rtid.sweep(rtid.params("worm-gear"), "Kww=1e5..1e6:3", "resonances"), ValueError,
+     "vary: unknown parameter `Kww`; did you mean `Kw`"),
+    (lambda: rtid.identify("x.json", rtid.params("worm-gear"), fit="Kw", bounds={"Kw": 5.0}), TypeError,
+     r"bounds\[Kw\]: expected a pair \(low, high\)"),
+    (lambda: rtid.frequency_response(rtid.params("worm-gear"), "100"), TypeError, "freqs_hz"),
+    (lambda: rtid.run_experiment("positioning", rtid.params("worm-gear"), travel_mm=100.0), ValueError,
+     "travel_mm: for a linear axis"),
+    (lambda: rtid.run_experiment("positioning", rtid.params("worm-gear"), target_step_deg=0.01), ValueError,
+     "target_step_deg.*over 1000 targets"),
+    (lambda: rtid.run_experiment("servo_trace", rtid.params("direct-drive"), moves="0.1@"), ValueError, "moves"),
+    (lambda: rtid.run_experiment("friction_map", rtid.params("direct-drive"), speeds_rpm=[0.0]), ValueError,
+     "speeds_rpm: 0 is not a speed"),
+    (lambda: rtid.tune(rtid.params("worm-gear"), phase_margin_deg=200.0), ValueError, "phase_margin_deg"),
+    (lambda: rtid.predict({"parameters": {}}, rtid.params("worm-gear"), draws=3), ValueError, "fit"),
+    (lambda: rtid.compensate(rtid.params("worm-gear"), runs="3-1"), ValueError, "runs"),
+    (lambda: rtid.evaluate("fixtures/worm-gear/torque_curve.json", runs="1-2"), ValueError,
+     "for positioning records"),
+])
+def test_the_commissioning_calls_name_what_is_wrong(root, monkeypatch, call, error, message):
+    monkeypatch.chdir(root)
+    with pytest.raises(error, match=message):
+        call()
+
+
+def test_a_decreasing_frequency_names_the_row_and_its_value():
+    f = np.arange(10.0, 410.0)
+    f[-2] = f[-3] - 1.0
+    with pytest.raises(ValueError) as e:
+        rtid.experiment("frequency_response", frequency_hz=f, gain_db=np.zeros(f.size), name="sweep")
+    text = str(e.value)
+    assert "row 398 of the columns" in text and "the previous row's value: 407" in text, text

@@ -74,9 +74,15 @@ def test_evaluate_of_a_servo_trace_on_a_model_is_the_cli_replay(cli, root):
         rtid.evaluate(root / manifest, params=rtid.params("worm-gear"))
 
 
-def test_evaluate_refuses_a_kind_it_does_not_wrap_yet(root):
-    with pytest.raises(ValueError, match="not part of this version yet"):
-        rtid.evaluate(root / "fixtures/real/two-mass/multisine_a.json")
+def test_evaluate_of_a_measured_multisine_is_the_cli_s(cli, root):
+    # A raw time record (the two-mass bench's periodic multisine, docs/multisine.md).
+    path = "fixtures/real/two-mass/multisine_a.json"
+    shown = cli("evaluate", path, "--json", json_out=True)
+    mine = rtid.evaluate(root / path)
+    shown.pop("source")
+    mine.pop("source")
+    assert mine == shown
+    assert mine["motor_resonances_hz"] and mine["motor_antiresonances_hz"]
 
 
 def read_rows(path):

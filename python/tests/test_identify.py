@@ -127,12 +127,16 @@ def test_bad_options_raise_value_error_naming_them(root, kwargs, argument):
 @pytest.mark.parametrize("columns, argument", [
     (dict(force_n=np.array([1.0, np.nan, 3.0])), r"force_n\[1\]"),
     (dict(force_n=np.zeros(3), time_s=np.zeros(4)), "time_s"),
-    (dict(force_n=np.array(["1", "2"])), "force_n: dtype"),
     (dict(force_n=[[1.0, 2.0]]), "force_n: 2-dimensional"),
 ])
 def test_bad_arrays_raise_value_error_naming_the_column(columns, argument):
     with pytest.raises(ValueError, match=argument):
         rtid.experiment("servo_trace", conditions=CONDITIONS, **columns)
+
+
+def test_a_column_of_strings_raises_type_error_naming_it():
+    with pytest.raises(TypeError, match="force_n: dtype"):
+        rtid.experiment("servo_trace", conditions=CONDITIONS, force_n=np.array(["1", "2"]))
 
 
 def test_a_missing_column_is_named_by_rtid_reader():
@@ -168,12 +172,18 @@ def test_held_ranges_give_the_cli_shifts(cli, root, tmp_path):
     expected = json.loads(out.read_text())["held"]
     r = rtid.identify(worm, rtid.params("worm-gear"), fit="Kw,Kg", model="linear",
                       uncertain={"Jt": 0.1})
-    assert [h["name"] for h in r.held] == ["Jt"]
-    for name, shift in expected[0]["shifts"].items():
-        assert r.held[0]["shifts"][name] == pytest.approx(shift, rel=1e-12, abs=0)
-    torque = root / "fixtures/worm-gear/torque_curve.json"
-    with pytest.raises(ValueError, match="uncertain.*resample"):
-        rtid.identify(torque, rtid.params("worm-gear"), fit="fm", uncertain={"Kw": 0.1})
+    # The preset's own held ranges are carried beside Jt's, by both.
+    assert [h["name"] for h in r.held] == [h["name"] for h in expected]
+    assert "Jw" in [h["name"] for h in r.held]
+    for mine, theirs in zip(r.held, expected):
+        assert mine["half_width"] == theirs["half_width"]
+        for name, shift in theirs["shifts"].items():
+            assert mine["shifts"][name] == pytest.approx(shift, rel=1e-12, abs=0)
+    jt = next(h for h in r.held if h["name"] == "Jt")
+    assert jt["half_width"] == 0.1
+    exact = rtid.identify(worm, rtid.params("worm-gear"), fit="Kw,Kg", model="linear",
+                          uncertain={"Jt": 0})
+    assert "Jt" not in [h["name"] for h in exact.held]
 
 
 @pytest.mark.parametrize("kwargs, argument", [

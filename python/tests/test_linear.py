@@ -52,3 +52,8 @@ def test_a_scalar_frequency_gives_a_complex_number():
     assert h == rtid.frequency_response(p, [100.0])[0]
     with pytest.raises(ValueError, match="response to the motor.s torque"):
         rtid.frequency_response(p, [10.0], input="table_torque")
+
+
+def test_more_frequencies_than_the_limit_are_refused_at_once():
+    with pytest.raises(ValueError, match="freqs_hz: ask for 2.000e5 frequencies, over the limit of 100000"):
+        rtid.frequency_response(rtid.params("worm-gear"), np.linspace(1.0, 1000.0, 200_000))

@@ -16,6 +16,7 @@ mod report;
 mod shell;
 mod sweep;
 mod tune;
+mod tune_measured;
 
 use clap::{Parser, Subcommand};
 

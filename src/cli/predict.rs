@@ -5,19 +5,18 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-use anyhow::{bail, Context};
+use anyhow::Context;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::common::inputs::refuse_overwrite;
 use crate::cli::common::{self, interrupt, model_args, progress};
 use crate::cli::ModelArgs;
-use rtid::experiments::positioning::PositioningTest;
 use rtid::identify::result::IdentifyResult;
 use rtid::io::compensation_file;
 use rtid::model::Params;
 use rtid::names::Num;
-use rtid::prediction::draws::Uncertain;
-use rtid::prediction::{self, draws, Case, DrawSource, Prediction, Setup, Test};
+use rtid::prediction::request::{self, Request, RequestError};
+use rtid::prediction::{self, draws, Case, DrawSource, Prediction, Setup};
 
 pub const LONG_ABOUT: &str = "\
 The effect of settings predicted on the identified model, with the fit's uncertainty: \
@@ -30,13 +29,14 @@ interval of the draws: \"A after 3.6 [3.4 … 3.9]″\".
 
 The model is the base the fit started from (--preset or --params, as given to identify) \
 with the fit's values set. The interval carries the fitted parameters' uncertainty and \
-that of the held parameters: those `identify --uncertain` gave ranges (drawn with the \
-fitted parameters moving as the fit said, or as the replicates drew them) and those \
-given here with --uncertain NAME=X% (drawn uniformly within value·(1 ± X %)); it is \
+that of the held parameters: the parameter set's held ranges (`rtid params` shows a \
+preset's) — those `identify` carried drawn with the fitted parameters moving as the \
+fit said, or as the replicates drew them; the others, and those given here with \
+--uncertain NAME=X%, uniformly within value·(1 ± X %); 0 % holds one exactly. It is \
 extended to the value at the fit where the draws' interval misses it. Every other \
 parameter keeps its value, and the output names them. On six worm gears that are not \
-the preset, 69 of 72 intervals from `identify --resample 24 --uncertain …` held the \
-machine's value (docs/validation.md). A fitted parameter \
+the preset, 57 of 72 intervals of the default chain held the machine's value, 69 of 72 \
+with 24 replicates and three ranges given by hand (docs/validation.md). A fitted parameter \
 the data did not determine (no standard error) cannot be drawn: the command refuses \
 until it is held at its value (--hold NAME), and then says so.
 
@@ -79,11 +79,11 @@ pub struct Args {
     /// Hold a fitted parameter at its value instead of drawing it; repeatable.
     #[arg(long, value_name = "NAME")]
     pub hold: Vec<String>,
-    /// A parameter the fit held at an assumed value, with its uncertainty as a
-    /// relative half-range: drawn uniformly within value·(1 ± X %) beside the fit's
-    /// draws (e.g. --uncertain Kw=10% for a stiffness taken from a catalogue);
-    /// repeatable. For one `identify --uncertain` carried, this width replaces its
-    /// own (the fitted parameters still move with it).
+    /// A held parameter's relative half-range in place of the parameter set's own
+    /// (or beside it, for one without): drawn uniformly within value·(1 ± X %)
+    /// beside the fit's draws (e.g. --uncertain Kw=10% for a stiffness taken from a
+    /// catalogue); 0% holds it exactly; repeatable. For one `identify` carried, this
+    /// width replaces its own (the fitted parameters still move with it).
     #[arg(long, value_name = "NAME=X%")]
     pub uncertain: Vec<String>,
     /// Positioning test: runs per direction.
@@ -112,18 +112,12 @@ pub enum FromArg {
     Bootstrap,
 }
 
-/// Most draws a prediction takes.
-const MAX_DRAWS: usize = 100_000;
-
 pub fn run(a: Args) -> anyhow::Result<()> {
     refuse_outputs(&a)?;
     let fit = model_args::read_fit(&a.fit)?;
     let mut params = a.model.load()?;
     model_args::apply_fit(&mut params, &fit, &a.fit)?;
-    let (source, draws) = draws(&a, &fit)?;
-    let uncertain = uncertain(&a.uncertain, &params, &fit, &draws.names)?;
-    let draws = draws.with_uncertain(&uncertain, a.seed);
-    let cases = cases(&a, &params)?;
+    let (source, draws, cases) = prepare(&a, &fit, &params)?;
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();
     interrupt::on_interrupt(move || !flag.swap(true, Ordering::SeqCst));
@@ -160,129 +154,47 @@ fn refuse_outputs(a: &Args) -> anyhow::Result<()> {
     refuse_overwrite("-o", out, &inputs)
 }
 
-fn draws(a: &Args, fit: &IdentifyResult) -> anyhow::Result<(DrawSource, draws::Draws)> {
-    if a.draws < prediction::MIN_DRAWS || a.draws > MAX_DRAWS {
-        bail!(
-            "--draws {}: from {} (an interval) to {MAX_DRAWS}",
-            a.draws,
-            prediction::MIN_DRAWS
-        );
-    }
-    for name in &a.hold {
-        if !fit.parameters.contains_key(name) {
-            bail!(
-                "--hold {name}: not a parameter of the fit ({})",
-                fitted(fit)
-            );
-        }
-    }
-    let bootstrap = match a.from {
-        Some(FromArg::Bootstrap) => true,
-        Some(FromArg::Covariance) => false,
-        None => fit.resampling.as_ref().is_some_and(|r| r.fitted > 1),
-    };
-    let context = || format!("{}", a.fit.display());
-    if bootstrap {
-        if !a.hold.is_empty() {
-            bail!("--hold: the bootstrap replicates are drawn as they are (use --from covariance)");
-        }
-        let d = draws::from_bootstrap(fit).with_context(context)?;
-        return Ok((DrawSource::Bootstrap, d));
-    }
-    let d = draws::from_covariance(fit, &a.hold, a.draws, a.seed).with_context(context)?;
-    Ok((DrawSource::Covariance, d))
-}
-
-/// The held parameters' ranges: the fit's (`identify --uncertain`, the fitted
-/// parameters moving with them), a range given here replacing its width, and
-/// those given here alone drawn independently of the fit.
-fn uncertain(
-    specs: &[String],
-    params: &Params,
+/// The draws, their source and the cases the options ask for
+/// (`rtid::prediction::request`), each refusal naming its option.
+fn prepare(
+    a: &Args,
     fit: &IdentifyResult,
-    drawn: &[String],
-) -> anyhow::Result<Vec<Uncertain>> {
-    let given = common::uncertain::parse(specs, params, &|n| fit.parameters.contains_key(n))?;
-    if let Some((name, ..)) = given.iter().find(|g| drawn.contains(&g.0)) {
-        bail!("--uncertain {name}: the fit's bootstrap replicates draw it already, within the range `identify --uncertain` gave it");
-    }
-    let width = |name: &str| given.iter().find(|g| g.0 == name).map(|g| g.2);
-    let mut out: Vec<Uncertain> = (fit.held.iter())
-        .map(|h| Uncertain::of_fit(h, fit, width(&h.name)))
-        .collect();
-    out.extend(
-        (given.iter())
-            .filter(|(n, ..)| !fit.held.iter().any(|h| &h.name == n))
-            .map(|(n, v, h)| Uncertain::independent(n, *v, *h)),
-    );
-    Ok(out)
-}
-
-fn fitted(fit: &IdentifyResult) -> String {
-    fit.parameters
-        .keys()
-        .cloned()
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// Before (the model as it is) and after (with the settings) for each test.
-fn cases(a: &Args, p: &Params) -> anyhow::Result<Vec<Case>> {
-    let mut after = PositioningTest::standard(p.axis);
-    if a.runs < 2 || a.runs > 100 {
-        bail!("--runs {}: from 2 (ISO 230-2) to 100", a.runs);
-    }
-    after.runs = a.runs;
-    let before = after.clone();
-    if let Some(path) = &a.compensation {
-        let file = compensation_file::read(path)?;
-        file.check_axis(path, p.axis)?;
-        after.compensation = file.compensation;
-    }
-    let tuned = a
-        .tune
-        .as_deref()
-        .map(|t| model_args::tuned_controller(t, p))
-        .transpose()?;
-    let mut out = Vec::new();
-    for test in a.tests.split(',').map(str::trim) {
-        let (before, after) = match test {
-            "positioning" => (
-                Test::Positioning {
-                    test: before.clone(),
-                    axis: p.axis,
-                },
-                Test::Positioning {
-                    test: after.clone(),
-                    axis: p.axis,
-                },
-            ),
-            "servo" => (
-                Test::Servo {
-                    compensation: Default::default(),
-                    axis: p.axis,
-                },
-                Test::Servo {
-                    compensation: after.compensation.clone(),
-                    axis: p.axis,
-                },
-            ),
-            _ => bail!("--tests {test}: not a test prediction runs (positioning, servo)"),
-        };
-        out.push(Case {
-            label: "before".into(),
-            test: before,
-            controller: None,
-        });
-        if a.compensation.is_some() || tuned.is_some() {
-            out.push(Case {
-                label: "after".into(),
-                test: after,
-                controller: tuned.clone(),
-            });
+    params: &Params,
+) -> anyhow::Result<(DrawSource, draws::Draws, Vec<Case>)> {
+    let uncertain = common::uncertain::parse(&a.uncertain)?;
+    let compensation = match &a.compensation {
+        Some(path) => {
+            let file = compensation_file::read(path)?;
+            file.check_axis(path, params.axis)?;
+            Some(file.compensation)
         }
-    }
-    Ok(out)
+        None => None,
+    };
+    let request = Request {
+        fit,
+        params,
+        compensation,
+        controller: a
+            .tune
+            .as_deref()
+            .map(|t| model_args::tuned_controller(t, params))
+            .transpose()?,
+        tests: a.tests.split(',').map(str::to_string).collect(),
+        draws: a.draws,
+        from: a.from.map(|f| match f {
+            FromArg::Covariance => DrawSource::Covariance,
+            FromArg::Bootstrap => DrawSource::Bootstrap,
+        }),
+        hold: a.hold.clone(),
+        uncertain,
+        runs: a.runs,
+        seed: a.seed,
+    };
+    request::prepare(&request).map_err(|e| match e {
+        RequestError::Draw(e) => anyhow::Error::new(e).context(a.fit.display().to_string()),
+        RequestError::Range(e) => anyhow::anyhow!("{e}"),
+        other => anyhow::anyhow!("--{other}"),
+    })
 }
 
 fn print(a: &Args, p: &Prediction, params: &Params) {

@@ -128,6 +128,13 @@ pub struct Args {
     /// speed and position loops' gains and the cascade's sensitivity |S|.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// A drive's measured closed speed loop (`rtid import` of its measuring function, a
+    /// frequency response with response "speed_loop"): overlaid on the model's with
+    /// today's and the proposed settings (FILE-speed-loop.svg beside --plot, and
+    /// `measured_speed_loop` in --json), with a warning first where the model does not
+    /// explain it.
+    #[arg(long, value_name = "SPEED_LOOP.json")]
+    pub measured: Option<PathBuf>,
     /// Write the tuned settings as a commented SINAMICS parameter list: p1460
     /// (speed controller gain, N·m·s/rad), p1462 (integral time, ms), the current
     /// setpoint filters p1656-p1676 (docs/drive-settings.md).
@@ -163,6 +170,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         p.controller.loop_mode = mode;
     }
     let options = options(&a, &p)?;
+    let measured = match &a.measured {
+        Some(path) => {
+            let m = crate::cli::tune_measured::read(path)?;
+            if let Some(w) = crate::cli::tune_measured::check(path, &m, &p)? {
+                eprintln!("warning: {w}");
+            }
+            Some((path, m))
+        }
+        None => None,
+    };
     let bar = crate::cli::common::progress::bar(0, "weighing", a.quiet || a.json);
     let t = tuning::tune(&p, &options, &|done, total| {
         bar.set_length(total as u64);
@@ -180,12 +197,25 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.plot.is_some() {
         write_plot(&plot, &p, &t)?;
     }
+    let overlay = match &measured {
+        Some((path, m)) => Some(crate::cli::tune_measured::overlay(
+            path, m, &p, &t.params, &plot,
+        )?),
+        None => None,
+    };
     if a.json {
-        println!("{}", rtid::io::json::pretty(&rtid::io::json::value(&t)?)?);
+        let mut v = rtid::io::json::value(&t)?;
+        if let (Some(o), serde_json::Value::Object(map)) = (&overlay, &mut v) {
+            map.insert("measured_speed_loop".into(), rtid::io::json::value(o)?);
+        }
+        println!("{}", rtid::io::json::pretty(&v)?);
     } else {
         print_table(&p, &t);
         print_check(&p, &t);
         print_warnings(&p, &t);
+        if let Some(o) = &overlay {
+            crate::cli::tune_measured::print(o);
+        }
     }
     Ok(())
 }

@@ -172,7 +172,9 @@ fn add(s: &mut Summary, exp: &Experiment) -> Result<(), BoxedError> {
             frequency_hz,
             gain_db,
             ..
-        } if s.resonances_hz.is_none() => {
+        } if s.resonances_hz.is_none()
+            && crate::experiments::frequency_response::measured::of_the_mechanics(exp) =>
+        {
             let curve: Vec<(f64, f64)> = frequency_hz
                 .iter()
                 .copied()

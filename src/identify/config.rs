@@ -96,6 +96,21 @@ pub struct Config {
     /// Where the search starts: at an experiment's direct estimate (default) or the
     /// given values.
     pub start: StartChoice,
+    /// How several experiments are fitted: each parameter first from the record that
+    /// determines it, then jointly (default), or all at once on their joint cost.
+    pub staging: Staging,
+}
+
+/// How an identification of several experiments proceeds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Staging {
+    /// By plan ([`crate::identify::by_record`]): each parameter from the record that
+    /// carries the most information about it, the others held, then the parameters
+    /// whose information the records share refined jointly.
+    #[default]
+    ByRecord,
+    /// Every fitted parameter on the joint cost of every experiment at once.
+    Joint,
 }
 
 impl Config {
@@ -113,6 +128,7 @@ impl Config {
             checkpoint: None,
             resume: false,
             start: StartChoice::default(),
+            staging: Staging::default(),
         }
     }
 

@@ -33,6 +33,7 @@
 //! parallel too — rayon's work stealing nests them, so two cores stay busy with one
 //! start or with eight.
 
+pub mod by_record;
 pub mod config;
 pub mod design;
 pub mod error;
@@ -47,7 +48,7 @@ pub mod setup;
 pub mod space;
 pub mod start;
 
-pub use config::{Config, ExperimentSpec, FidelityChoice, SearchOptions, StartChoice};
+pub use config::{Config, ExperimentSpec, FidelityChoice, SearchOptions, Staging, StartChoice};
 pub use error::IdentifyError;
 pub use pipeline::checkpoint::CheckpointError;
 pub use result::starts::{StartEstimate, StartRecord};

@@ -5,7 +5,8 @@
 use std::borrow::Cow;
 use std::time::Instant;
 
-use crate::identify::config::Config;
+use crate::identify::by_record;
+use crate::identify::config::{Config, Staging};
 use crate::identify::error::IdentifyError;
 use crate::identify::pipeline::assemble::{assemble, Run};
 use crate::identify::pipeline::assess::assess;
@@ -19,7 +20,7 @@ use crate::identify::search::settings::Settings;
 use crate::identify::space::ParamSpace;
 use crate::identify::start::start;
 use crate::model::Params;
-use crate::objectives::{Objective, ObjectiveError, Smoothness};
+use crate::objectives::{Fidelity, Objective, ObjectiveError, Smoothness, Stage};
 
 /// The identified parameters and the complete parameter set, with the objective
 /// the result minimises and the search's settings (for a profile of the result).
@@ -34,6 +35,9 @@ pub struct Identified {
     pub settings: Settings,
     /// How `objective`'s cost varies (the roughest of its parts).
     pub smoothness: Smoothness,
+    /// The stage and model of the objectives whose residuals the result reports
+    /// (the last stage run).
+    pub(crate) report: (Stage, Fidelity),
 }
 
 /// Runs the identification. `monitor` carries the stop flag (Ctrl-C) and the count
@@ -59,6 +63,20 @@ pub struct Identified {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, IdentifyError> {
+    if config.staging == Staging::ByRecord && config.experiments.len() > 1 {
+        if let Some(planned) = by_record::plan(config, monitor)? {
+            return by_record::run(config, planned, monitor);
+        }
+    }
+    identify_one(config, monitor)
+}
+
+/// One identification of all of `config`'s experiments together: its plan's search
+/// (and corrections) on their joint cost.
+pub(crate) fn identify_one(
+    config: &Config,
+    monitor: &Monitor,
+) -> Result<Identified, IdentifyError> {
     let clock = Instant::now();
     let plan = Plan::new(config)?;
     let start = start(config, &plan.fit)?;
@@ -96,6 +114,10 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
         warnings.push(Warning::CheckpointNotWritten { path, error });
     }
     let assessment = assess(&plan, &space, &ran, &best, &params, monitor)?;
+    let report = (
+        plan.stages[ran.stages.clamp(1, plan.stages.len()) - 1].stage,
+        ran.fidelity,
+    );
     let run = Run {
         values: best.values,
         start_estimates: start.estimates,
@@ -120,5 +142,6 @@ pub fn identify(config: &Config, monitor: &Monitor) -> Result<Identified, Identi
             None => Box::new(ran.joint),
         },
         settings: plan.stages[0].settings,
+        report,
     })
 }

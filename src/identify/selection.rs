@@ -121,6 +121,12 @@ fn check(
     Ok(())
 }
 
+/// One result's own criteria — n, k, the cost, AIC, AICc, BIC — as `select` computes
+/// them (Δ and weight 0: they need other fits).
+pub fn statistics(label: &str, r: &IdentifyResult) -> Candidate {
+    information::candidate(figures(label, r))
+}
+
 /// The figures of one result.
 fn figures(label: &str, r: &IdentifyResult) -> Figures {
     Figures {

@@ -48,7 +48,37 @@ impl Params {
                 }
             }
         }
-        self.check_consistency()
+        self.check_consistency()?;
+        self.check_ranges()
+    }
+
+    /// Each held range names a parameter of this drive, a half-width strictly
+    /// between 0 and 100 % and a reason.
+    fn check_ranges(&self) -> Result<(), ParamError> {
+        for (name, range) in &self.ranges {
+            let bad = |reason: String| ParamError::BadRange {
+                name: name.clone(),
+                reason,
+            };
+            let s = spec(name).map_err(|e| bad(e.to_string()))?;
+            if s.name != name {
+                return Err(bad(format!("write the parameter's name as {}", s.name)));
+            }
+            // A value set to 0 (`--set theta_bg=0` on a preset) carries no range: a
+            // relative range of 0 is 0.
+            s.get(self)
+                .ok_or_else(|| bad(format!("{name} does not apply to this drive")))?;
+            if !(range.percent > 0.0 && range.percent < 100.0) {
+                return Err(bad(format!(
+                    "percent {} must lie strictly between 0 and 100",
+                    crate::names::Num(range.percent)
+                )));
+            }
+            if range.reason.trim().is_empty() {
+                return Err(bad("give the reason the value is uncertain".into()));
+            }
+        }
+        Ok(())
     }
 
     /// The checks that involve two parameters.

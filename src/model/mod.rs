@@ -22,6 +22,6 @@ pub use by_name::MAGNITUDE_RANGE;
 pub use drive::{idx, Drive, NSTATE};
 pub use kernel::{Kernel, States};
 pub use lane_drive::{LaneDrive, LaneKey, LaneMismatch};
-pub use params::{Axis, ControllerParams, LoopMode, ParamError, Params, Topology};
+pub use params::{Axis, ControllerParams, HeldRange, LoopMode, ParamError, Params, Topology};
 pub use registry::{spec, Applies, Constraint, ParamSpec, PARAMS};
 pub use setpoint_filter::{FilterError, SetpointFilter, MAX_FILTERS};

@@ -457,6 +457,7 @@ mod tests {
         let mut direct = spur.clone();
         direct.topology = Topology::Direct;
         (direct.kg, direct.rg, direct.cig, direct.theta_bg) = (None, None, None, None);
+        direct.ranges.remove("theta_bg");
 
         let s = modes(&spur).unwrap();
         let d = modes(&direct).unwrap();

@@ -351,6 +351,20 @@ pub struct Params {
     pub controller: ControllerParams,
     /// Where each value comes from, and which ones are uncertain (free text per name).
     pub notes: BTreeMap<String, String>,
+    /// The held ranges of values that are uncertain or assumed: name → relative
+    /// half-width with its reason. Where such a parameter is held (not fitted), the
+    /// identification's intervals and `rtid predict`'s carry the range.
+    pub ranges: BTreeMap<String, HeldRange>,
+}
+
+/// How far an uncertain or assumed value may be off: value·(1 ± percent/100), and why.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HeldRange {
+    /// The relative half-width, per cent (0 < percent < 100).
+    pub percent: f64,
+    /// Why the value is uncertain ("the column is ambiguous", "assumed").
+    pub reason: String,
 }
 
 /// Standard gravity, m/s².
@@ -414,6 +428,8 @@ pub enum ParamError {
     LinearTopology { topology: Topology },
     #[error(transparent)]
     Filter(#[from] super::setpoint_filter::FilterError),
+    #[error("ranges.{name}: {reason}")]
+    BadRange { name: String, reason: String },
     #[error("parameter {name} = {}: {reason}", Num(*value))]
     Inconsistent {
         name: &'static str,
@@ -428,4 +444,27 @@ impl Params {
     pub fn ratio(&self) -> f64 {
         self.rg.unwrap_or(1.0) * self.rw
     }
+
+    /// The controller settings of `tuned` (a tuned set, `rtid tune -o`) for this
+    /// model: a drive of another topology or axis has settings of other units and
+    /// meanings, and is refused.
+    pub fn controller_for(&self, tuned: &Params) -> Result<ControllerParams, OtherDrive> {
+        if tuned.topology != self.topology || tuned.axis != self.axis {
+            return Err(OtherDrive {
+                tuned: format!("{:?} {:?}", tuned.topology, tuned.axis),
+                model: format!("{:?} {:?}", self.topology, self.axis),
+            });
+        }
+        Ok(tuned.controller.clone())
+    }
+}
+
+/// Controller settings of another drive ([`Params::controller_for`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("a {tuned} drive's settings for a {model} model")]
+pub struct OtherDrive {
+    /// The tuned set's topology and axis.
+    pub tuned: String,
+    /// The model's.
+    pub model: String,
 }

@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-use super::params::{Axis, ControllerParams, ParamError, Params, Topology};
+use super::params::{Axis, ControllerParams, HeldRange, ParamError, Params, Topology};
 use super::registry::spec;
 
 /// [`Params`] as it is written: every field that may be absent is an `Option`.
@@ -102,6 +102,8 @@ pub struct ParamsJson {
     controller: ControllerParams,
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     notes: BTreeMap<String, String>,
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    ranges: BTreeMap<String, HeldRange>,
 }
 
 fn is_rotary(axis: &Axis) -> bool {
@@ -203,6 +205,7 @@ impl TryFrom<ParamsJson> for Params {
             tload: f.optional("Tload", j.tload),
             controller: j.controller,
             notes: j.notes,
+            ranges: j.ranges,
         })
     }
 }
@@ -255,6 +258,7 @@ impl From<Params> for ParamsJson {
             tload: (p.tload != 0.0).then_some(p.tload),
             controller: p.controller,
             notes: p.notes,
+            ranges: p.ranges,
         }
     }
 }

@@ -15,7 +15,9 @@ use super::measured_peaks::measured_peaks;
 use super::model_peaks::{nonlinear_responses, GRID_BAND};
 use super::resonance::drive_stiffnesses;
 use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
-use crate::experiments::frequency_response::measured::{self, fits_whole_curve, DB_PER_NEPER};
+use crate::experiments::frequency_response::measured::{
+    self, fits_whole_curve, of_the_mechanics, DB_PER_NEPER,
+};
 use crate::experiments::frequency_response::FrequencyTest;
 use crate::io::experiment_file::{Delay, Experiment, Kind, Response};
 use crate::model::linear_response::{Channel, LinearResponse};
@@ -35,7 +37,9 @@ pub static DEFINITION: Definition = Definition {
     needs: "a frequency_response experiment",
     properties: PROPERTIES,
     determines: curve_determines,
-    default_weight: |exp, stage| (stage == Stage::Search && fits_whole_curve(exp)).then_some(1.0),
+    default_weight: |exp, stage| {
+        (stage == Stage::Search && fits_whole_curve(exp) && of_the_mechanics(exp)).then_some(1.0)
+    },
     build: |source, fidelity| Ok(Box::new(GainCurve::of(source, fidelity, |_| true)?)),
     first_estimate: None,
     describe,
@@ -55,7 +59,10 @@ pub static NEAR_PEAKS: Definition = Definition {
     properties: PROPERTIES,
     determines: |_, p| drive_stiffnesses(p),
     default_weight: |exp, stage| {
-        (exp.manifest.kind == Kind::FrequencyResponse && stage == Stage::Correction).then_some(1.0)
+        (exp.manifest.kind == Kind::FrequencyResponse
+            && stage == Stage::Correction
+            && of_the_mechanics(exp))
+        .then_some(1.0)
     },
     build: near_peaks,
     first_estimate: None,
@@ -82,6 +89,7 @@ fn curve_determines(exp: &Experiment, p: &Params) -> Vec<&'static str> {
         (Response::TableOverMotor, Topology::DirectDrive) => return Vec::new(),
         (Response::MotorCompliance, _) => vec!["Jm"],
         (Response::TableOverMotor, _) => Vec::new(),
+        (Response::SpeedLoop, _) => return Vec::new(),
     };
     out.extend(drive_stiffnesses(p));
     if measured::has_phase(exp) {
@@ -134,6 +142,14 @@ impl GainCurve {
     ) -> Result<GainCurve, SetupError> {
         let exp = source.experiment;
         let form = measured::form(exp);
+        if form.response == Response::SpeedLoop {
+            return Err(SetupError::Data {
+                file: source.file.into(),
+                reason: "a speed_loop response is the drive's closed loop, not the \
+                         mechanics alone: the speed_loop objective fits it (the default)"
+                    .into(),
+            });
+        }
         if fidelity == Fidelity::Nonlinear && form.response != Response::TableOverMotor {
             return Err(SetupError::Data {
                 file: source.file.into(),
@@ -183,7 +199,8 @@ impl GainCurve {
     fn channel(&self) -> Channel {
         match self.response {
             Response::TableOverMotor => Channel::TableOverMotor,
-            Response::MotorCompliance => Channel::MotorOverTorque,
+            // `of` refuses a speed loop; its closed loop is `objectives::speed_loop`'s.
+            Response::MotorCompliance | Response::SpeedLoop => Channel::MotorOverTorque,
         }
     }
 

@@ -16,6 +16,8 @@
 //!   deviation steps across the backlash (the table friction ft);
 //! - [`friction_map`]: error of the steady-state motor torque at each run of a
 //!   friction map (the friction law: Coulomb, Stribeck, viscous, offset);
+//! - [`speed_loop`]: complex error of a drive's measured closed speed loop (actual
+//!   speed over setpoint) against the model inside its speed controller;
 //! - [`joint`]: several of these, weighted, as one.
 //!
 //! Every objective is a plain `Sync` struct holding the measured data; the simulator
@@ -87,6 +89,7 @@ pub mod peak_amplitude;
 pub mod registry;
 pub mod resonance;
 pub mod servo_trace;
+pub mod speed_loop;
 pub mod torque_curve;
 pub mod unbalance_step;
 

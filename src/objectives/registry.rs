@@ -17,6 +17,7 @@ pub static REGISTRY: &[&Definition] = &[
     &super::unbalance_step::DEFINITION,
     &super::servo_trace::DEFINITION,
     &super::friction_map::DEFINITION,
+    &super::speed_loop::DEFINITION,
 ];
 
 impl ObjectiveKind {
@@ -146,5 +147,15 @@ mod tests {
             .definition()
             .determines)(&gain_curve(false), &p);
         assert_eq!(without, ["Kw", "Kg"]);
+    }
+
+    /// A drive's closed speed loop feeds its own objective alone: its peaks are no
+    /// resonances of the mechanics and its gain no table over motor.
+    #[test]
+    fn a_speed_loop_feeds_the_speed_loop_objective_alone() {
+        let mut e = gain_curve(true);
+        e.manifest.conditions.response = Some(crate::io::experiment_file::Response::SpeedLoop);
+        assert_eq!(names(&e, Stage::Search), [("speed_loop", 1.0)]);
+        assert!(names(&e, Stage::Correction).is_empty());
     }
 }

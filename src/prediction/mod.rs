@@ -9,6 +9,7 @@
 
 pub mod cases;
 pub mod draws;
+pub mod request;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -155,6 +156,11 @@ pub fn predict(
                 return Vec::new();
             }
             let runs = run_draws(s, sets);
+            // Draws a stop cut short (`crate::interrupt`) were not run, not failed.
+            if stop.load(Ordering::Relaxed) || crate::interrupt::requested() {
+                skipped.fetch_add(sets.len(), Ordering::Relaxed);
+                return Vec::new();
+            }
             sets.iter().for_each(|_| progress());
             runs
         })

@@ -8,6 +8,8 @@ use serde_json::{json, Value};
 
 use crate::estimation::inverse_dynamics::IdimFit;
 use crate::experiments::fluctuation::Evaluation as FluctuationEvaluation;
+use crate::experiments::frequency_response::periodic_evaluation::Mode;
+use crate::experiments::frequency_response::time_evaluation::Evaluation as TimeEvaluation;
 use crate::experiments::friction_map::MapEvaluation;
 use crate::experiments::positioning::iso230::{Iso230Report, ReportUnits};
 use crate::experiments::servo_trace::{Misfit, TraceEvaluation};
@@ -75,19 +77,47 @@ pub fn fluctuation(
     kind: Kind,
     source: &str,
 ) -> Result<Value, JsonError> {
-    let mut v = value(e)?;
-    v["kind"] = json!(kind.name());
-    v["source"] = json!(source);
+    let mut v = labelled(e, kind.name(), source)?;
     v["unit"] = json!("arcsec");
+    Ok(v)
+}
+
+/// `e` as JSON with its `kind` and `source`.
+fn labelled(e: &impl Serialize, kind: &str, source: &str) -> Result<Value, JsonError> {
+    let mut v = value(e)?;
+    v["kind"] = json!(kind);
+    v["source"] = json!(source);
+    Ok(v)
+}
+
+/// A raw time record's gain curve (stepped-sine demodulation, H1 with coherence) or a
+/// periodic multisine's two channels, with the channels' mode frequencies as flat
+/// `*_hz` keys for scripts.
+pub fn frequency_response_time(
+    e: &TimeEvaluation,
+    kind: Kind,
+    source: &str,
+) -> Result<Value, JsonError> {
+    let mut v = labelled(e, kind.name(), source)?;
+    if let (TimeEvaluation::Periodic(p), Some(map)) = (e, v.as_object_mut()) {
+        let hz = |m: &[Mode]| value(&m.iter().map(|m| m.frequency_hz).collect::<Vec<_>>());
+        map.insert("table_resonances_hz".into(), hz(&p.table.resonances)?);
+        map.insert(
+            "table_antiresonances_hz".into(),
+            hz(&p.table.antiresonances)?,
+        );
+        map.insert("motor_resonances_hz".into(), hz(&p.motor.resonances)?);
+        map.insert(
+            "motor_antiresonances_hz".into(),
+            hz(&p.motor.antiresonances)?,
+        );
+    }
     Ok(v)
 }
 
 /// A friction map's laws and the one the data support.
 pub fn friction_map(e: &MapEvaluation, source: &str) -> Result<Value, JsonError> {
-    let mut v = value(e)?;
-    v["kind"] = json!("friction_map");
-    v["source"] = json!(source);
-    Ok(v)
+    labelled(e, "friction_map", source)
 }
 
 /// What the evaluation of a servo trace reports (SI units).

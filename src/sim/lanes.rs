@@ -114,6 +114,9 @@ impl<const L: usize> LaneSimulation<L> {
             .step(&self.lanes, &mut self.y, motor, &self.load, self.dt);
         self.tick();
         match diverged(&self.y) {
+            None if crate::interrupt::at_step(self.steps[0]) => {
+                Err(SimError::Interrupted { time: self.time(0) })
+            }
             None => Ok(()),
             Some(l) => Err(self.diverged_error(l)),
         }
@@ -122,6 +125,7 @@ impl<const L: usize> LaneSimulation<L> {
     /// A controller for lane `l`'s table (`params`: that lane's), at rest at its
     /// current angles, as [`Simulation::controller`](super::Simulation::controller).
     pub fn controller(&self, l: usize, params: &Params) -> Result<Controller, SimError> {
+        super::check_control_period(params)?;
         Ok(Controller::new(
             Gains::new(params)?,
             self.y[THETA_M][l],
@@ -206,6 +210,10 @@ impl<const L: usize> LaneSimulation<L> {
             if diverged(&self.y).is_some() {
                 self.stop_diverged(failed);
             }
+            if crate::interrupt::at_step(self.steps[0]) {
+                self.stop_all(failed);
+                return;
+            }
             for (l, r) in recorders.iter_mut().enumerate() {
                 if failed[l].is_none() {
                     r.record(self.time(l), &self.state(l), u[l]);
@@ -233,6 +241,16 @@ impl<const L: usize> LaneSimulation<L> {
             }
             self.kernel.reset_lane(l);
             self.load[l] = 0.0;
+        }
+    }
+
+    /// Records an interruption in `failed` for every lane still running.
+    #[cold]
+    fn stop_all(&self, failed: &mut [Option<SimError>; L]) {
+        for (l, f) in failed.iter_mut().enumerate() {
+            if f.is_none() {
+                *f = Some(SimError::Interrupted { time: self.time(l) });
+            }
         }
     }
 

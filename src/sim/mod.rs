@@ -58,6 +58,15 @@ pub enum SimError {
     Lanes(#[from] LaneMismatch),
     #[error("lane {lane} is integrated with dt = {dt} s, lane 0 with {dt0} s: lanes of one batch share the step")]
     LaneStep { lane: usize, dt: f64, dt0: f64 },
+    /// A sine the step cannot resolve: above the Nyquist frequency 1/(2·dt).
+    #[error("a sine of {} Hz on an integration step of {dt:e} s, above its Nyquist frequency {} Hz: the run would alias it to another frequency (lower freq_hz, or give a shorter dt)", crate::names::Num(*freq_hz), crate::names::Num((0.5e6 / *dt).round() / 1e6))]
+    AboveNyquist { freq_hz: f64, dt: f64 },
+    /// A control period the model cannot run: longer than its slowest mode's period.
+    #[error("control period Tc = {} s is longer than the period of the drive's slowest mode ({} Hz, {:.3e} s): a servo sampled that slowly does not control the drive (a unit slip? Tc is in seconds, e.g. 1e-3)", crate::names::Num(*tc), crate::names::Num(*mode_hz), 1.0 / *mode_hz)]
+    ControlPeriodTooLong { tc: f64, mode_hz: f64 },
+    /// Stopped at a request ([`crate::interrupt`]) at time `time`.
+    #[error("simulation interrupted at t = {time:.6} s")]
+    Interrupted { time: f64 },
 }
 
 /// The default integration step for `params`: the largest of 1e-5 s, 5e-6 s, 2e-6 s,
@@ -185,6 +194,7 @@ impl Simulation {
 
     /// A controller for this table, at rest at the current angles.
     pub fn controller(&self, params: &Params) -> Result<Controller, SimError> {
+        check_control_period(params)?;
         let gains = Gains::new(params)?;
         Ok(Controller::new(
             gains,
@@ -280,6 +290,9 @@ impl Simulation {
         }
         self.steps += 1;
         if diverged(&self.y).is_none() {
+            if crate::interrupt::at_step(self.steps) {
+                return Err(SimError::Interrupted { time: self.time() });
+            }
             Ok(())
         } else {
             Err(SimError::Diverged {
@@ -288,6 +301,25 @@ impl Simulation {
             })
         }
     }
+}
+
+/// Refuses a control period longer than the period of the drive's slowest
+/// (motor-free, elastic) mode: such a servo cannot hold the drive, and a 10 s `Tc` is a
+/// slip for 10 ms. A rigid drive has no such mode and no such limit.
+pub fn check_control_period(params: &Params) -> Result<(), SimError> {
+    let tc = params.controller.tc;
+    let slowest = crate::model::modes::modes(params)?
+        .free_hz
+        .into_iter()
+        .filter(|f| *f > 0.0 && f.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    if slowest.is_finite() && tc * slowest > 1.0 {
+        return Err(SimError::ControlPeriodTooLong {
+            tc,
+            mode_hz: slowest,
+        });
+    }
+    Ok(())
 }
 
 /// The compiled model, after checking the step `dt` against its stiffest mode.

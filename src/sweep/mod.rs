@@ -25,6 +25,7 @@ pub mod stream;
 
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use ndarray::Array2;
@@ -330,14 +331,24 @@ pub fn run(sweep: &Sweep, out: &Path, opts: &RunOptions) -> Result<RunReport, Sw
         .len()
         .div_ceil(rayon::current_num_threads())
         .clamp(1, crate::sim::LANES);
+    let computed = AtomicUsize::new(0);
     todo.par_chunks(per_task)
         .try_for_each(|chunk| -> Result<(), StreamError> {
-            for (&i, row) in chunk.iter().zip(sweep.rows(&design, &evaluator, chunk)) {
+            if crate::interrupt::requested() {
+                return Ok(());
+            }
+            let batch = sweep.rows(&design, &evaluator, chunk);
+            // Rows of a batch a stop request cut short are not the points' outputs.
+            if crate::interrupt::requested() {
+                return Ok(());
+            }
+            for (&i, row) in chunk.iter().zip(batch) {
                 journal
                     .lock()
                     .expect("no panic holds the lock")
                     .append(&row)?;
                 rows.lock().expect("no panic holds the lock").insert(i, row);
+                computed.fetch_add(1, Ordering::Relaxed);
                 (opts.on_row)();
             }
             Ok(())
@@ -353,7 +364,7 @@ pub fn run(sweep: &Sweep, out: &Path, opts: &RunOptions) -> Result<RunReport, Sw
     Ok(RunReport {
         total: mine.len(),
         resumed,
-        computed: todo.len(),
+        computed: computed.into_inner(),
         failed,
         complete,
     })

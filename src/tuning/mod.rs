@@ -6,7 +6,9 @@
 //! [`stability`]), its closed loops ([`closed_loop`]), over a range of machines
 //! ([`range`]); the candidates that keep the targets ([`candidates`]), weighed on the
 //! nonlinear model against today's setting as ensembles ([`weigh`]). [`tune`] puts
-//! them together; [`bode`] gives a setting's loops as a Bode plot draws them.
+//! them together; [`bode`] gives a setting's loops as a Bode plot draws them;
+//! [`speed_loop`] the closed speed loop's response as a drive measures it, against a
+//! measurement.
 //!
 //! Layer: above `model`, `controller` and `experiments::positioning` (it reads the
 //! linear response, the modes and the controller's discretised filters, and runs the
@@ -22,6 +24,7 @@ pub mod options;
 pub mod range;
 pub mod sampled;
 pub mod search;
+pub mod speed_loop;
 pub mod stability;
 pub mod weigh;
 

@@ -100,17 +100,8 @@ pub fn read_fit(path: &Path) -> anyhow::Result<IdentifyResult> {
 /// The controller settings of a tuned parameter file (`rtid tune -o`) for model `p`.
 pub fn tuned_controller(path: &Path, p: &Params) -> anyhow::Result<ControllerParams> {
     let tuned = params_file::read(path)?;
-    if tuned.topology != p.topology || tuned.axis != p.axis {
-        bail!(
-            "--tune {}: a {:?} {:?} drive's settings for a {:?} {:?} model",
-            path.display(),
-            tuned.topology,
-            tuned.axis,
-            p.topology,
-            p.axis
-        );
-    }
-    Ok(tuned.controller)
+    p.controller_for(&tuned)
+        .with_context(|| format!("--tune {}", path.display()))
 }
 
 /// `NAME=VALUE` with a finite number.

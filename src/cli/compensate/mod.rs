@@ -14,13 +14,12 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use crate::cli::common::inputs::refuse_overwrite;
 use crate::cli::ModelArgs;
 use rtid::controller::FrictionCompensation;
-use rtid::estimation::friction_law::LawFit;
 use rtid::experiments::friction_map;
 use rtid::experiments::positioning::compensate::{self, BeforeAfter, Computed, Runs};
 use rtid::experiments::positioning::iso230::{AxisStats, ReportUnits};
 use rtid::experiments::positioning::{self};
 use rtid::io::compensation_file::{self, table_csv, CompensationFile, Source};
-use rtid::io::experiment_file::{self, Data, Experiment};
+use rtid::io::experiment_file::{self, Experiment};
 use rtid::model::Axis;
 
 pub const LONG_ABOUT: &str = "\
@@ -213,36 +212,8 @@ fn origin(a: &Args) -> anyhow::Result<Origin> {
 /// selected family, if determined, on the positioning record's axis.
 fn friction_of(path: &Path, axis: Axis) -> anyhow::Result<FrictionCompensation> {
     let exp = experiment_file::read(path)?;
-    let Data::FrictionMap(map) = &exp.data else {
-        bail!(
-            "--friction-map {}: a `{}` experiment, not a friction map",
-            path.display(),
-            exp.manifest.kind.name()
-        );
-    };
-    if map.axis != axis {
-        bail!(
-            "--friction-map {}: a map of a {} axis for a {} axis's compensation",
-            path.display(),
-            compensation_file::axis_name(map.axis),
-            compensation_file::axis_name(axis)
-        );
-    }
-    let evaluation = friction_map::evaluate(map)
-        .with_context(|| format!("--friction-map {}", path.display()))?;
-    let Some((law, offset)) = evaluation.symmetric().and_then(LawFit::steady) else {
-        bail!(
-            "--friction-map {}: the map determines no symmetric law (the data support {}, \
-             whose symmetric form is not determined): no friction compensation",
-            path.display(),
-            evaluation.laws.selected
-        );
-    };
-    Ok(FrictionCompensation {
-        law,
-        offset,
-        pulse: None,
-    })
+    friction_map::compensation::of_experiment(&exp, axis)
+        .with_context(|| format!("--friction-map {}", path.display()))
 }
 
 /// The outputs asked for, each refused over an input or over another output.
@@ -318,7 +289,10 @@ fn file_of(a: &Args, o: &Origin, c: &Computed) -> CompensationFile {
         source: std::iter::once(Source {
             file: o.name.clone(),
             runs: o.runs.as_ref().map(Runs::to_string),
-            model: o.model.as_ref().map(|_| MODEL_SOURCE.to_string()),
+            model: o
+                .model
+                .as_ref()
+                .map(|_| compensation_file::MODEL_SOURCE.to_string()),
         })
         .chain(a.friction_map.iter().map(|m| Source {
             file: m.display().to_string(),
@@ -329,75 +303,11 @@ fn file_of(a: &Args, o: &Origin, c: &Computed) -> CompensationFile {
     }
 }
 
-/// What a model's compensation rests on, in the file's source.
-const MODEL_SOURCE: &str =
-    "the virtual positioning test (ISO 230-2 standard cycle) of the identified model";
-
 fn print_json(o: &Origin, c: &Computed, zeroed: Option<&sinumerik::Zeroed>) -> anyhow::Result<()> {
-    let u = ReportUnits::of(c.axis);
-    let k = u.deviation_per_si;
-    // Every number through the finite check: `json!` would write a NaN as null.
-    let num = |x: f64| rtid::io::json::value(&x);
-    let scaled = |b: &BeforeAfter| -> anyhow::Result<serde_json::Value> {
-        Ok(serde_json::json!({
-            "before": rtid::io::json::value(&b.before.scaled(k))?,
-            "backlash_only": rtid::io::json::value(&b.backlash_only.scaled(k))?,
-            "after": rtid::io::json::value(&b.after.scaled(k))?,
-        }))
-    };
-    let targets: Vec<_> = c
-        .targets
-        .iter()
-        .map(|t| {
-            Ok(serde_json::json!({
-                format!("target_{}", u.target_key): num(t.target * u.target_per_si)?,
-                "mean_up": num(t.mean_up * k)?, "mean_down": num(t.mean_down * k)?,
-                "reversal": num(t.reversal * k)?, "table": num(t.table * k)?,
-            }))
-        })
-        .collect::<anyhow::Result<_>>()?;
-    let warnings: Vec<_> = c
-        .warnings
-        .iter()
-        .map(|w| {
-            let mut v = rtid::io::json::value(w)?;
-            v["message"] = w.message(k, u.deviation).into();
-            Ok(v)
-        })
-        .collect::<anyhow::Result<_>>()?;
-    let value = serde_json::json!({
-        "kind": "compensation",
-        "source": o.name,
-        "unit": u.deviation_key,
-        "build_runs": c.build_runs,
-        "check_runs": c.check_runs,
-        "backlash": num(c.compensation.backlash.unwrap_or(0.0) * k)?,
-        "friction": c.compensation.friction.as_ref().map(friction_json).transpose()?,
-        "targets": targets,
-        "build": scaled(&c.build)?,
-        "check": c.check.as_ref().map(scaled).transpose()?,
-        "warnings": warnings,
-        "sinumerik": zeroed.map(|z| sinumerik::json(z, c.axis)).transpose()?,
-    });
+    let sinumerik = zeroed.map(|z| sinumerik::json(z, c.axis)).transpose()?;
+    let value = rtid::report::compensation::compensation(&o.name, c, sinumerik)?;
     println!("{}", rtid::io::json::pretty(&value)?);
     Ok(())
-}
-
-/// A friction compensation in JSON, SI at the motor (through the finite check).
-fn friction_json(f: &FrictionCompensation) -> Result<serde_json::Value, rtid::io::json::JsonError> {
-    let num = |x: f64| rtid::io::json::value(&x);
-    let stribeck = match f.law.rise {
-        Some(r) => Some(serde_json::json!({
-            "rise": num(r.rise)?, "speed": num(r.speed)?, "shape": num(r.shape)?,
-        })),
-        None => None,
-    };
-    Ok(serde_json::json!({
-        "coulomb": num(f.law.coulomb)?,
-        "viscous": num(f.law.viscous)?,
-        "stribeck": stribeck,
-        "offset": num(f.offset)?,
-    }))
 }
 
 /// The friction compensation in words.
@@ -542,16 +452,13 @@ pub fn evaluate(
     let runs_used = runs_text(&compensate::run_numbers(&measurements));
     let k = u.deviation_per_si;
     if json {
-        let value = serde_json::json!({
-            "kind": "positioning",
-            "source": exp.path,
-            "compensation": file,
-            "runs": compensate::run_numbers(&measurements),
-            "unit": u.deviation_key,
-            "uncompensated": rtid::io::json::value(&b.before.scaled(k))?,
-            "backlash_only": rtid::io::json::value(&b.backlash_only.scaled(k))?,
-            "compensated": rtid::io::json::value(&b.after.scaled(k))?,
-        });
+        let value = rtid::report::compensation::compensated(
+            &exp.path.display().to_string(),
+            &file.display().to_string(),
+            &compensate::run_numbers(&measurements),
+            &b,
+            u,
+        )?;
         println!("{}", rtid::io::json::pretty(&value)?);
         return Ok(());
     }

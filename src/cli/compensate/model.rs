@@ -3,14 +3,12 @@
 //! elastic lost motion and the friction make together) and, with `--friction`, the
 //! friction law its steady map gives at the motor.
 
-use anyhow::{bail, Context};
+use anyhow::Context;
 
 use super::Args;
 use rtid::controller::FrictionCompensation;
-use rtid::estimation::friction_law::LawFit;
-use rtid::experiments::friction_map::{self, steady::model_map, MapTest};
+use rtid::experiments::friction_map;
 use rtid::experiments::positioning::{self, iso230::Measurement, PositioningTest};
-use rtid::io::experiment_file::FrictionMap;
 use rtid::model::Params;
 
 /// The identified model: the base set (--preset, --params) with the fit's values and
@@ -43,19 +41,6 @@ pub fn record(p: &Params, quiet: bool) -> anyhow::Result<Vec<Measurement>> {
 /// map at the standard friction-map speeds (exact where the bodies' laws lump into
 /// one; the fit's family chosen as for a measured map).
 pub fn friction(p: &Params, name: &str) -> anyhow::Result<FrictionCompensation> {
-    let speeds = MapTest::default_speeds(p);
-    let effort = model_map(p, &speeds).context("the model's friction map")?;
-    let map = FrictionMap::new(p.axis, speeds, effort);
-    let evaluation = friction_map::evaluate(&map).context("the model's friction map")?;
-    let Some((law, offset)) = evaluation.symmetric().and_then(LawFit::steady) else {
-        bail!(
-            "--friction: the steady map of {name} determines no symmetric law (it supports {}, whose symmetric form is not determined)",
-            evaluation.laws.selected
-        );
-    };
-    Ok(FrictionCompensation {
-        law,
-        offset,
-        pulse: None,
-    })
+    friction_map::compensation::of_model(p)
+        .with_context(|| format!("--friction: the steady map of {name}"))
 }

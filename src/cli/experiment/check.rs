@@ -61,44 +61,21 @@ fn within(v: f64, option: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The environment variable that lifts the work limits for a rare large job.
-pub const ALLOW_LARGE: &str = "RTID_ALLOW_LARGE";
+pub use rtid::limits::{MAX_POINTS, MAX_SIMULATED_S};
 
-/// Frequencies, samples or points one command may ask for.
-pub const MAX_POINTS: f64 = 1e5;
-
-/// Seconds of simulated time one run may ask for (an hour: the paper's tests need
-/// minutes; a worm-gear run simulates ≈ 40 s per wall-clock second on one core).
-pub const MAX_SIMULATED_S: f64 = 3600.0;
-
-/// Work estimated before it starts: `amount` (of `what`) from `options` must stay
-/// within `limit`, unless [`ALLOW_LARGE`] is set to 1. A non-finite amount is always
-/// refused.
+/// Work estimated before it starts (`rtid::limits::work`): `amount` (of `what`) from
+/// `options` must stay within `limit`, unless `RTID_ALLOW_LARGE` is set to 1.
 pub fn work(amount: f64, limit: f64, what: &str, options: &str) -> anyhow::Result<()> {
-    let allowed = std::env::var(ALLOW_LARGE).is_ok_and(|v| v == "1");
-    if amount.is_finite() && (amount <= limit || allowed) {
-        return Ok(());
-    }
-    if !amount.is_finite() {
-        bail!("{options}: ask for more {what} than can be counted");
-    }
-    bail!(
-        "{options}: ask for {amount:.3e} {what}, over the limit of {} (set {ALLOW_LARGE}=1 to run it anyway)",
-        Num(limit)
-    )
+    Ok(rtid::limits::work(amount, limit, what, options)?)
 }
 
 /// The frequencies `from`, `from + step`, … up to `to` (Hz), their number checked
 /// against [`MAX_POINTS`] before the list is made.
 pub fn frequency_grid(from: f64, to: f64, step: f64) -> anyhow::Result<Vec<f64>> {
-    let count = ((to - from) / step + 1e-9).floor();
-    work(
-        count + 1.0,
-        MAX_POINTS,
-        "frequencies",
+    Ok(rtid::limits::frequency_grid(
+        from,
+        to,
+        step,
         "--from-hz, --to-hz, --step-hz",
-    )?;
-    Ok((0..=count as usize)
-        .map(|i| from + step * i as f64)
-        .collect())
+    )?)
 }

@@ -317,6 +317,7 @@ fn complex_evaluation(exp: &Experiment, plot: &Plot) -> anyhow::Result<Option<Co
     let (integrators, ratio, unit) = match form.response {
         Response::TableOverMotor => (0, "table / motor × ratio", "1"),
         Response::MotorCompliance => (2, "motor angle / motor torque", "rad/(N·m)"),
+        Response::SpeedLoop => (0, "actual speed / speed setpoint", "1"),
     };
     let modes = modal::modes(&c, integrators);
     // The plots along ascending frequency.

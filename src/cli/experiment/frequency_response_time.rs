@@ -237,7 +237,7 @@ impl Args {
         )?;
         check::work(
             test.duration() * test.sample_rate_hz,
-            1e8,
+            rtid::limits::MAX_RECORD_SAMPLES,
             "samples",
             "--sample-rate-hz with the record's length",
         )?;
@@ -303,16 +303,9 @@ pub fn report_with(
     let mechanism = exp.manifest.mechanism.as_deref().unwrap_or("table");
     plot_evaluation(&e, mechanism, plot)?;
     if json {
-        let mut value = rtid::io::json::value(&e)?;
-        value["kind"] = serde_json::json!(exp.manifest.kind.name());
-        value["source"] = serde_json::json!(exp.path);
-        if let Evaluation::Periodic(p) = &e {
-            if let (Some(v), serde_json::Value::Object(keys)) =
-                (value.as_object_mut(), super::periodic_summary::hz_keys(p)?)
-            {
-                v.extend(keys);
-            }
-        }
+        let source = exp.path.display().to_string();
+        let value =
+            rtid::report::evaluation::frequency_response_time(&e, exp.manifest.kind, &source)?;
         println!("{}", rtid::io::json::pretty(&value)?);
         return Ok(());
     }

@@ -6,7 +6,7 @@ use anyhow::Context;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use rtid::estimation::friction_law::LawFit;
 use rtid::experiments::friction_map::{self, MapEvaluation, MapTest};
-use rtid::io::experiment_file::{Axis, Data, Experiment, Kind, Manifest};
+use rtid::io::experiment_file::{Axis, Data, Experiment};
 use rtid::model::Params;
 use rtid::report::friction_map as figures;
 
@@ -110,19 +110,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     )?;
     a.common.create_out()?;
     let bar = progress::bar(test.speeds.len() as u64, "friction map", a.common.quiet);
-    let mut map = friction_map::run(&p, &test, |done, _| bar.set_position(done as u64))?;
+    let progress = |done, _| bar.set_position(done as u64);
+    let (manifest, map) = friction_map::run::record(&p, &test, a.scatter_percent, progress)?;
     bar.finish_and_clear();
-    rtid::experiments::measurement_noise::perturb_relative(
-        &mut map.effort,
-        a.scatter_percent,
-        a.seed.wrapping_add(test.speeds.len() as u64),
-    );
-    a.common.write_and_report(
-        "friction_map",
-        manifest(&p, &test, &a),
-        &Data::FrictionMap(map),
-        report,
-    )
+    a.common
+        .write_and_report("friction_map", manifest, &Data::FrictionMap(map), report)
 }
 
 /// The test the flags describe, or why they do not describe one.
@@ -184,32 +176,6 @@ fn speeds(given: &[f64], option: &str, si: f64) -> anyhow::Result<Vec<f64>> {
     }
     out.sort_by(f64::total_cmp);
     Ok(out)
-}
-
-fn manifest(p: &Params, test: &MapTest, a: &Args) -> Manifest {
-    let mut m = Manifest::new(Kind::FrictionMap);
-    m.mechanism = Some(p.name.clone());
-    let mut notes = format!(
-        "virtual friction map: the servo ({}) at {} constant motor speeds from rest, settled {} s, averaged over {} s or whole shaft revolutions",
-        p.controller.loop_mode,
-        test.speeds.len(),
-        test.settle,
-        test.average
-    );
-    if a.noise_percent > 0.0 {
-        notes += &format!(
-            "; {} % (of each run's RMS) Gaussian noise on the torque samples (seed {})",
-            a.noise_percent, a.seed
-        );
-    }
-    if a.scatter_percent > 0.0 {
-        notes += &format!(
-            "; each run's mean torque scattered by {} % (Gaussian)",
-            a.scatter_percent
-        );
-    }
-    m.notes = Some(notes);
-    m
 }
 
 /// Evaluates a friction-map experiment: runs and laws printed (table or JSON), the map

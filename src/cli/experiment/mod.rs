@@ -10,6 +10,7 @@ pub mod friction_map;
 pub mod periodic_summary;
 pub mod positioning;
 pub mod servo_trace;
+pub mod speed_loop;
 pub mod torque_curve;
 pub mod unbalance;
 
@@ -55,6 +56,9 @@ pub enum Test {
     /// A servo trace of the model along point-to-point moves, as a drive's oscilloscope records it.
     #[command(long_about = servo_trace::LONG_ABOUT)]
     ServoTrace(servo_trace::Args),
+    /// The closed speed loop's response (actual over setpoint speed) as a drive's measuring function records it.
+    #[command(long_about = speed_loop::LONG_ABOUT)]
+    SpeedLoop(speed_loop::Args),
 }
 
 /// Arguments every test takes.
@@ -172,5 +176,6 @@ pub fn run(test: Test) -> anyhow::Result<()> {
         Test::Unbalance(a) => unbalance::run(a),
         Test::ServoTrace(a) => servo_trace::run(a),
         Test::FrictionMap(a) => friction_map::run(a),
+        Test::SpeedLoop(a) => speed_loop::run(a),
     }
 }

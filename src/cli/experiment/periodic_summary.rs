@@ -1,4 +1,4 @@
-//! The printed evaluation of a multisine record, and the `*_hz` keys of its JSON.
+//! The printed evaluation of a multisine record.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -140,17 +140,4 @@ fn class(
         ),
         _ => "   —                     ".into(),
     }
-}
-
-/// The channels' mode frequencies as flat `*_hz` keys, for scripts (through the
-/// finite check: `json!` would write a NaN as null).
-pub fn hz_keys(p: &PeriodicEvaluation) -> Result<serde_json::Value, rtid::io::json::JsonError> {
-    let hz =
-        |m: &[Mode]| rtid::io::json::value(&m.iter().map(|m| m.frequency_hz).collect::<Vec<_>>());
-    Ok(serde_json::json!({
-        "table_resonances_hz": hz(&p.table.resonances)?,
-        "table_antiresonances_hz": hz(&p.table.antiresonances)?,
-        "motor_resonances_hz": hz(&p.motor.resonances)?,
-        "motor_antiresonances_hz": hz(&p.motor.antiresonances)?,
-    }))
 }

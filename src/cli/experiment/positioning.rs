@@ -154,17 +154,14 @@ fn rotary(a: &Args) -> anyhow::Result<(Vec<f64>, f64, f64)> {
     let speed = check::positive(a.speed_deg_per_min.unwrap_or(3600.0), "--speed-deg-per-min")?;
     let noise = a.noise_arcsec.unwrap_or(0.0);
     check::non_negative(noise, "--noise-arcsec")?;
-    if 360.0 / step > 1000.0 {
-        bail!(
-            "--target-step-deg {}: over 1000 targets in a revolution",
+    let targets = positioning::rotary_targets(step).map_err(|e| {
+        anyhow::anyhow!(
+            "--target-step-deg {}: {e} in a revolution",
             rtid::names::Num(step)
-        );
-    }
-    let count = (360.0 / step).floor() as usize;
+        )
+    })?;
     Ok((
-        (0..=count)
-            .map(|i| (step * i as f64).to_radians())
-            .collect(),
+        targets,
         speed.to_radians() / 60.0,
         noise / iso230::ARCSEC_PER_RAD,
     ))
@@ -185,19 +182,14 @@ fn linear(a: &Args) -> anyhow::Result<(Vec<f64>, f64, f64)> {
     let speed = check::positive(a.speed_mm_per_min.unwrap_or(3000.0), "--speed-mm-per-min")?;
     let noise = a.noise_um.unwrap_or(0.0);
     check::non_negative(noise, "--noise-um")?;
-    if travel / step > 1000.0 {
-        bail!(
-            "--travel-mm {} / --target-step-mm {}: over 1000 targets",
+    let targets = positioning::linear_targets(step, travel).map_err(|e| {
+        anyhow::anyhow!(
+            "--travel-mm {} / --target-step-mm {}: {e}",
             rtid::names::Num(travel),
             rtid::names::Num(step)
-        );
-    }
-    let count = (travel / step + 1e-9).floor() as usize;
-    Ok((
-        (0..=count).map(|i| step * i as f64 * 1e-3).collect(),
-        speed * 1e-3 / 60.0,
-        noise * 1e-6,
-    ))
+        )
+    })?;
+    Ok((targets, speed * 1e-3 / 60.0, noise * 1e-6))
 }
 
 /// Runs `test` on `p` and writes it, `note` (the loop's override) in its manifest.

@@ -7,11 +7,11 @@ use crate::cli::common::plot::Plot;
 use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
-use rtid::estimation::inverse_dynamics::IdimSettings;
+use rtid::estimation::inverse_dynamics::{IdimOverrideError, IdimOverrides, IdimSettings};
 use rtid::experiments::servo_trace::{
     evaluate, virtual_trace, MoveTo, ServoTrace, TrapezoidalMoves,
 };
-use rtid::io::experiment_file::{Axis, CommandUnit, Data, Experiment, Kind, Manifest};
+use rtid::io::experiment_file::{Axis, Data, Experiment};
 use rtid::model::Params;
 use rtid::report::evaluation::TraceReport;
 use rtid::report::servo_trace as figures;
@@ -46,29 +46,21 @@ impl IdimArgs {
     /// The settings for a record sampled every `period_s`: the defaults
     /// ([`IdimSettings::for_sample_period`]) with what was given.
     pub fn settings(&self, period_s: f64) -> anyhow::Result<IdimSettings> {
-        let mut s = IdimSettings::for_sample_period(period_s);
-        for (option, value) in [
-            ("--cutoff-hz", self.cutoff_hz),
-            ("--trim-s", self.trim_s),
-            ("--min-speed", self.min_speed),
-        ] {
-            if value.is_some_and(|v| !v.is_finite() || v < 0.0) {
-                bail!(
-                    "{option} {}: must be a finite number ≥ 0",
-                    value.unwrap_or_default()
-                );
+        let overrides = IdimOverrides {
+            cutoff_hz: self.cutoff_hz,
+            decimation: self.decimation,
+            trim_s: self.trim_s,
+            min_speed: self.min_speed,
+        };
+        overrides.settings(period_s).map_err(|e| match e {
+            IdimOverrideError::Negative { name, value } => anyhow::anyhow!(
+                "--{} {value}: must be a finite number ≥ 0",
+                name.replace('_', "-")
+            ),
+            IdimOverrideError::Decimation => {
+                anyhow::anyhow!("--decimation 0: must be at least 1 (1: no decimation)")
             }
-        }
-        if self.decimation == Some(0) {
-            bail!("--decimation 0: must be at least 1 (1: no decimation)");
-        }
-        s.cutoff_hz = self.cutoff_hz.unwrap_or(s.cutoff_hz);
-        s.decimation = self.decimation.unwrap_or(s.decimation);
-        s.min_speed = self.min_speed.unwrap_or(s.min_speed);
-        if let Some(t) = self.trim_s {
-            s.trim = (t / period_s).round() as usize;
-        }
-        Ok(s)
+        })
     }
 }
 use crate::cli::common::progress;
@@ -165,26 +157,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let bar = progress::bar(1, "servo trace", a.common.quiet);
     let trace = virtual_trace(&p, &m, None)?;
     bar.finish_and_clear();
-    let unit = match (p.controller.drive_gain == 1.0, p.axis) {
-        (false, _) => CommandUnit::Volt,
-        (true, Axis::Rotary) => CommandUnit::NewtonMetre,
-        (true, Axis::Linear) => CommandUnit::Newton,
-    };
-    let mut manifest = Manifest::new(Kind::ServoTrace);
-    manifest.mechanism = Some(p.name.clone());
-    manifest.notes = Some(format!(
-        "virtual servo trace by rtid: {} trapezoidal move(s) from rest at 0 (targets and speeds {}), acceleration {}, dwell {} s; sampled at the control period {} s, encoders quantised",
-        m.moves.len(),
-        m.moves
-            .iter()
-            .map(|x| format!("{}@{}", x.target, x.speed))
-            .collect::<Vec<_>>()
-            .join(", "),
-        m.acceleration,
-        m.dwell_s,
-        p.controller.tc
-    ));
-    let data = Data::ServoTrace(trace.to_file(p.axis, unit));
+    let (manifest, data) = rtid::experiments::servo_trace::to_file(&p, &m, &trace);
     a.common
         .write_and_report("servo_trace", manifest, &data, |exp, plot, json| {
             report(exp, plot, json, None, &IdimArgs::default())

@@ -23,11 +23,12 @@ use crate::cli::identify::profile::{
 };
 use crate::cli::identify::resample::{add_resampling, resample_table};
 use crate::cli::ModelArgs;
+use rtid::identify::intervals::chosen::{self, held_ranges, Chosen};
 use rtid::identify::pipeline::comparison;
 use rtid::identify::result::comparison::Comparison;
 use rtid::identify::{
     identify, Bound, Config, ExperimentSpec, FidelityChoice, Identified, IdentifyResult, Method,
-    Monitor, SearchOptions, StartChoice, Warning,
+    Monitor, SearchOptions, Staging, StartChoice, Warning,
 };
 use rtid::io::experiment_file::{self, Kind};
 use rtid::io::params_file;
@@ -184,6 +185,14 @@ pub struct Args {
     /// Tload), else the --preset/--params values; `given` — at those values always.
     #[arg(long, value_enum, default_value = "estimate")]
     pub start: StartArg,
+    /// With several experiments, fit every parameter on all of them at once. By
+    /// default the fit goes by plan: each parameter first from the record that
+    /// carries the most information about it (the others held; closed-loop
+    /// simulations first, then frequency responses), then those whose information
+    /// the records share are refined jointly; the plan is printed and in the result
+    /// as `plan`.
+    #[arg(long)]
+    pub joint: bool,
     /// Profile likelihood of these fitted parameters (comma-separated; `--profile`
     /// alone: every fitted one): each is held at values walking out from the fit both
     /// ways while the others are re-fitted, giving its 95 % likelihood-ratio interval
@@ -194,26 +203,39 @@ pub struct Args {
     /// FILE-profile-NAME.svg beside --out.
     #[arg(long, value_name = "NAMES", num_args = 0..=1, default_missing_value = "")]
     pub profile: Option<String>,
-    /// Residual block bootstrap with N replicates (`--resample` alone: 20): each
-    /// replicate is the fitted model's response plus the fit's residuals resampled in
-    /// blocks, fitted again by the same search from the same start, in parallel. Its
-    /// 95 % interval (the fit less the replicates' bias, ± 1.96 of their spread) holds
-    /// where the standard errors do not — a torque curve's or an unbalance test's
-    /// rough cost — and replaces the warning that they are lower bounds. Costs N
-    /// fits. In the result as `resampling`.
+    /// Which interval: `auto` — by the cost: where it is smooth (a frequency
+    /// response), the standard errors, widened by the held parameters' ranges;
+    /// where it is rough (a torque curve, an unbalance test, a servo trace: the
+    /// search stops in the quantised encoders' local minima) or the nonlinear
+    /// corrections did not converge, the residual block bootstrap, whose intervals
+    /// hold there (docs/validation.md); `standard-errors` — the Jacobian's only
+    /// (lower bounds on a rough cost: fast); `bootstrap` — whatever the cost.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub intervals: IntervalsArg,
+    /// The bootstrap's replicates [default: 16] (`--resample` alone: 20), and the
+    /// bootstrap whatever the cost: each replicate is the fitted model's response
+    /// plus the fit's residuals resampled in blocks (an unbalance test's few steps:
+    /// normal errors), each held parameter drawn within its range, fitted again from
+    /// the fit by the fit's solver, side by side in the kernel's lanes. Its 95 %
+    /// interval (the fit less the replicates' bias, ± 1.96 of their spread; with
+    /// held ranges around the replicates' mean) holds where the standard errors do
+    /// not and replaces the warning that they are lower bounds. In the result as
+    /// `resampling`.
     #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "20",
           value_parser = clap::value_parser!(u64).range(5..=10_000))]
     pub resample: Option<u64>,
     /// A parameter the fit holds at an assumed value, with its uncertainty as a
     /// relative half-range (e.g. --uncertain Kw=10% for a stiffness from a
-    /// catalogue, --uncertain theta_bg=50% for a backlash nobody measured);
-    /// repeatable. After the fit, the fit is repeated with the held parameter at
-    /// each end of its range (from the fit's values, the same search): how the
-    /// fitted parameters follow it is printed, with each one's interval widened by
-    /// it, and written in the result as `held`; `rtid predict` then draws the held
-    /// parameter within its range and moves the fitted ones with it. On a rough cost
-    /// (torque curve, unbalance test, servo trace) it needs --resample: each
-    /// replicate draws the held parameters within their ranges.
+    /// catalogue, --uncertain theta_bg=50% for a backlash nobody measured; 0% holds
+    /// it exactly); repeatable. By default every held parameter with a range in the
+    /// parameter set (a preset's uncertain or assumed values: `rtid params`) is
+    /// carried; this replaces or adds one. On a smooth cost the fit is repeated with
+    /// each held parameter at each end of its range (from the fit's values, the same
+    /// search): how the fitted parameters follow it is printed, with each one's
+    /// interval widened by it, and written in the result as `held`; `rtid predict`
+    /// then draws the held parameter within its range and moves the fitted ones with
+    /// it. With the bootstrap (a rough cost) each replicate draws the held
+    /// parameters within their ranges.
     #[arg(long, value_name = "NAME=X%")]
     pub uncertain: Vec<String>,
     /// Print the result as JSON.
@@ -251,6 +273,27 @@ impl From<MethodArg> for Method {
             MethodArg::Lm => Method::Lm,
             MethodArg::NelderMead => Method::NelderMead,
             MethodArg::Pso => Method::Pso,
+        }
+    }
+}
+
+/// Which interval (`--intervals`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum IntervalsArg {
+    /// By the cost: standard errors where smooth, the bootstrap where rough.
+    Auto,
+    /// The Jacobian's standard errors only.
+    StandardErrors,
+    /// The residual block bootstrap.
+    Bootstrap,
+}
+
+impl From<IntervalsArg> for chosen::Choice {
+    fn from(i: IntervalsArg) -> chosen::Choice {
+        match i {
+            IntervalsArg::Auto => chosen::Choice::Auto,
+            IntervalsArg::StandardErrors => chosen::Choice::StandardErrors,
+            IntervalsArg::Bootstrap => chosen::Choice::Bootstrap,
         }
     }
 }
@@ -369,6 +412,11 @@ impl Args {
             checkpoint: self.checkpoint.clone(),
             resume: self.resume,
             start: self.start.into(),
+            staging: if self.joint {
+                Staging::Joint
+            } else {
+                Staging::ByRecord
+            },
         })
     }
 
@@ -490,15 +538,8 @@ fn usable(all: &[ObjectiveKind], spec: &ExperimentSpec) -> anyhow::Result<Vec<Ob
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let config = a.config()?;
-    let held = uncertain::parse(&a.uncertain, &config.base, &|n| {
-        config.fit.iter().any(|f| f == n)
-    })?;
-    if !held.is_empty()
-        && a.resample.is_none()
-        && rtid::identify::plan::Plan::new(&config)?.declared.rough
-    {
-        bail!("--uncertain on a closed-loop simulation's rough cost (torque curve, unbalance test, servo trace) needs --resample N: there a fit's linear response to a held parameter is not what its search does (on the worm gear's torque curve and unbalance test, 6 times too small), so each replicate draws the held parameters and is fitted again");
-    }
+    let fitted = rtid::identify::plan::Plan::new(&config)?.fit;
+    let held = held_ranges(&config.base, &fitted, &uncertain::parse(&a.uncertain)?)?;
     let provenance = Provenance::of_this_run(&a.inputs(&config.experiments))
         .context("hashing the input files")?;
     let monitor = Arc::new(Monitor::default());
@@ -516,27 +557,23 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         objective,
         settings,
         smoothness,
+        ..
     } = outcome?;
     if let Some(names) = &a.profile {
         let fit = (objective.as_ref(), settings, smoothness);
         add_profiles(names, &mut result, &params, fit, &monitor, a.quiet)?;
     }
-    if let Some((name, ..)) = held.iter().find(|h| result.parameters.contains_key(&h.0)) {
-        bail!("--uncertain {name}: {name} is fitted; its uncertainty is the fit's");
-    }
-    if let Some(n) = a.resample {
-        let fit = (objective.as_ref(), settings);
-        add_resampling(
-            n as usize,
-            &held,
-            &mut result,
-            &params,
-            fit,
-            &monitor,
-            a.quiet,
-        )?;
-    } else if !held.is_empty() {
-        add_held(&held, &mut result, &params, (objective.as_ref(), settings))?;
+    let replicates = a.resample.map(|n| n as usize);
+    match chosen::decide(&result, smoothness, a.intervals.into(), replicates) {
+        _ if result.interrupted => {}
+        Chosen::Bootstrap(n) => {
+            let fit = (objective.as_ref(), settings);
+            add_resampling(n, &held, &mut result, &params, fit, &monitor, a.quiet)?;
+        }
+        Chosen::StandardErrors if !held.is_empty() && !chosen::rough(&result, smoothness) => {
+            add_held(&held, &mut result, &params, (objective.as_ref(), settings))?;
+        }
+        Chosen::StandardErrors => {}
     }
     result.provenance = Some(provenance);
     if a.out.is_some() || a.json {
@@ -631,6 +668,9 @@ fn print_summary(r: &IdentifyResult) {
         let names: Vec<&str> = e.values.keys().map(String::as_str).collect();
         println!("start of {}: {}", names.join(", "), e.method);
     }
+    if let Some(p) = &r.plan {
+        print_plan(p);
+    }
     println!("{}", parameter_table(r));
     if let Some(t) = profile_table(r) {
         println!("{t}");
@@ -671,7 +711,68 @@ fn print_summary(r: &IdentifyResult) {
     }
 }
 
-/// Parameter, start, identified ± standard error, bounds.
+/// The plan by record: each stage's record and parameters, each parameter's share of
+/// information by record, what was refined jointly and what is not determined.
+fn print_plan(p: &rtid::identify::result::record_plan::RecordPlan) {
+    println!("plan: each parameter from the record that carries the most information about it, the others held; then refined jointly where the records share it");
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    let records: Vec<String> = p
+        .shares
+        .first()
+        .map(|(_, s)| s.iter().map(|(r, _)| r.clone()).collect())
+        .unwrap_or_default();
+    let mut header = vec!["parameter".to_string(), "determined by".into()];
+    header.extend(
+        records
+            .iter()
+            .map(|r| format!("information share: {}", short(r))),
+    );
+    t.set_header(header);
+    for (name, shares) in &p.shares {
+        let by = p
+            .stages
+            .iter()
+            .position(|s| s.parameters.contains(name))
+            .map_or_else(String::new, |k| {
+                format!("stage {} ({})", k + 1, short(&p.stages[k].record))
+            });
+        let by = match (p.undetermined.contains(name), p.refined.contains(name)) {
+            (true, _) => "not determined".to_string(),
+            (false, true) if by.is_empty() => "the joint refinement".into(),
+            (false, true) => format!("{by}, refined jointly"),
+            (false, false) => by,
+        };
+        let mut row = vec![name.clone(), by];
+        row.extend(shares.iter().map(|(_, s)| format!("{:.1} %", 100.0 * s)));
+        t.add_row(row);
+    }
+    println!("{t}");
+    for (k, s) in p.stages.iter().enumerate() {
+        println!(
+            "stage {}: {} — {} ({} evaluations, {:.1} s, {})",
+            k + 1,
+            s.record,
+            s.parameters.join(", "),
+            s.evaluations,
+            s.wall_time_s,
+            s.termination
+        );
+    }
+    if let Some(r) = &p.refinement {
+        println!("refined jointly: {} ({r})", p.refined.join(", "));
+    }
+}
+
+/// A record's file name without its folder.
+fn short(path: &str) -> String {
+    Path::new(path)
+        .file_name()
+        .map_or(path.to_string(), |f| f.to_string_lossy().into_owned())
+}
+
+/// Parameter, start, identified, the 95 % interval that holds and what it is
+/// made of, the standard error (marked where it is a lower bound), bounds.
 fn parameter_table(r: &IdentifyResult) -> Table {
     let mut t = Table::new();
     t.load_preset(UTF8_FULL_CONDENSED);
@@ -679,22 +780,71 @@ fn parameter_table(r: &IdentifyResult) -> Table {
         "parameter",
         "start",
         "identified",
-        "± standard error",
+        "95 % interval",
+        "from",
+        "standard error",
         "bounds",
     ]);
+    let lower_bounds = r.uncertainty.as_ref().is_some_and(|u| u.lower_bounds);
     for (name, v) in &r.parameters {
         let b = r.bounds[name];
+        let (interval, from) = interval_of(r, name, *v);
         t.add_row([
             name.clone(),
             format!("{:.5e}", r.initial[name]),
             format!("{v:.5e}"),
+            interval,
+            from,
             r.standard_error(name).map_or("—".into(), |s| {
-                format!("{s:.2e} ({:.2} %)", 100.0 * s / v.abs())
+                let note = if lower_bounds { ", a lower bound" } else { "" };
+                format!("{s:.2e} ({:.2} %{note})", 100.0 * s / v.abs())
             }),
             format!("{:.3e}..{:.3e}", b[0], b[1]),
         ]);
     }
     t
+}
+
+/// The 95 % interval of `name` (identified `v`) that holds, and what it comes from:
+/// the bootstrap's, the standard error widened by the held ranges' shifts, or the
+/// standard error alone where it is not a lower bound.
+fn interval_of(r: &IdentifyResult, name: &str, v: f64) -> (String, String) {
+    let cell = |lo: f64, hi: f64| {
+        let rel = |x: f64| 100.0 * (x - v) / v.abs();
+        format!("{lo:.4e} … {hi:.4e} ({:+.2} / {:+.2} %)", rel(lo), rel(hi))
+    };
+    let undetermined = r
+        .plan
+        .as_ref()
+        .is_some_and(|p| p.undetermined.iter().any(|n| n == name));
+    if undetermined {
+        return ("not determined".into(), "no record determines it".into());
+    }
+    if let Some(i) = r.resampling.as_ref().and_then(|s| s.intervals.get(name)) {
+        let n = r.resampling.as_ref().map_or(0, |s| s.fitted);
+        return (cell(i.lower, i.upper), format!("bootstrap, {n} replicates"));
+    }
+    let se = r.standard_error(name);
+    let lower_bounds = r.uncertainty.as_ref().is_some_and(|u| u.lower_bounds);
+    match se {
+        None => ("not determined".into(), "no standard error".into()),
+        Some(_) if lower_bounds => (
+            "—".into(),
+            "the standard error is a lower bound here: --intervals bootstrap".into(),
+        ),
+        Some(se) if !r.held.is_empty() => {
+            let held: f64 = r.held.iter().map(|h| h.spread(name).powi(2)).sum();
+            let s = (se * se + held).sqrt();
+            (
+                cell(v - 1.96 * s, v + 1.96 * s),
+                "standard error and held ranges".into(),
+            )
+        }
+        Some(se) => (
+            cell(v - 1.96 * se, v + 1.96 * se),
+            "±1.96 standard errors".into(),
+        ),
+    }
 }
 
 /// The correlation matrix.

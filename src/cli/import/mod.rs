@@ -11,11 +11,13 @@ use rtid::io::formats::detect::{self, Format};
 use rtid::io::import::kinds::ImportKind;
 use rtid::io::import::{self, mapping, Source};
 
+mod drive;
 mod list;
 
 pub const LONG_ABOUT: &str = "\
 Reads the files labs export — MATLAB MAT-files (v5/v7), Beckhoff TwinCAT Scope View CSV, \
-Maxon EPOS Studio data-recorder CSV, UFF datasets 58/58b, delimited text with a header — \
+Maxon EPOS Studio data-recorder CSV, UFF datasets 58/58b, SINUMERIK/SINAMICS \
+measuring-function XML, delimited text with a header — \
 as they are, and writes rtid experiment files (manifest + CSV in SI units) from them \
 (docs/import.md).
 
@@ -56,6 +58,13 @@ per file, the maps applied to each file alike; one file whose speed steps throug
 plateaus gives one run per plateau
 --condition NAME=VALUE sets a manifest condition (docs/experiment-files.md), e.g. \
 drive_gain=35.15, loop_period_s=0.001.
+
+A drive's own measurement (SINUMERIK/SINAMICS measuring-function XML) says what it \
+measured: `rtid import freq_trace.XML --out DIR` writes the closed speed loop's response \
+(actual over setpoint speed, response \"speed_loop\") from the drive's stored spectra as \
+DIR/speed_loop.json and, as a check, recomputed from its time series with rtid's periodic \
+estimator as DIR/speed_loop_time_series.json (--name NAME for another stem); no --kind, \
+no --map.
 
 Nothing is smoothed silently: a sample more than 10 robust deviations from its \
 neighbours is reported with file, line and value (and kept), a gap in the time base \
@@ -117,8 +126,9 @@ pub struct Args {
     /// e.g. servo_trace).
     #[arg(long, value_name = "NAME")]
     pub name: Option<String>,
-    /// The folder to write the manifest and its CSV into.
-    #[arg(long, value_name = "DIR", requires = "kind")]
+    /// The folder to write the manifest and its CSV into (without --kind: a drive's
+    /// own measurement, which says what it measured).
+    #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Print JSON instead of tables.
     #[arg(long)]
@@ -147,8 +157,11 @@ fn parse_kind(s: &str) -> Result<ImportKind, String> {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let sources = read_all(&a.files, a.format)?;
-    if a.list || a.kind.is_none() {
+    if a.list || (a.kind.is_none() && a.out.is_none()) {
         return list::list(&sources, a.filter.as_deref(), a.json);
+    }
+    if a.kind.is_none() {
+        return drive_measurement(&a, &sources);
     }
     let request = request(&a)?;
     let imported = import::build(&sources, &request)?;
@@ -165,6 +178,37 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     experiment_file::write(&manifest_path, &imported.manifest, &imported.data)?;
     report(&manifest_path, &imported, a.json, a.quiet)
+}
+
+/// `--out` without `--kind`: the one file a drive's own measurement.
+fn drive_measurement(a: &Args, sources: &[Source]) -> anyhow::Result<()> {
+    let [source] = sources else {
+        bail!("--out without --kind writes one drive measurement at a time: give one file");
+    };
+    if !import::drive_measurement::is_drive_measurement(source) {
+        bail!(
+            "{} is a {} recording, whose channels must be mapped: give --kind and --map \
+             (rtid import FILE --list shows them); only a drive's own measurement \
+             (sinumerik-trace) says what it measured",
+            source.path.display(),
+            source.recording.format
+        );
+    }
+    if !a.map.is_empty() {
+        bail!("--map needs --kind: a drive's own measurement is imported without maps");
+    }
+    let out = a.out.as_deref().context("--out DIR")?;
+    drive::write(
+        source,
+        out,
+        a.name.as_deref(),
+        (
+            &conditions(&a.condition)?,
+            &a.condition,
+            a.mechanism.clone(),
+        ),
+        (a.json, a.quiet),
+    )
 }
 
 /// Every file read.
@@ -218,7 +262,7 @@ fn conditions(given: &[String]) -> anyhow::Result<Conditions> {
     serde_json::from_value(Value::Object(map)).context("--condition: a value of the wrong type")
 }
 
-fn refuse_overwriting_inputs(manifest: &Path, inputs: &[PathBuf]) -> anyhow::Result<()> {
+pub(super) fn refuse_overwriting_inputs(manifest: &Path, inputs: &[PathBuf]) -> anyhow::Result<()> {
     let csv = manifest.with_extension("csv");
     for input in inputs {
         let same = |p: &Path| match (p.canonicalize(), input.canonicalize()) {

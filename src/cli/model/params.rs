@@ -9,9 +9,13 @@ use rtid::io::params_file;
 use rtid::model::PARAMS;
 
 pub const LONG_ABOUT: &str = "\
-Lists every parameter of a mechanism with its value, SI unit and meaning, and the notes on \
-where uncertain values come from. With --out, writes the set (after --set overrides) as a \
-parameter file that every command accepts with --params.
+Lists every parameter of a mechanism with its value, SI unit and meaning, the notes on \
+where uncertain values come from, and the held range of each value that is uncertain or \
+assumed (value·(1 ± X %), with its reason: a parameter file's `ranges`). Where such a \
+parameter is held — not fitted — `rtid identify` and `rtid predict` carry its range into \
+their intervals by default (`--uncertain NAME=X%` gives another, `--uncertain NAME=0%` \
+holds it exactly). With --out, writes the set (after --set overrides) as a parameter file \
+that every command accepts with --params.
 
 Examples:
   rtid params --preset worm-gear
@@ -48,16 +52,25 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let mut t = Table::new();
     t.load_preset(UTF8_FULL_CONDENSED);
-    t.set_header(["name", "value", "unit", "meaning", "note"]);
+    t.set_header(["name", "value", "unit", "meaning", "held range", "note"]);
     for s in PARAMS {
         let Some(v) = s.get(&p) else { continue };
         let note = p.notes.get(s.name).map(String::as_str).unwrap_or("");
-        t.add_row([s.name, &format!("{v:.6e}"), s.unit, s.meaning, note]);
+        let range = p.ranges.get(s.name).map_or(String::new(), |r| {
+            format!("±{} %", rtid::names::Num(r.percent))
+        });
+        t.add_row([s.name, &format!("{v:.6e}"), s.unit, s.meaning, &range, note]);
     }
     println!(
         "{} ({} topology, {} loop)",
         p.name, p.topology, p.controller.loop_mode
     );
     println!("{t}");
+    if !p.ranges.is_empty() {
+        println!("held ranges (carried into identify's and predict's intervals where the parameter is held):");
+        for (name, r) in &p.ranges {
+            println!("  {name} ±{} %: {}", rtid::names::Num(r.percent), r.reason);
+        }
+    }
     Ok(())
 }

@@ -12,6 +12,7 @@ use crate::cli::ModelArgs;
 use rtid::input::{Move, Samples};
 use rtid::input_spec::InputSpec;
 use rtid::io::{atomic, torque_file};
+use rtid::limits::{MAX_ROWS, MAX_STEPS};
 use rtid::model::{idx::*, NSTATE};
 use rtid::recorder::Recorder;
 use rtid::sim::{Simulation, STATE_NAMES};
@@ -111,12 +112,6 @@ impl<W: Write> Recorder for CsvRecorder<W> {
         self.bar.set_position((t * 1e3) as u64);
     }
 }
-
-/// Integration steps of one run (10⁴ s simulated at the worm preset's 1e-5 s step).
-const MAX_STEPS: f64 = 1e9;
-
-/// Rows of the output CSV (≈ 3 GB).
-const MAX_ROWS: f64 = 2e7;
 
 impl Args {
     /// The numeric options, checked before anything runs.

@@ -116,6 +116,54 @@ impl IdimSettings {
     }
 }
 
+/// What a caller changes of [`IdimSettings::for_sample_period`] (`rtid evaluate
+/// --cutoff-hz …`, `rtid.evaluate(cutoff_hz=…)`): `None` keeps the default.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IdimOverrides {
+    pub cutoff_hz: Option<f64>,
+    pub decimation: Option<usize>,
+    /// Seconds dropped at each end (rounded to samples).
+    pub trim_s: Option<f64>,
+    pub min_speed: Option<f64>,
+}
+
+/// An override that is not a setting.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum IdimOverrideError {
+    /// A cut-off, trim or speed threshold that is negative or not finite; `name` is
+    /// the field's (`cutoff_hz`, `trim_s`, `min_speed`).
+    #[error("{name} {value}: must be a finite number ≥ 0")]
+    Negative { name: &'static str, value: f64 },
+    #[error("decimation 0: must be at least 1 (1: no decimation)")]
+    Decimation,
+}
+
+impl IdimOverrides {
+    /// The settings for a record sampled every `period_s`, these overrides applied.
+    pub fn settings(&self, period_s: f64) -> Result<IdimSettings, IdimOverrideError> {
+        for (name, value) in [
+            ("cutoff_hz", self.cutoff_hz),
+            ("trim_s", self.trim_s),
+            ("min_speed", self.min_speed),
+        ] {
+            if let Some(v) = value.filter(|v| !v.is_finite() || *v < 0.0) {
+                return Err(IdimOverrideError::Negative { name, value: v });
+            }
+        }
+        if self.decimation == Some(0) {
+            return Err(IdimOverrideError::Decimation);
+        }
+        let mut s = IdimSettings::for_sample_period(period_s);
+        s.cutoff_hz = self.cutoff_hz.unwrap_or(s.cutoff_hz);
+        s.decimation = self.decimation.unwrap_or(s.decimation);
+        s.min_speed = self.min_speed.unwrap_or(s.min_speed);
+        if let Some(t) = self.trim_s {
+            s.trim = (t / period_s).round() as usize;
+        }
+        Ok(s)
+    }
+}
+
 /// One estimated parameter.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Estimate {

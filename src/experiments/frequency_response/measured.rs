@@ -173,6 +173,13 @@ pub fn fits_whole_curve(exp: &Experiment) -> bool {
         && (has_phase(exp) || form(exp).response != Response::TableOverMotor)
 }
 
+/// Whether a frequency response is of the mechanics (table over motor, the motor's
+/// compliance), which the gain-curve objectives compare, rather than a drive's closed
+/// speed loop (`objectives::speed_loop`).
+pub fn of_the_mechanics(exp: &Experiment) -> bool {
+    form(exp).response != Response::SpeedLoop
+}
+
 /// Whether a frequency-response file has a phase column.
 pub fn has_phase(exp: &Experiment) -> bool {
     matches!(

@@ -180,7 +180,9 @@ pub fn linear(p: &Params, freqs_hz: &[f64]) -> Result<Vec<(f64, f64)>, crate::mo
     linear_of(p, Response::TableOverMotor, freqs_hz)
 }
 
-/// The gain (dB) and phase (deg) of the linearised model's `response` at `freqs_hz`.
+/// The gain (dB) and phase (deg) of the linearised model's `response` at `freqs_hz`
+/// (none of a speed loop, which is the controller's closed loop and not the
+/// mechanics': `tuning::speed_loop` computes it).
 pub fn linear_of(
     p: &Params,
     response: Response,
@@ -190,6 +192,7 @@ pub fn linear_of(
     let channel = match response {
         Response::TableOverMotor => Channel::TableOverMotor,
         Response::MotorCompliance => Channel::MotorOverTorque,
+        Response::SpeedLoop => return Ok(vec![(f64::NAN, f64::NAN); freqs_hz.len()]),
     };
     Ok(LinearResponse::new(p, channel)?.gain_phase(freqs_hz))
 }

@@ -6,8 +6,10 @@
 //! - [`steady`]: the model's map, the torque its steady state needs at each speed;
 //! - [`run`]: the virtual experiment, the servo holding each speed in turn;
 //! - [`evaluate`]: a map's fitted laws (estimation/friction_law) and which the data
-//!   support.
+//!   support;
+//! - [`compensation`]: the friction compensation a map (or a model's) determines.
 
+pub mod compensation;
 pub mod evaluate;
 pub mod run;
 pub mod steady;

@@ -11,7 +11,7 @@
 use rayon::prelude::*;
 
 use crate::experiments::measurement_noise::perturb_by_rms;
-use crate::io::experiment_file::FrictionMap;
+use crate::io::experiment_file::{FrictionMap, Kind, Manifest};
 use crate::model::idx::OMEGA_M;
 use crate::model::{Params, NSTATE};
 use crate::recorder::{NullRecorder, Recorder};
@@ -92,6 +92,44 @@ impl Recorder for Samples {
         }
         self.count += 1;
     }
+}
+
+/// The virtual map as `rtid experiment friction-map` writes it: [`run`], each run's
+/// mean effort scattered by `scatter_percent` (Gaussian, relative: what a real map
+/// shows from run to run beyond the recorder's noise; seed `test.seed` + the runs),
+/// and its manifest.
+pub fn record(
+    p: &Params,
+    test: &MapTest,
+    scatter_percent: f64,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<(Manifest, FrictionMap), SimError> {
+    let mut map = run(p, test, progress)?;
+    crate::experiments::measurement_noise::perturb_relative(
+        &mut map.effort,
+        scatter_percent,
+        test.seed.wrapping_add(test.speeds.len() as u64),
+    );
+    let mut m = Manifest::new(Kind::FrictionMap);
+    m.mechanism = Some(p.name.clone());
+    let mut notes = format!(
+        "virtual friction map: the servo ({}) at {} constant motor speeds from rest, settled {} s, averaged over {} s or whole shaft revolutions",
+        p.controller.loop_mode,
+        test.speeds.len(),
+        test.settle,
+        test.average
+    );
+    if test.noise_percent > 0.0 {
+        notes += &format!(
+            "; {} % (of each run's RMS) Gaussian noise on the torque samples (seed {})",
+            test.noise_percent, test.seed
+        );
+    }
+    if scatter_percent > 0.0 {
+        notes += &format!("; each run's mean torque scattered by {scatter_percent} % (Gaussian)");
+    }
+    m.notes = Some(notes);
+    Ok((m, map))
 }
 
 /// Runs the map: one row per speed, in the order of `test.speeds` (the writer sorts

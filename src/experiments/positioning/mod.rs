@@ -436,6 +436,36 @@ pub fn manifest(params: &Params, test: &PositioningTest) -> Manifest {
     m
 }
 
+/// Most targets a positioning test takes: beyond, a step in the wrong unit.
+pub const MAX_TARGETS: f64 = 1000.0;
+
+/// A target spacing that makes more than [`MAX_TARGETS`] targets.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("over 1000 targets")]
+pub struct TooManyTargets;
+
+/// A rotary table's targets, rad: every `step_deg` from 0° to 360° (`rtid experiment
+/// positioning --target-step-deg`).
+pub fn rotary_targets(step_deg: f64) -> Result<Vec<f64>, TooManyTargets> {
+    if 360.0 / step_deg > MAX_TARGETS {
+        return Err(TooManyTargets);
+    }
+    let count = (360.0 / step_deg).floor() as usize;
+    Ok((0..=count)
+        .map(|i| (step_deg * i as f64).to_radians())
+        .collect())
+}
+
+/// A linear axis's targets, m: every `step_mm` from 0 to `travel_mm` (`--target-step-mm`,
+/// `--travel-mm`).
+pub fn linear_targets(step_mm: f64, travel_mm: f64) -> Result<Vec<f64>, TooManyTargets> {
+    if travel_mm / step_mm > MAX_TARGETS {
+        return Err(TooManyTargets);
+    }
+    let count = (travel_mm / step_mm + 1e-9).floor() as usize;
+    Ok((0..=count).map(|i| step_mm * i as f64 * 1e-3).collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

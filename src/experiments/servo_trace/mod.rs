@@ -32,7 +32,7 @@ mod virtual_trace;
 
 pub use evaluate::{evaluate, EvaluateError, TraceEvaluation};
 pub use replay::{replay, replay_batch, simulation_error, Misfit, Replay};
-pub use virtual_trace::{virtual_trace, MoveTo, TrapezoidalMoves};
+pub use virtual_trace::{command_unit, to_file, virtual_trace, MoveTo, TrapezoidalMoves};
 
 use crate::estimation::inverse_dynamics::{self, IdimError, IdimFit, IdimSettings};
 use crate::io::experiment_file::{self as file, check_uniform, sample_period, NonUniform};

@@ -4,6 +4,7 @@
 
 use super::replay::{run_servo, Start};
 use super::{ServoTrace, TraceError};
+use crate::io::experiment_file::{Axis, CommandUnit, Data, Kind, Manifest};
 use crate::model::params::Params;
 
 /// One point-to-point move of a [`TrapezoidalMoves`] reference.
@@ -170,6 +171,40 @@ pub fn virtual_trace(
         controller_added: added,
         drive_functions: None,
     })
+}
+
+/// The unit a drive's controller output is recorded in: volts where a drive gain
+/// stands between it and the effort, else the effort's own (N·m, or N on a linear
+/// axis).
+pub fn command_unit(params: &Params) -> CommandUnit {
+    match (params.controller.drive_gain == 1.0, params.axis) {
+        (false, _) => CommandUnit::Volt,
+        (true, Axis::Rotary) => CommandUnit::NewtonMetre,
+        (true, Axis::Linear) => CommandUnit::Newton,
+    }
+}
+
+/// A virtual trace of `params` along `moves` as an experiment file holds it (the
+/// manifest with the moves in its notes, the data in the axis's units), as
+/// `rtid experiment servo-trace` writes it.
+pub fn to_file(params: &Params, moves: &TrapezoidalMoves, trace: &ServoTrace) -> (Manifest, Data) {
+    let mut manifest = Manifest::new(Kind::ServoTrace);
+    manifest.mechanism = Some(params.name.clone());
+    manifest.notes = Some(format!(
+        "virtual servo trace by rtid: {} trapezoidal move(s) from rest at 0 (targets and speeds {}), acceleration {}, dwell {} s; sampled at the control period {} s, encoders quantised",
+        moves.moves.len(),
+        moves
+            .moves
+            .iter()
+            .map(|x| format!("{}@{}", x.target, x.speed))
+            .collect::<Vec<_>>()
+            .join(", "),
+        moves.acceleration,
+        moves.dwell_s,
+        params.controller.tc
+    ));
+    let data = Data::ServoTrace(trace.to_file(params.axis, command_unit(params)));
+    (manifest, data)
 }
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 //! the residual block bootstrap ([`resample`]), and the fit's response to the held
 //! parameters' ranges ([`held`]).
 
+pub mod chosen;
 pub mod held;
 pub mod profile;
 pub mod request;

@@ -78,7 +78,7 @@ pub(crate) fn from_solver_jacobian(
 
 /// σ² = Σr²/(m − n) of `m` residuals `r0` after fitting `n` parameters (NaN: unknown,
 /// no more residuals than parameters).
-fn residual_variance(r0: &[f64], m: usize, n: usize) -> f64 {
+pub(crate) fn residual_variance(r0: &[f64], m: usize, n: usize) -> f64 {
     if m > n {
         r0.iter().map(|r| r * r).sum::<f64>() / (m - n) as f64
     } else {
@@ -121,6 +121,7 @@ pub(crate) fn from_jacobian(
             correlation: zero_undefined(correlation),
             residual_variance: if sigma2.is_finite() { sigma2 } else { 0.0 },
             conditioning: shape.conditioning,
+            lower_bounds: false,
         },
         warnings,
     }

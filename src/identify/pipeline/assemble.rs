@@ -76,6 +76,7 @@ pub fn assemble(
         interrupted: run.interrupted,
         starts: run.starts,
         uncertainty: assessment.uncertainty,
+        plan: None,
         nonlinear_check: assessment.nonlinear_check,
         warnings: warnings.into_iter().map(Coded).collect(),
         profiles: None,

@@ -66,11 +66,9 @@ pub fn assess(
         };
         warnings.extend(a.warnings);
         let mut a_uncertainty = a.uncertainty;
-        warnings.extend(unconverged_corrections(
-            &ran.starts,
-            &best.values,
-            &mut a_uncertainty,
-        ));
+        let unconverged = unconverged_corrections(&ran.starts, &best.values, &mut a_uncertainty);
+        a_uncertainty.lower_bounds = plan.declared.rough || unconverged.is_some();
+        warnings.extend(unconverged);
         if plan.declared.rough {
             warnings.push(Warning::RoughCost);
         }
@@ -195,7 +193,11 @@ fn search_warnings(
 }
 
 /// Each part's residuals at the result, with their details in the measurement's units.
-fn residual_report(joint: &Joint, p: &Params, parts: Vec<Vec<f64>>) -> Vec<ExperimentResidual> {
+pub(crate) fn residual_report(
+    joint: &Joint,
+    p: &Params,
+    parts: Vec<Vec<f64>>,
+) -> Vec<ExperimentResidual> {
     joint
         .parts
         .iter()

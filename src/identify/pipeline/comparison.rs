@@ -7,6 +7,7 @@ use crate::identify::result::comparison::{Comparison, Curve, Role};
 
 mod frequency_response;
 mod grid;
+mod speed_loop;
 
 use crate::experiments::fluctuation::{self, FluctuationTest};
 use crate::experiments::servo_trace::{self, ServoTrace, TraceError};
@@ -63,6 +64,11 @@ pub fn compare(
     fitted: &Params,
 ) -> Result<Vec<Comparison>, ComparisonError> {
     Ok(match &exp.data {
+        Data::FrequencyResponse { .. }
+            if crate::tuning::speed_loop::measured::is_speed_loop(exp) =>
+        {
+            speed_loop::compare(source, exp, start, fitted)
+        }
         Data::FrequencyResponse { .. } => frequency_response::compare(source, exp, start, fitted),
         Data::TorqueCurve {
             time_s,

@@ -4,6 +4,7 @@
 pub mod comparison;
 pub mod held;
 pub mod profile;
+pub mod record_plan;
 pub mod resampling;
 pub mod starts;
 pub mod termination;
@@ -18,6 +19,7 @@ use crate::objectives::Detail;
 use comparison::Comparison;
 use held::Held;
 use profile::Profile;
+use record_plan::RecordPlan;
 use resampling::Resampling;
 use starts::{StartEstimate, StartRecord};
 use termination::Termination;
@@ -104,6 +106,10 @@ pub struct IdentifyResult {
     pub interrupted: bool,
     pub starts: Vec<StartRecord>,
     pub uncertainty: Option<Uncertainty>,
+    /// With several records: which record determined which parameter, and what was
+    /// refined jointly ([`crate::identify::by_record`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plan: Option<RecordPlan>,
     /// With `--model auto`: the resonances of the nonlinear virtual test at the linear
     /// search's result — the check that decides whether the nonlinear fit follows.
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -14,4 +14,10 @@ pub struct Uncertainty {
     pub residual_variance: f64,
     /// Smallest / largest singular value of the column-scaled Jacobian.
     pub conditioning: f64,
+    /// Whether the standard errors are known lower bounds: the cost is rough (a
+    /// closed-loop simulation, where the search stops in local minima) or the
+    /// nonlinear corrections did not converge. They are then not the interval to
+    /// read: the bootstrap's is (docs/identification.md).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub lower_bounds: bool,
 }

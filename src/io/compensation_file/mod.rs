@@ -177,13 +177,22 @@ pub fn axis_name(axis: Axis) -> &'static str {
     }
 }
 
+/// What a compensation built from a model rests on, in the file's `source`.
+pub const MODEL_SOURCE: &str =
+    "the virtual positioning test (ISO 230-2 standard cycle) of the identified model";
+
 /// Reads and checks a compensation file.
 pub fn read(path: &Path) -> Result<CompensationFile, CompensationFileError> {
     let text = super::read_input(path).map_err(|source| CompensationFileError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    let form: FileForm = serde_json::from_str(super::without_bom(&text)).map_err(|source| {
+    parse(&text, path)
+}
+
+/// Checks a compensation file's text (`path` names it in errors).
+pub fn parse(text: &str, path: &Path) -> Result<CompensationFile, CompensationFileError> {
+    let form: FileForm = serde_json::from_str(super::without_bom(text)).map_err(|source| {
         CompensationFileError::Json {
             path: path.to_path_buf(),
             source,
@@ -192,14 +201,19 @@ pub fn read(path: &Path) -> Result<CompensationFile, CompensationFileError> {
     from_form(form, path)
 }
 
+/// The file's text, as [`write`] writes it.
+pub fn to_text(file: &CompensationFile) -> Result<String, super::json::JsonError> {
+    Ok(format!("{}\n", super::json::pretty(&to_form(file))?))
+}
+
 /// Writes `file` at `path` atomically.
 pub fn write(path: &Path, file: &CompensationFile) -> Result<(), CompensationFileError> {
     let io = |source| CompensationFileError::Io {
         path: path.to_path_buf(),
         source,
     };
-    let text = super::json::pretty(&to_form(file)).map_err(|e| io(std::io::Error::other(e)))?;
-    super::atomic::write(path, format!("{text}\n").as_bytes()).map_err(io)
+    let text = to_text(file).map_err(|e| io(std::io::Error::other(e)))?;
+    super::atomic::write(path, text.as_bytes()).map_err(io)
 }
 
 impl CompensationFile {

@@ -35,11 +35,17 @@ impl Excitation {
     }
 }
 
-/// A servo trace's controller functions as the drive had them, each replacing the
-/// model's where given (docs/experiment-files.md, servo trace).
+/// A servo trace's (or a speed-loop response's) controller settings as the drive had
+/// them, each replacing the model's where given (docs/experiment-files.md, servo trace).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DriveFunctions {
+    /// The speed controller's proportional gain, as the model's `Kvp`.
+    #[serde(rename = "Kvp", default, skip_serializing_if = "Option::is_none")]
+    pub kvp: Option<f64>,
+    /// The speed controller's integral gain, as the model's `Kvi`.
+    #[serde(rename = "Kvi", default, skip_serializing_if = "Option::is_none")]
+    pub kvi: Option<f64>,
     /// Velocity feed-forward, the fraction of the reference's speed.
     #[serde(rename = "Kvff", default, skip_serializing_if = "Option::is_none")]
     pub kvff: Option<f64>,
@@ -57,6 +63,12 @@ pub struct DriveFunctions {
 impl DriveFunctions {
     /// `controller` with these functions in place of its own.
     pub fn apply(&self, controller: &mut ControllerParams) {
+        if let Some(v) = self.kvp {
+            controller.kvp = v;
+        }
+        if let Some(v) = self.kvi {
+            controller.kvi = v;
+        }
         if let Some(v) = self.kvff {
             controller.kvff = v;
         }
@@ -146,12 +158,14 @@ pub struct Conditions {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub drive_gain: Option<f64>,
     /// Servo trace: the sample period of the control loop, s, where it differs from the
-    /// record's (a trace decimated for storage). Absent: the record's.
+    /// record's (a trace decimated for storage). Absent: the record's. Speed-loop
+    /// response: the speed controller's sample period (absent: the model's `Tc`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub loop_period_s: Option<f64>,
     /// Servo trace: the drive's functions as they were set when it was recorded
     /// (feed-forward, symmetrising lag, setpoint filters); a replay runs the model's
-    /// controller with them.
+    /// controller with them. Speed-loop response: the speed controller's gains `Kvp`
+    /// and `Kvi` where the measurement carries them (fitted otherwise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub controller: Option<DriveFunctions>,
     /// Frequency response or resonances: the band in which resonances are sought,
@@ -182,7 +196,7 @@ pub struct Conditions {
 
 impl Conditions {
     /// The JSON keys of the typed fields.
-    pub(super) const KEYS: [&'static str; 25] = [
+    pub const KEYS: [&'static str; 25] = [
         "torque_amplitude_nm",
         "preload_nm",
         "amplitude_deg",

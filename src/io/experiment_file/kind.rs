@@ -175,6 +175,15 @@ impl Kind {
     pub fn has_data_file(self) -> bool {
         self.definition().data_file
     }
+
+    /// Every column name rtid reads from this kind's CSV: the reader's own (each
+    /// position or angle under each unit suffix) and the optional ones its
+    /// evaluators read (docs/experiment-files.md).
+    pub fn columns(self) -> Vec<String> {
+        let mut all = (self.definition().reserved)();
+        all.extend(columns::optional(self));
+        all
+    }
 }
 
 #[cfg(test)]

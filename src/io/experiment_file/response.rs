@@ -19,6 +19,11 @@ pub enum Response {
     /// compliance the motor sees — antiresonances at the motor-held modes, resonances
     /// at the free ones; the only informative ratio of a direct drive.
     MotorCompliance,
+    /// Actual motor speed over speed setpoint with the speed loop closed
+    /// (dimensionless): the drive's own reference response of its speed loop, 1 at
+    /// low frequency — the mechanics seen through the speed controller
+    /// (`objectives::speed_loop`).
+    SpeedLoop,
 }
 
 impl Response {
@@ -27,6 +32,7 @@ impl Response {
         match self {
             Response::TableOverMotor => "table_over_motor",
             Response::MotorCompliance => "motor_compliance",
+            Response::SpeedLoop => "speed_loop",
         }
     }
 
@@ -35,6 +41,7 @@ impl Response {
         match self {
             Response::TableOverMotor => Reference::MotorAngle,
             Response::MotorCompliance => Reference::MotorTorque,
+            Response::SpeedLoop => Reference::SpeedSetpoint,
         }
     }
 
@@ -43,6 +50,7 @@ impl Response {
         match self {
             Response::TableOverMotor => Reference::TableAngle,
             Response::MotorCompliance => Reference::MotorAngle,
+            Response::SpeedLoop => Reference::MotorSpeed,
         }
     }
 }
@@ -54,6 +62,10 @@ pub enum Reference {
     MotorAngle,
     TableAngle,
     MotorTorque,
+    /// The speed loop's setpoint.
+    SpeedSetpoint,
+    /// The motor's actual speed as the drive measures it.
+    MotorSpeed,
 }
 
 impl Reference {
@@ -63,6 +75,8 @@ impl Reference {
             Reference::MotorAngle => "motor_angle",
             Reference::TableAngle => "table_angle",
             Reference::MotorTorque => "motor_torque",
+            Reference::SpeedSetpoint => "speed_setpoint",
+            Reference::MotorSpeed => "motor_speed",
         }
     }
 }
@@ -148,6 +162,11 @@ pub(super) fn check(c: &Conditions) -> Result<(), String> {
                 "`conditions.delay_s` is {d}: a delay is a time ≥ 0 s (or \"unknown\" to fit it)"
             ));
         }
+    }
+    if let Some(p) = c.loop_period_s.filter(|p| *p <= 0.0) {
+        return Err(format!(
+            "`conditions.loop_period_s` is {p}: the speed loop's sample period must be positive"
+        ));
     }
     if c.averages == Some(0) {
         return Err(

@@ -6,7 +6,10 @@ use std::io::Read;
 use std::path::Path;
 
 pub use super::format::{Definition, Format, Head};
-use super::{delimited, epos_studio, mat, twincat_scope, uff, FormatError, Location, Recording};
+use super::{
+    delimited, epos_studio, mat, sinumerik_trace, twincat_scope, uff, FormatError, Location,
+    Recording,
+};
 
 /// Every format, in the order their signatures are tried; delimited text, which
 /// takes any file, last.
@@ -15,6 +18,7 @@ pub static FORMATS: &[&Definition] = &[
     &twincat_scope::DEFINITION,
     &epos_studio::DEFINITION,
     &uff::DEFINITION,
+    &sinumerik_trace::DEFINITION,
     &delimited::DEFINITION,
 ];
 

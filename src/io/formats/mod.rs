@@ -14,6 +14,7 @@ pub mod detect;
 pub mod epos_studio;
 pub mod format;
 pub mod mat;
+pub mod sinumerik_trace;
 mod text;
 pub mod twincat_scope;
 pub mod uff;

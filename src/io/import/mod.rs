@@ -7,6 +7,7 @@
 //! stepped-speed record ([`runs`], [`plateaus`], `friction_map`).
 
 mod auto_map;
+pub mod drive_measurement;
 mod friction_map;
 pub mod glitches;
 pub mod kinds;
@@ -336,6 +337,15 @@ fn check_time_base<'p>(
         path_of(source.resolved.file).display(),
         channel.name
     )))
+}
+
+/// Whether `channel`'s abscissa is a frequency.
+fn over_frequency(channel: &Channel) -> bool {
+    let unit = match &channel.abscissa {
+        Abscissa::Uniform { unit, .. } | Abscissa::Values { unit, .. } => unit,
+        Abscissa::Index => return false,
+    };
+    units::parse(unit).is_ok_and(|u| u.quantity == Quantity::Frequency)
 }
 
 /// Where sample `index` of `channel` is: its line in a text file where each sample
@@ -675,10 +685,15 @@ fn findings(sources: &[Source], filled: &[Filled]) -> Vec<String> {
 
 /// What [`glitches`] finds in one channel of `file`: gaps if it is a time base, else
 /// its glitches; each naming the line (or the sample, in a binary file) and the value.
+/// A spectrum (a channel over frequency) is not a signal's samples: its lines are not
+/// checked.
 pub fn channel_findings(file: &std::path::Path, channel: &Channel, is_time: bool) -> Vec<String> {
     let Samples::Real(raw) = &channel.samples else {
         return Vec::new();
     };
+    if over_frequency(channel) {
+        return Vec::new();
+    }
     let place = |index: usize| format!("{}, {}", file.display(), place(channel, index));
     if is_time {
         return glitches::gaps(raw)

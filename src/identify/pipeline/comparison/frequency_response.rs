@@ -82,7 +82,8 @@ fn model_grid(f: &[f64], response: Response, start: &Params, fitted: &Params) ->
 fn channel(response: Response) -> Channel {
     match response {
         Response::TableOverMotor => Channel::TableOverMotor,
-        Response::MotorCompliance => Channel::MotorOverTorque,
+        // A speed loop is compared by `super::speed_loop`, never here.
+        Response::MotorCompliance | Response::SpeedLoop => Channel::MotorOverTorque,
     }
 }
 
@@ -101,6 +102,7 @@ fn gain_label(response: Response) -> &'static str {
     match response {
         Response::TableOverMotor => "gain θt/(θm·Rg·Rw), dB",
         Response::MotorCompliance => "compliance θm/Tm, dB re 1 rad/(N·m)",
+        Response::SpeedLoop => "closed speed loop, actual / setpoint speed, dB",
     }
 }
 

@@ -39,6 +39,15 @@ pub(super) fn text(w: &Warning) -> String {
              RMS over a span of {position_span:.4e}, SI): the fitted values do not describe this \
              drive — check the controller's settings, the loop and the frame (ratio)"
         ),
+        Warning::NotDetermined { names } => format!(
+            "{} not determined: no record moves {} apart from the other fitted parameters, nor \
+             do all of them together; held at the start value, without an interval (fix {}, \
+             or add a record that moves {})",
+            names.join(", "),
+            if names.len() == 1 { "it" } else { "them" },
+            if names.len() == 1 { "it" } else { "them" },
+            if names.len() == 1 { "it" } else { "them" },
+        ),
         Warning::NoEffect { name } => {
             format!("{name} has no effect on the residuals: the data say nothing about it")
         }

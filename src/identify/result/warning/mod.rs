@@ -112,6 +112,10 @@ pub enum Warning {
         widened: Vec<String>,
         undetermined: Vec<String>,
     },
+    /// By plan: no record determines these parameters, nor all together (their
+    /// information is nil, or a combination of the others'): held at their start
+    /// values, without an interval.
+    NotDetermined { names: Vec<String> },
     /// A profile stays below the 95 % level up to the parameter's bound on one side:
     /// the data bound it on the other side only; `family` are the other fitted
     /// parameters that moved along it (ratio of largest to smallest value).
@@ -153,6 +157,7 @@ impl Warning {
             Warning::Escalated { .. } => "escalated",
             Warning::LinearStands { .. } => "linear_stands",
             Warning::CorrectionsNotConverged { .. } => "corrections_not_converged",
+            Warning::NotDetermined { .. } => "not_determined",
             Warning::ProfileOpen { .. } => "profile_open",
             Warning::ProfileBetterFit { .. } => "profile_better_fit",
         }

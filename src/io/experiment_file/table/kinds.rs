@@ -397,6 +397,25 @@ fn reserved(plain: &[&str], positions: &[&str]) -> Vec<String> {
         .collect()
 }
 
+/// Columns a kind's reader or evaluators read when present, beside its [`reserved`]
+/// ones (docs/experiment-files.md's optional columns): a frequency response's noise
+/// per line, a positioning record's measured positions.
+pub(in crate::io::experiment_file) fn optional(kind: Kind) -> Vec<String> {
+    match kind {
+        Kind::FrequencyResponse => [
+            "gain_sigma_db",
+            "phase_sigma_deg",
+            "coherence",
+            "below_resolution",
+            "linear_gain_db",
+        ]
+        .map(String::from)
+        .to_vec(),
+        Kind::Positioning => reserved(&[], &["measured"]),
+        _ => Vec::new(),
+    }
+}
+
 /// The column names each kind's reader interprets: an extra column must not take one.
 pub(in crate::io::experiment_file) fn frequency_response() -> Vec<String> {
     reserved(&["frequency_hz", "gain_db"], &["phase"])

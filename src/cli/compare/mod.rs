@@ -6,6 +6,8 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use rtid::experiments::compare::{self, Summary, THRESHOLD_ARCSEC};
 
+mod speed_loop;
+
 pub const LONG_ABOUT: &str = "\
 Compares two rotary tables as the paper's Table 3 (§5, \"Comparison between driving \
 mechanisms\"): one column per folder of experiment files, measured or written by \
@@ -29,6 +31,11 @@ deviation θt − θm·Rg·Rw is larger than 0.72″, else \"cannot be identifie
 deviation is larger than 0.72″, else \"no influence\"
   backlash              lost motion at the table, arc-sec: |B̄| of positioning.json, else \
 the CW−CCW gap of fluctuation.json (the row says which)
+  speed loop            where a folder holds a closed speed loop's response (a \
+frequency response with response \"speed_loop\": `rtid import` of a drive's measuring \
+function, or `rtid experiment speed-loop`): its −3 dB line with the phase there, and \
+its peak below it; with --plot FILE.svg all of them on one Bode plot (a measurement as \
+markers, a model as a line), and in --json as `speed_loop` of each folder
 
 The threshold 0.72″ is two counts of the paper's table encoder (0.0001° = 0.36″): one \
 count can be quantisation of a reading, more than two is a feature of the drive.
@@ -37,7 +44,10 @@ Examples:
   rtid experiment positioning --preset worm-gear --out runs/worm
   rtid experiment positioning --preset roller-gear-cam --out runs/roller
   rtid compare runs/worm runs/roller
-  rtid compare runs/worm runs/roller --json";
+  rtid compare runs/worm runs/roller --json
+  rtid import freq_trace.XML --out measured
+  rtid experiment speed-loop --params axis.json --tune tuned.json --out tuned
+  rtid compare measured tuned --plot speed-loops.svg";
 
 /// Arguments of `rtid compare`.
 #[derive(Debug, clap::Args)]
@@ -51,6 +61,9 @@ pub struct Args {
     /// Print JSON {"DIR_A": summary, "DIR_B": summary} instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// The folders' closed speed loops on one Bode plot (SVG; never over an input).
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
     /// No progress display or notes on stderr (the command is quick: it has no
     /// progress bar; accepted like every command's `--quiet`, for scripts).
     #[arg(long)]
@@ -60,14 +73,48 @@ pub struct Args {
 pub fn run(a: Args) -> anyhow::Result<()> {
     let sa = compare::summarize(&a.a)?;
     let sb = compare::summarize(&a.b)?;
+    let loops = [
+        speed_loop::find(&sa.sources)?,
+        speed_loop::find(&sb.sources)?,
+    ];
+    if let Some(path) = &a.plot {
+        let inputs: Vec<&Path> = sa
+            .sources
+            .iter()
+            .chain(&sb.sources)
+            .map(PathBuf::as_path)
+            .collect();
+        let plot = crate::cli::common::plot::Plot::at(path.clone(), &inputs)?;
+        speed_loop::plot(
+            &plot,
+            &[(&a.a, loops[0].as_ref()), (&a.b, loops[1].as_ref())],
+        )?;
+    }
+    print(&a, &sa, &sb, &loops)
+}
+
+/// The table, or the JSON, with the speed loops' rows.
+fn print(
+    a: &Args,
+    sa: &Summary,
+    sb: &Summary,
+    loops: &[Option<speed_loop::Found>; 2],
+) -> anyhow::Result<()> {
     if a.json {
         let mut map = serde_json::Map::new();
-        map.insert(a.a.display().to_string(), rtid::io::json::value(&sa)?);
-        map.insert(a.b.display().to_string(), rtid::io::json::value(&sb)?);
+        for (dir, s, l) in [(&a.a, sa, &loops[0]), (&a.b, sb, &loops[1])] {
+            let mut v = rtid::io::json::value(s)?;
+            if let (Some(l), serde_json::Value::Object(o)) = (l, &mut v) {
+                o.insert("speed_loop".into(), rtid::io::json::value(&l.summary)?);
+            }
+            map.insert(dir.display().to_string(), v);
+        }
         println!("{}", rtid::io::json::pretty(&map)?);
     } else {
         println!("Table 3. Comparison between driving mechanisms");
-        println!("{}", table(&[(&a.a, &sa), (&a.b, &sb)]));
+        let mut t = table(&[(&a.a, sa), (&a.b, sb)]);
+        speed_loop::rows(&mut t, loops);
+        println!("{t}");
     }
     Ok(())
 }
