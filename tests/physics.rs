@@ -329,6 +329,7 @@ fn direct_topology_equals_a_very_stiff_spur_stage() {
         let mut direct = spur.clone();
         direct.topology = Topology::Direct;
         (direct.kg, direct.rg, direct.cig, direct.theta_bg) = (None, None, None, None);
+        direct.ranges.remove("theta_bg");
         let dt = rtid::sim::default_step(&spur).unwrap();
         let run = |p: &Params| {
             let mut sim = Simulation::new(p, dt).unwrap();

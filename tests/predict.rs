@@ -105,7 +105,13 @@ fn the_fit_compensates_the_preset_and_the_prediction_holds_what_its_test_shows()
     let out = predict(dir.path(), "12", &["--json"]);
     let p = json(&out);
     assert_eq!(p["completed"], 12);
-    assert_eq!(p["drawn"], serde_json::json!(["theta_bw", "fm", "fw"]));
+    let mut want = vec!["theta_bw", "fm", "fw"];
+    want.extend(["Cb", "Jt", "Jw", "Kw", "Mw", "W", "theta_bg"]);
+    assert_eq!(
+        p["drawn"],
+        serde_json::json!(want),
+        "the preset's held ranges drawn too"
+    );
     let real = preset_with_compensation(dir.path());
     let (b_before, _, _) = predicted(&p, "before", "B_mean");
     let (a_before, _, _) = predicted(&p, "before", "A");
@@ -210,7 +216,11 @@ fn a_parameter_the_data_did_not_determine_is_refused_until_held() {
     held.extend(["--hold", "fm", "--json"]);
     let p = json(&rtid(&held, dir.path()));
     assert_eq!(p["held"], serde_json::json!(["fm"]));
-    assert_eq!(p["drawn"], serde_json::json!(["theta_bw", "fw"]));
+    // The fitted parameters drawn, then the preset's held ranges (`rtid params`).
+    let preset = ["Cb", "Jt", "Jw", "Kw", "Mw", "W", "theta_bg"];
+    let mut want = vec!["theta_bw", "fw"];
+    want.extend(preset);
+    assert_eq!(p["drawn"], serde_json::json!(want));
     // Only "before": nothing to predict the effect of.
     assert_eq!(p["cases"].as_array().unwrap().len(), 1);
 }
@@ -257,6 +267,8 @@ fn the_shipped_fit_is_rtid_s_identification() {
             "worm-gear",
             "--fit",
             "theta_bw,fm,fw",
+            "--intervals",
+            "standard-errors",
             "--out",
             "fit.json",
             "--quiet",
@@ -555,7 +567,10 @@ fn held_ranges_go_from_the_identification_into_the_prediction() {
         ],
         dir.path(),
     ));
-    assert!(e.contains("--uncertain Kw=10%: Kw is fitted"), "{e}");
+    assert!(
+        e.contains("--uncertain Kw") && e.contains("Kw is fitted"),
+        "{e}"
+    );
     let mut shipped: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(fit_file()).unwrap()).unwrap();
     shipped["held"] = serde_json::json!([{"name": "theta_bg", "value": 3e-4,

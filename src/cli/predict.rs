@@ -35,8 +35,8 @@ fit said, or as the replicates drew them; the others, and those given here with 
 --uncertain NAME=X%, uniformly within value·(1 ± X %); 0 % holds one exactly. It is \
 extended to the value at the fit where the draws' interval misses it. Every other \
 parameter keeps its value, and the output names them. On six worm gears that are not \
-the preset, 57 of 72 intervals of the default chain held the machine's value, 69 of 72 \
-with 24 replicates and three ranges given by hand (docs/validation.md). A fitted parameter \
+the preset, 69 of 72 intervals held the machine's value with 24 replicates and three \
+ranges given by hand (docs/validation.md). A fitted parameter \
 the data did not determine (no standard error) cannot be drawn: the command refuses \
 until it is held at its value (--hold NAME), and then says so.
 

@@ -58,7 +58,7 @@ pub enum RequestError {
     HoldNotFitted { name: String, fitted: String },
     #[error("hold: the bootstrap replicates are drawn as they are (draw from the covariance)")]
     HoldBootstrap,
-    #[error("uncertain {0}: the fit's bootstrap replicates draw it already, within the range `identify --uncertain` gave it")]
+    #[error("uncertain {0}: the fit's bootstrap replicates draw it already, within the range `identify` gave it")]
     DrawnAlready(String),
     #[error("runs {0}: from 2 (ISO 230-2) to 100")]
     Runs(u32),
@@ -113,6 +113,9 @@ fn source_draws(r: &Request) -> Result<(DrawSource, Draws), RequestError> {
 /// of the fit.
 fn uncertain(r: &Request, drawn: &[String]) -> Result<Vec<Uncertain>, RequestError> {
     let given = &r.uncertain;
+    if let Some((name, _)) = given.iter().find(|g| r.fit.parameters.contains_key(&g.0)) {
+        return Err(RangeError::Fitted { name: name.clone() }.into());
+    }
     if let Some((name, _)) = given.iter().find(|g| drawn.contains(&g.0)) {
         return Err(RequestError::DrawnAlready(name.clone()));
     }

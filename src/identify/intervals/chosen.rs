@@ -11,8 +11,8 @@
 //!   nonlinear corrections did not converge, the standard errors are lower bounds
 //!   (on six worm gears that are not the preset they held θbw, fm and fw 1 time in
 //!   18). There the residual block bootstrap runs without being asked, each
-//!   replicate drawing the held parameters within their ranges and refitted from
-//!   the fit ([`super::resample`]).
+//!   replicate drawing the held parameters within their ranges and refitted by the
+//!   fit's search from the fit's start ([`super::resample`]).
 //!
 //! The held ranges are those of the parameter set (a preset's `ranges`: the values
 //! its notes mark uncertain or assumed, each with a percentage and its reason) for
@@ -21,7 +21,6 @@
 
 use crate::identify::result::warning::Warning;
 use crate::identify::result::IdentifyResult;
-use crate::identify::search::settings::{Method, Settings, SIMPLEX_STEP_NEAR};
 use crate::model::Params;
 use crate::objectives::Smoothness;
 
@@ -76,26 +75,6 @@ pub fn rough(result: &IdentifyResult, smoothness: Smoothness) -> bool {
             .iter()
             .any(|w| matches!(w.0, Warning::CorrectionsNotConverged { .. }))
 }
-
-/// How a bootstrap replicate is refitted: from the fit (not from the fit's start),
-/// by the fit's solver; Nelder–Mead with a small simplex (about 5 % of a parameter
-/// within its default bounds) and at most [`REPLICATE_ITERATIONS`] iterations — a
-/// replicate's data differ from the record by its noise, so its optimum lies within
-/// the fit's interval, not across the bounds.
-pub fn replicate_settings(fit: Settings) -> Settings {
-    match fit.method {
-        Method::NelderMead => Settings {
-            simplex_step: SIMPLEX_STEP_NEAR,
-            max_iters: fit.max_iters.min(REPLICATE_ITERATIONS),
-            starts: 1,
-            ..fit
-        },
-        _ => Settings { starts: 1, ..fit },
-    }
-}
-
-/// Iterations of a replicate's Nelder–Mead search from the fit.
-pub const REPLICATE_ITERATIONS: u64 = 15;
 
 /// Why a held range cannot be taken.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -117,6 +117,7 @@ pub fn resample(request: &Request) -> Result<Resampling, ResampleError> {
     let names: Vec<String> = result.parameters.keys().cloned().collect();
     let problem = Problem {
         fit: names.iter().map(|n| result.parameters[n]).collect(),
+        initial: names.iter().map(|n| result.initial[n]).collect(),
         bounds: names
             .iter()
             .map(|n| {
@@ -128,7 +129,7 @@ pub fn resample(request: &Request) -> Result<Resampling, ResampleError> {
         held: request.held,
         params: request.params,
         objective: request.objective,
-        settings: super::chosen::replicate_settings(request.settings),
+        settings: request.settings,
         parts: parts(result),
     };
     problem.run(request.replicates, request.stop, request.on_replicate)
@@ -154,9 +155,10 @@ fn parts(result: &IdentifyResult) -> Vec<(String, usize)> {
 
 /// What one bootstrap needs of a fit.
 struct Problem<'a> {
-    /// The fitted parameters, their fitted values, and bounds.
+    /// The fitted parameters, their fitted and start values, and bounds.
     names: Vec<String>,
     fit: Vec<f64>,
+    initial: Vec<f64>,
     bounds: Vec<(String, Bound)>,
     /// The held parameters' ranges the replicates draw from.
     held: &'a [(String, f64, f64)],
@@ -278,9 +280,8 @@ impl Problem<'_> {
             .collect()
     }
 
-    /// The fit repeated on the objective shifted by `offset`: the fit's solver from
-    /// the fit ([`super::chosen::replicate_settings`]). The fitted values, in
-    /// `names`' order.
+    /// The fit repeated on the objective shifted by `offset`: the same search from
+    /// the same start. The fitted values, in `names`' order.
     fn refit(
         &self,
         objective: &dyn Objective,
@@ -289,7 +290,7 @@ impl Problem<'_> {
     ) -> Result<Vec<f64>, IdentifyError> {
         let mut base = self.params.clone();
         let held = self.held.iter().map(|h| &h.0).zip(held);
-        for (name, &v) in self.names.iter().zip(&self.fit).chain(held) {
+        for (name, &v) in self.names.iter().zip(&self.initial).chain(held) {
             base.set(name, v).map_err(ObjectiveError::from)?;
         }
         let space = ParamSpace::new(base, &self.names, &self.bounds)?;
@@ -612,6 +613,7 @@ mod tests {
         let problem = Problem {
             names: names.clone(),
             fit,
+            initial,
             bounds,
             params: &params,
             objective: &decay,
@@ -666,6 +668,7 @@ mod tests {
         let problem = Problem {
             names: vec!["Kw".into()],
             fit: vec![3.1e5],
+            initial: vec![3.1e5],
             bounds: vec![("Kw".into(), Bound { lo: 1e5, hi: 1e6 })],
             params: &p,
             objective: &decay,
