@@ -67,6 +67,9 @@ pub fn tune(
             notch_min_width: options.notch_min_width,
         },
         torque_reserve: options.torque_reserve,
+        // The command line's defaults without --vary, --delay-periods, --ensemble.
+        range: tuning::range::default_range(&p),
+        ensemble: Default::default(),
     };
     let (done, total) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let on_step = |d: usize, t: usize| {
