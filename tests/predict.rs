@@ -594,9 +594,10 @@ fn held_ranges_go_from_the_identification_into_the_prediction() {
         "held.json",
         &["--uncertain", "theta_bg=20%", "--json"],
     ));
+    // The fit's draws, its held theta_bg, then the preset's other held ranges.
     assert_eq!(
         p["drawn"],
-        serde_json::json!(["theta_bw", "fm", "fw", "theta_bg"])
+        serde_json::json!(["theta_bw", "fm", "fw", "theta_bg", "Cb", "Jt", "Jw", "Kw", "Mw", "W"])
     );
     let values: Vec<f64> = (0..10)
         .map(|k| shipped["parameters"]["fm"].as_f64().unwrap() * (k as f64))

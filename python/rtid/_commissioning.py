@@ -165,7 +165,7 @@ class Tuning:
 
     def sinamics(self) -> str:
         """The tuned settings as a commented SINAMICS parameter list (``--sinamics``)."""
-        return _rtid.sinamics_settings(_params_arg(self.params))
+        return _rtid.sinamics_settings(_params_arg(self.params), self._closed_loop())
 
     def sinumerik(self, axis_number: int, *, gear_ratio: tuple | None = None) -> str:
         """The tuned settings as SINUMERIK machine data for axis ``AX<axis_number>``
@@ -176,7 +176,12 @@ class Tuning:
             if not isinstance(gear_ratio, (tuple, list)) or len(gear_ratio) != 2:
                 raise TypeError(f"gear_ratio: expected (motor, load) revolutions, got {gear_ratio!r}")
             gear_ratio = (_whole(gear_ratio[0], "gear_ratio"), _whole(gear_ratio[1], "gear_ratio"))
-        return _rtid.sinumerik_settings(_params_arg(self.params), n, gear_ratio)
+        return _rtid.sinumerik_settings(_params_arg(self.params), n, gear_ratio, self._closed_loop())
+
+    def _closed_loop(self) -> tuple:
+        """The tuned speed loop's equivalent time constant and bandwidth (MD32810)."""
+        c = (self.after or {}).get("closed_loop") or {}
+        return (c.get("equivalent_time_s"), c.get("speed_bandwidth_hz"))
 
     def __repr__(self) -> str:
         a = self.after or {}

@@ -95,9 +95,15 @@ pub fn tune(
 
 /// The servo settings of `params` as a SINAMICS parameter list (`rtid tune
 /// --sinamics`).
+/// `closed_loop` (equivalent time constant s, speed bandwidth Hz) is the tuned speed
+/// loop's, as `rtid tune` writes MD32810 from it.
 #[pyfunction]
-pub fn sinamics_settings(params: PyRef<'_, PyParams>) -> PyResult<String> {
-    let s = ServoSettings::from_params(&params.inner);
+#[pyo3(signature = (params, closed_loop=(None, None)))]
+pub fn sinamics_settings(
+    params: PyRef<'_, PyParams>,
+    closed_loop: (Option<f64>, Option<f64>),
+) -> PyResult<String> {
+    let s = servo_settings(&params.inner, closed_loop);
     sinamics::program(&s, &sinamics::SinamicsContext::default())
         .map_err(|e| with_context("sinamics", &e))
 }
@@ -105,11 +111,12 @@ pub fn sinamics_settings(params: PyRef<'_, PyParams>) -> PyResult<String> {
 /// The servo settings of `params` as SINUMERIK machine data for axis `axis_number`
 /// (`rtid tune --sinumerik --axis-number N [--gear-ratio M:L]`).
 #[pyfunction]
-#[pyo3(signature = (params, axis_number, gear_ratio=None))]
+#[pyo3(signature = (params, axis_number, gear_ratio=None, closed_loop=(None, None)))]
 pub fn sinumerik_settings(
     params: PyRef<'_, PyParams>,
     axis_number: u32,
     gear_ratio: Option<(u64, u64)>,
+    closed_loop: (Option<f64>, Option<f64>),
 ) -> PyResult<String> {
     if gear_ratio.is_some_and(|(m, l)| m == 0 || l == 0) {
         return Err(bad_argument(
@@ -117,7 +124,7 @@ pub fn sinumerik_settings(
             "give (motor, load) revolutions as whole numbers above 0, e.g. (90, 1)",
         ));
     }
-    let s = ServoSettings::from_params(&params.inner);
+    let s = servo_settings(&params.inner, closed_loop);
     let ctx = sinumerik::SinumerikContext {
         axis_number: Some(axis_number),
         gear: gear_ratio,
@@ -176,6 +183,8 @@ pub fn predict(
         held: options.hold.clone(),
         level: options.level,
         cases: &cases,
+        // The command line's default: the positioning test's ensemble at the fit.
+        ensemble: Some(Default::default()),
     };
     let on_draw = || {
         done.fetch_add(1, Ordering::Relaxed);
@@ -275,4 +284,15 @@ pub fn select(results: Vec<(String, String)>) -> PyResult<String> {
     }
     let s = rtid::identify::selection::select(&read).map_err(|e| with_context("results", &e))?;
     rtid::io::json::pretty(&s).map_err(|e| rtid_error(&e))
+}
+
+/// The servo settings of `p` with the tuned speed loop's equivalent time constant and
+/// bandwidth where given (as `rtid tune`'s drive forms take them).
+fn servo_settings(p: &rtid::Params, closed_loop: (Option<f64>, Option<f64>)) -> ServoSettings {
+    let s = ServoSettings::from_params(p);
+    ServoSettings {
+        equivalent_time_s: closed_loop.0.or(s.equivalent_time_s),
+        speed_bandwidth_hz: closed_loop.1.or(s.speed_bandwidth_hz),
+        ..s
+    }
 }

@@ -11,6 +11,7 @@ use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 use crate::cli::common::inputs::refuse_overwrite;
 use crate::cli::common::{self, interrupt, model_args, progress};
 use crate::cli::ModelArgs;
+use rtid::experiments::positioning::ensemble;
 use rtid::identify::result::IdentifyResult;
 use rtid::io::compensation_file;
 use rtid::model::Params;
@@ -89,6 +90,12 @@ pub struct Args {
     /// Positioning test: runs per direction.
     #[arg(long, value_name = "N", default_value_t = 5)]
     pub runs: u32,
+    /// Runs of the positioning test at the fit under perturbations that do not change
+    /// the machine (where the axis comes to rest in stick, sub-count offsets of the
+    /// compensation, the noise's seed); their spread below and above the unperturbed
+    /// run is added to each interval. 0: the draws' interval alone.
+    #[arg(long, value_name = "N", default_value_t = ensemble::DEFAULT_MEMBERS)]
+    pub ensemble: usize,
     /// Probability of the central interval.
     #[arg(long, value_name = "P", default_value_t = 0.95)]
     pub level: f64,
@@ -129,6 +136,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         held: a.hold.clone(),
         level: a.level,
         cases: &cases,
+        ensemble: match a.ensemble {
+            0 => None,
+            n => Some(
+                ensemble::Ensemble::new(n).map_err(|e| anyhow::anyhow!("--ensemble {n}: {e}"))?,
+            ),
+        },
     };
     let p = prediction::predict(&setup, &|| bar.inc(1), &stop)?;
     bar.finish_and_clear();
@@ -211,6 +224,12 @@ fn print(a: &Args, p: &Prediction, params: &Params) {
         p.drawn.join(", "),
         Num(p.level * 100.0)
     );
+    if p.ensemble > 0 {
+        println!(
+            "each interval widened by the positioning test's own spread at the fit: {} runs under perturbations that do not change the machine (--ensemble)",
+            p.ensemble
+        );
+    }
     print_tables(p);
     if !a.quiet {
         notes(p, params);

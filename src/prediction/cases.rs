@@ -2,6 +2,7 @@
 //! from them, in the units the field reports them in.
 
 use crate::controller::Compensation;
+use crate::experiments::positioning::ensemble::{self, Ensemble, EnsembleError};
 use crate::experiments::positioning::iso230::{self, Iso230Error, Measurement, ReportUnits};
 use crate::experiments::positioning::{self, PositioningTest};
 use crate::model::params::ControllerParams;
@@ -47,6 +48,8 @@ pub enum CaseError {
     Sim(#[from] SimError),
     #[error(transparent)]
     Iso230(#[from] Iso230Error),
+    #[error(transparent)]
+    Ensemble(#[from] EnsembleError),
 }
 
 impl Case {
@@ -72,6 +75,30 @@ impl Case {
                 .map(|p| servo_outputs(p, compensation))
                 .collect(),
         }
+    }
+
+    /// The test's own spread on the model `p`: for each output, how far below and
+    /// above its unperturbed run the runs of `ensemble` go (the rest positions'
+    /// stick, sub-count offsets of the compensation, the noise's seed: issue 58's
+    /// ensemble), or None for a test run once (the servo's responses).
+    pub fn spread(
+        &self,
+        p: &Params,
+        ensemble: &Ensemble,
+    ) -> Result<Option<Vec<(f64, f64)>>, CaseError> {
+        let Test::Positioning { test, .. } = &self.test else {
+            return Ok(None);
+        };
+        let e = ensemble::run(&self.tuned(p), test, ensemble)?;
+        let values = |s: &iso230::AxisStats| [s.b_mean, s.b, s.e, s.m, s.r, s.a];
+        let first = values(&e.members[0]);
+        let mut out: Vec<(f64, f64)> = first.iter().map(|_| (0.0, 0.0)).collect();
+        for member in &e.members {
+            for ((lo, hi), (v, v0)) in out.iter_mut().zip(values(member).iter().zip(&first)) {
+                (*lo, *hi) = (lo.min(v - v0), hi.max(v - v0));
+            }
+        }
+        Ok(Some(out))
     }
 
     /// `p` with the case's controller settings, if it has its own.

@@ -15,6 +15,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
+use crate::experiments::positioning::ensemble::Ensemble;
 use crate::model::{ParamError, Params};
 use crate::sim::batch::{by_point, on_valid};
 use crate::sim::LANES;
@@ -65,6 +66,10 @@ pub struct Predicted {
     /// Whether the interval was extended to the value at the fit.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub extended: bool,
+    /// The test's own spread at the fit (below, above its unperturbed run), added
+    /// to the draws' interval: the ensemble's least and largest less its first run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spread: Option<(f64, f64)>,
 }
 
 /// The outputs of one case (a test with or without the settings), in `unit`.
@@ -91,6 +96,10 @@ pub struct Prediction {
     /// The parameters drawn, and the fitted ones held at their values.
     pub drawn: Vec<String>,
     pub held: Vec<String>,
+    /// Runs of the test's ensemble at the fit, whose spread widens the intervals (0:
+    /// none).
+    #[serde(default)]
+    pub ensemble: usize,
     pub cases: Vec<CasePrediction>,
     /// What the interval does not include, and why draws are missing.
     pub notes: Vec<String>,
@@ -122,6 +131,9 @@ pub struct Setup<'a> {
     pub held: Vec<String>,
     pub level: f64,
     pub cases: &'a [Case],
+    /// The test's own ensemble at the fit (issue 58), its spread added to the
+    /// intervals; None: the draws' interval alone.
+    pub ensemble: Option<Ensemble>,
 }
 
 /// Runs every case at the fit and on every drawn set (in parallel), `progress` called
@@ -144,6 +156,7 @@ pub fn predict(
             })
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let spreads = spreads(s)?;
     let skipped = AtomicUsize::new(0);
     // Draws in groups of the kernel's lane count: each case runs a group together.
     let runs: Vec<Result<Vec<Vec<Output>>, String>> = s
@@ -179,7 +192,7 @@ pub fn predict(
     let mut notes = Vec::new();
     note_missing(&mut notes, failures.len(), skipped.into_inner(), done.len());
     note_assumed(&mut notes, s.params, &s.draws.names);
-    let cases = summarise(s, &nominal, &done);
+    let cases = summarise(s, &nominal, &done, &spreads);
     note_rough(&mut notes, &cases);
     Ok(Prediction {
         source: s.source,
@@ -189,6 +202,7 @@ pub fn predict(
         rejected: s.draws.rejected,
         drawn: s.draws.names.clone(),
         held: s.held.clone(),
+        ensemble: s.ensemble.map_or(0, |e| e.members),
         cases,
         notes,
     })
@@ -305,8 +319,32 @@ fn outside(x: f64, lo: f64, hi: f64) -> bool {
     x < lo - slack || x > hi + slack
 }
 
-/// Each case's outputs: value at the fit, the draws' median and central interval.
-fn summarise(s: &Setup, nominal: &[Vec<Output>], done: &[Vec<Vec<Output>>]) -> Vec<CasePrediction> {
+/// Each case's spread of its test at the fit (None for a case run once).
+type Spreads = Vec<Option<Vec<(f64, f64)>>>;
+
+fn spreads(s: &Setup) -> Result<Spreads, PredictError> {
+    let Some(ensemble) = &s.ensemble else {
+        return Ok(vec![None; s.cases.len()]);
+    };
+    (s.cases.par_iter())
+        .map(|c| {
+            c.spread(s.params, ensemble)
+                .map_err(|source| PredictError::Nominal {
+                    case: c.label.clone(),
+                    source,
+                })
+        })
+        .collect()
+}
+
+/// Each case's outputs: value at the fit, the draws' median and central interval,
+/// widened by the test's own spread.
+fn summarise(
+    s: &Setup,
+    nominal: &[Vec<Output>],
+    done: &[Vec<Vec<Output>>],
+    spreads: &Spreads,
+) -> Vec<CasePrediction> {
     let tail = (1.0 - s.level) / 2.0;
     s.cases
         .iter()
@@ -322,7 +360,9 @@ fn summarise(s: &Setup, nominal: &[Vec<Output>], done: &[Vec<Vec<Output>>]) -> V
                     let mut v: Vec<f64> = done.iter().map(|d| d[c][k].value).collect();
                     v.sort_by(f64::total_cmp);
                     let at = |q: f64| (v.len() >= MIN_DRAWS).then(|| quantile(&v, q));
-                    let (lower, upper) = (at(tail), at(1.0 - tail));
+                    let spread = spreads[c].as_ref().map(|v| v[k]);
+                    let (below, above) = spread.unwrap_or((0.0, 0.0));
+                    let (lower, upper) = (at(tail).map(|lo| lo + below), at(1.0 - tail).map(|hi| hi + above));
                     let extended = matches!((lower, upper), (Some(lo), Some(hi)) if outside(out.value, lo, hi));
                     Predicted {
                         name: out.name.to_string(),
@@ -331,6 +371,7 @@ fn summarise(s: &Setup, nominal: &[Vec<Output>], done: &[Vec<Vec<Output>>]) -> V
                         lower: lower.map(|lo| if extended { lo.min(out.value) } else { lo }),
                         upper: upper.map(|hi| if extended { hi.max(out.value) } else { hi }),
                         extended,
+                        spread,
                     }
                 })
                 .collect(),
