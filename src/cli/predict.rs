@@ -92,8 +92,8 @@ pub struct Args {
     pub runs: u32,
     /// Runs of the positioning test at the fit under perturbations that do not change
     /// the machine (where the axis comes to rest in stick, sub-count offsets of the
-    /// compensation, the noise's seed); their spread below and above the unperturbed
-    /// run is added to each interval. 0: the draws' interval alone.
+    /// compensation, the noise's seed); their range (largest less least) is added on
+    /// each side of each interval. 0: the draws' interval alone.
     #[arg(long, value_name = "N", default_value_t = ensemble::DEFAULT_MEMBERS)]
     pub ensemble: usize,
     /// Probability of the central interval.
@@ -226,7 +226,7 @@ fn print(a: &Args, p: &Prediction, params: &Params) {
     );
     if p.ensemble > 0 {
         println!(
-            "each interval widened by the positioning test's own spread at the fit: {} runs under perturbations that do not change the machine (--ensemble)",
+            "each interval widened on each side by the range of the positioning test's own runs at the fit: {} runs under perturbations that do not change the machine (--ensemble)",
             p.ensemble
         );
     }

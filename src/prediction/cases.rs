@@ -77,10 +77,12 @@ impl Case {
         }
     }
 
-    /// The test's own spread on the model `p`: for each output, how far below and
-    /// above its unperturbed run the runs of `ensemble` go (the rest positions'
-    /// stick, sub-count offsets of the compensation, the noise's seed: issue 58's
-    /// ensemble), or None for a test run once (the servo's responses).
+    /// The test's own spread on the model `p`: for each output, the range (largest
+    /// less least) of its runs under `ensemble` (the rest positions' stick, sub-count
+    /// offsets of the compensation, the noise's seed: issue 58's ensemble), as the
+    /// widening (below, above) of an interval: a draw is one run of the test, the
+    /// machine's another, so either may lie at either end of the range. None for a
+    /// test run once (the servo's responses).
     pub fn spread(
         &self,
         p: &Params,
@@ -91,14 +93,9 @@ impl Case {
         };
         let e = ensemble::run(&self.tuned(p), test, ensemble)?;
         let values = |s: &iso230::AxisStats| [s.b_mean, s.b, s.e, s.m, s.r, s.a];
-        let first = values(&e.members[0]);
-        let mut out: Vec<(f64, f64)> = first.iter().map(|_| (0.0, 0.0)).collect();
-        for member in &e.members {
-            for ((lo, hi), (v, v0)) in out.iter_mut().zip(values(member).iter().zip(&first)) {
-                (*lo, *hi) = (lo.min(v - v0), hi.max(v - v0));
-            }
-        }
-        Ok(Some(out))
+        let (least, largest) = (values(&e.min), values(&e.max));
+        let range = least.iter().zip(&largest).map(|(lo, hi)| hi - lo);
+        Ok(Some(range.map(|r| (-r, r)).collect()))
     }
 
     /// `p` with the case's controller settings, if it has its own.

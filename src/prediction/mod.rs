@@ -66,8 +66,8 @@ pub struct Predicted {
     /// Whether the interval was extended to the value at the fit.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub extended: bool,
-    /// The test's own spread at the fit (below, above its unperturbed run), added
-    /// to the draws' interval: the ensemble's least and largest less its first run.
+    /// The test's own spread at the fit, added to the draws' interval (below,
+    /// above): the ensemble's range, largest less least, on each side.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spread: Option<(f64, f64)>,
 }
@@ -362,7 +362,13 @@ fn summarise(
                     let at = |q: f64| (v.len() >= MIN_DRAWS).then(|| quantile(&v, q));
                     let spread = spreads[c].as_ref().map(|v| v[k]);
                     let (below, above) = spread.unwrap_or((0.0, 0.0));
-                    let (lower, upper) = (at(tail).map(|lo| lo + below), at(1.0 - tail).map(|hi| hi + above));
+                    // B, E, M, R, A are magnitudes (B̄ alone is signed): the widening
+                    // stops at 0.
+                    let floor = if spread.is_some() && out.name != "B_mean" { 0.0 } else { f64::NEG_INFINITY };
+                    let (lower, upper) = (
+                        at(tail).map(|lo| (lo + below).max(floor.min(lo))),
+                        at(1.0 - tail).map(|hi| hi + above),
+                    );
                     let extended = matches!((lower, upper), (Some(lo), Some(hi)) if outside(out.value, lo, hi));
                     Predicted {
                         name: out.name.to_string(),
