@@ -103,8 +103,8 @@ fn the_fit_compensates_the_preset_and_the_prediction_holds_what_its_test_shows()
     let backlash = c["backlash"].as_f64().unwrap();
     assert!((-36.0..-34.0).contains(&backlash), "{backlash}");
     // The machine here is the preset itself: its held values are exact, so they are
-    // held at 0 % (drawn within the preset's ranges, B̄ after fell below the fit's
-    // value in all 12 draws and the interval missed the preset's 0.25″: noted in
+    // held at 0 % (drawn within the preset's ranges, the draws' upper end of B̄ after
+    // lay below the fit's value and the interval missed the preset's 0.25″: noted in
     // docs/validation.md as open).
     let exact = ["Cb", "Jt", "Jw", "Kw", "Mw", "W", "theta_bg"].map(|n| format!("{n}=0%"));
     let mut extra = vec!["--json"];
