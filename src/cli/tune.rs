@@ -410,8 +410,24 @@ fn print_table(p: &rtid::Params, t: &Tuned) {
         "after (today's kept)"
     };
     table.set_header(vec!["", "before", after]);
-    let (b, a) = (&t.before, &t.after);
-    let row = |label: &str, f: &dyn Fn(&Setting) -> String| vec![label.to_string(), f(b), f(a)];
+    add_gain_rows(&mut table, p, t);
+    add_margin_rows(&mut table, t);
+    add_closed_loop_rows(&mut table, t);
+    if let (Some(_), Some(_)) = (&t.before.over_range, &t.after.over_range) {
+        add_range_rows(&mut table, t);
+    }
+    println!("{table}");
+    print_search(t);
+}
+
+/// A row of the table: `label`, then `f` of today's setting and of the proposed one.
+fn row(t: &Tuned, label: &str, f: &dyn Fn(&Setting) -> String) -> Vec<String> {
+    vec![label.to_string(), f(&t.before), f(&t.after)]
+}
+
+/// The gains in rtid's and the CNC's units, and the setpoint filters.
+fn add_gain_rows(table: &mut Table, p: &rtid::Params, t: &Tuned) {
+    let row = |label: &str, f: &dyn Fn(&Setting) -> String| row(t, label, f);
     let (kvp_unit, kvi_unit) = gain_units(p);
     table.add_row(row(&format!("Kvp ({kvp_unit})"), &|s| {
         format!("{:.4e}", s.kvp)
@@ -433,6 +449,11 @@ fn print_table(p: &rtid::Params, t: &Tuned) {
     };
     table.add_row(row(kv_unit, &|s| format!("{:.3}", s.kpp * kv_per)));
     table.add_row(row("setpoint filters", &|s| filters(s)));
+}
+
+/// The velocity loop's and the cascade's margins.
+fn add_margin_rows(table: &mut Table, t: &Tuned) {
+    let row = |label: &str, f: &dyn Fn(&Setting) -> String| row(t, label, f);
     let velocity = |s: &Setting| s.velocity_loop;
     table.add_row(row("velocity loop alone: crossover", &|s| {
         velocity(s)
@@ -471,6 +492,11 @@ fn print_table(p: &rtid::Params, t: &Tuned) {
             " dB",
         )
     }));
+}
+
+/// The closed loops: peaks, bandwidths, MD32810's time constant, |S|max.
+fn add_closed_loop_rows(table: &mut Table, t: &Tuned) {
+    let row = |label: &str, f: &dyn Fn(&Setting) -> String| row(t, label, f);
     table.add_row(row("position loop: peak", &|s| {
         format!("{:.2} dB", s.position_peak_db)
     }));
@@ -504,10 +530,10 @@ fn print_table(p: &rtid::Params, t: &Tuned) {
             c.sensitivity_peak_db, c.sensitivity_peak_hz
         )
     }));
-    if let (Some(_), Some(_)) = (&b.over_range, &a.over_range) {
-        add_range_rows(&mut table, t);
-    }
-    println!("{table}");
+}
+
+/// What the search did, in one line.
+fn print_search(t: &Tuned) {
     let s = &t.search;
     let machines = if s.machines > 1 {
         format!(" at each of {} machines of the range", s.machines)

@@ -36,6 +36,7 @@
 pub mod by_record;
 pub mod config;
 pub mod design;
+pub mod dispatch;
 pub mod error;
 pub mod intervals;
 pub mod pipeline;
@@ -49,13 +50,14 @@ pub mod space;
 pub mod start;
 
 pub use config::{Config, ExperimentSpec, FidelityChoice, SearchOptions, Staging, StartChoice};
+pub use dispatch::identify;
 pub use error::IdentifyError;
 pub use pipeline::checkpoint::CheckpointError;
 pub use result::starts::{StartEstimate, StartRecord};
 pub use result::termination::Termination;
 pub use result::warning::Warning;
 pub use result::IdentifyResult;
-pub use run::{identify, Identified};
+pub use run::Identified;
 pub use search::problem::{Best, Monitor};
 pub use search::settings::Method;
 pub use search::settings::Settings;

@@ -25,11 +25,10 @@
 //! Adding an objective is one new file (the struct, its `Objective` impl and its
 //! `DEFINITION`) and one line in [`registry::REGISTRY`].
 
-pub mod complex_response;
 pub mod definition;
 pub mod detail;
+pub mod frequency_response;
 pub mod friction_map;
-pub mod gain_curve;
 #[cfg(test)]
 pub(crate) mod in_lanes {
     //! For tests: an objective handed its points in batches, as one that runs in the
@@ -83,13 +82,8 @@ pub(crate) mod in_lanes {
     }
 }
 pub mod joint;
-pub mod measured_peaks;
-pub mod model_peaks;
-pub mod peak_amplitude;
 pub mod registry;
-pub mod resonance;
 pub mod servo_trace;
-pub mod speed_loop;
 pub mod torque_curve;
 pub mod unbalance_step;
 
@@ -100,6 +94,10 @@ use crate::sim::SimError;
 
 pub use definition::{Definition, Estimated, ObjectiveKind, SetupError, Source, Stage};
 pub use detail::Detail;
+pub use frequency_response::{
+    complex_response, gain_curve, measured_peaks, model_peaks, peak_amplitude, resonance,
+    speed_loop,
+};
 pub use joint::Joint;
 
 /// What the model's frequency response is computed with.

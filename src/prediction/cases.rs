@@ -92,9 +92,8 @@ impl Case {
             return Ok(None);
         };
         let e = ensemble::run(&self.tuned(p), test, ensemble)?;
-        let values = |s: &iso230::AxisStats| [s.b_mean, s.b, s.e, s.m, s.r, s.a];
-        let (least, largest) = (values(&e.min), values(&e.max));
-        let range = least.iter().zip(&largest).map(|(lo, hi)| hi - lo);
+        let (least, largest) = (iso_values(&e.min), iso_values(&e.max));
+        let range = least.iter().zip(&largest).map(|(lo, hi)| hi.1 - lo.1);
         Ok(Some(range.map(|r| (-r, r)).collect()))
     }
 
@@ -131,14 +130,22 @@ impl Case {
 fn positioning_outputs(readings: &[Measurement], axis: Axis) -> Result<Vec<Output>, CaseError> {
     let stats = iso230::evaluate(readings)?.axis;
     let s = stats.scaled(ReportUnits::of(axis).deviation_per_si);
-    Ok(outputs(vec![
-        ("B_mean", s.b_mean),
+    Ok(outputs(iso_values(&s).to_vec()))
+}
+
+/// The signed one of the ISO 230-2 outputs; the others are magnitudes.
+pub const SIGNED: &str = "B_mean";
+
+/// B̄, B, E, M, R, A of `s`, named as the prediction reports them.
+fn iso_values(s: &iso230::AxisStats) -> [(&'static str, f64); 6] {
+    [
+        (SIGNED, s.b_mean),
         ("B", s.b),
         ("E", s.e),
         ("M", s.m),
         ("R", s.r),
         ("A", s.a),
-    ]))
+    ]
 }
 
 /// The servo's responses on `p` with `compensation`.

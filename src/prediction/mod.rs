@@ -364,7 +364,7 @@ fn summarise(
                     let (below, above) = spread.unwrap_or((0.0, 0.0));
                     // B, E, M, R, A are magnitudes (B̄ alone is signed): the widening
                     // stops at 0.
-                    let floor = if spread.is_some() && out.name != "B_mean" { 0.0 } else { f64::NEG_INFINITY };
+                    let floor = if spread.is_some() && out.name != cases::SIGNED { 0.0 } else { f64::NEG_INFINITY };
                     let (lower, upper) = (
                         at(tail).map(|lo| (lo + below).max(floor.min(lo))),
                         at(1.0 - tail).map(|hi| hi + above),

@@ -3,17 +3,13 @@
 
 pub mod compensation;
 pub mod evaluation;
+pub mod experiments;
 pub mod figure;
-pub mod fluctuation;
-pub mod frequency_response;
-pub mod frequency_response_time;
-pub mod friction_map;
 pub mod html;
 pub mod identify;
-pub mod periodic;
-pub mod positioning;
-pub mod servo_trace;
-pub mod speed_loop;
 pub mod sweep;
-pub mod torque_curve;
 pub mod tuning;
+pub use experiments::{
+    fluctuation, frequency_response, frequency_response_time, friction_map, periodic, positioning,
+    servo_trace, speed_loop, torque_curve,
+};

@@ -26,7 +26,7 @@ pub fn build(
     conditions_given: &[String],
     mechanism: Option<String>,
 ) -> Result<Imported, ImportError> {
-    let fail = |e: String| ImportError(format!("{}: {e}", source.path.display()));
+    let fail = |e: response::ResponseError| ImportError(format!("{}: {e}", source.path.display()));
     let measured = response::measured_loop(m).map_err(fail)?;
     let r = response::stored_response(m).map_err(fail)?;
     let request = Request {

@@ -20,6 +20,18 @@ pub const DEFAULT_SIGMA: f64 = 0.01;
 /// each line by more than √2 of its σ on average.
 pub const MISFIT_CHI2: f64 = 2.0;
 
+/// Why an experiment is not a measured speed-loop response.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum NotSpeedLoop {
+    #[error("not a speed-loop response (a frequency_response with response \"speed_loop\")")]
+    Kind,
+    #[error("a speed-loop response needs its phase (phase_deg)")]
+    NoPhase,
+    #[error("no valid line (every line outside band_hz?)")]
+    NoLine,
+}
+
 /// The measured lines of a speed-loop response.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeasuredSpeedLoop {
@@ -54,17 +66,13 @@ pub fn is_speed_loop(exp: &Experiment) -> bool {
 
 impl MeasuredSpeedLoop {
     /// The lines of `exp`, or why it is not a speed-loop response with phase.
-    pub fn of(exp: &Experiment) -> Result<MeasuredSpeedLoop, String> {
+    pub fn of(exp: &Experiment) -> Result<MeasuredSpeedLoop, NotSpeedLoop> {
         if !is_speed_loop(exp) {
-            return Err(
-                "not a speed-loop response (a frequency_response with response \"speed_loop\")"
-                    .into(),
-            );
+            return Err(NotSpeedLoop::Kind);
         }
-        let m = measured::complex_points(exp, |_| true)
-            .ok_or("a speed-loop response needs its phase (phase_deg)")?;
+        let m = measured::complex_points(exp, |_| true).ok_or(NotSpeedLoop::NoPhase)?;
         if m.frequency_hz.is_empty() {
-            return Err("no valid line (every line outside band_hz?)".into());
+            return Err(NotSpeedLoop::NoLine);
         }
         let noise_stated = m.sigma_ln.is_some();
         let or_default = |s: Option<Vec<f64>>| {

@@ -16,28 +16,27 @@
 use crate::estimation::periodic::estimate::{h1, FrfEstimate};
 use crate::estimation::periodic::record::{PeriodicError, PeriodicOptions, PeriodicRecord};
 use crate::io::experiment_file::{Columns, Data};
-use crate::io::formats::sinumerik_trace::response::{self, StoredResponse};
+use crate::io::formats::sinumerik_trace::response::{self, ResponseError, StoredResponse};
 use crate::io::formats::sinumerik_trace::Measurement;
 
 /// Why the response cannot be recomputed.
 #[derive(Debug, Clone, thiserror::Error)]
 #[non_exhaustive]
 pub enum RecomputeError {
-    #[error("{0}")]
-    File(String),
+    #[error(transparent)]
+    File(#[from] ResponseError),
+    #[error("{0} time series per signal: the noise needs two periods (both directions)")]
+    OneDirection(usize),
     #[error("the time series: {0}")]
     Estimate(#[from] PeriodicError),
 }
 
 /// H1 of the primary output over its input from the time series of both directions.
 pub fn recompute(m: &Measurement) -> Result<FrfEstimate, RecomputeError> {
-    let n = response::samples_per_period(m).map_err(RecomputeError::File)?;
-    let directions = response::directions(m).map_err(RecomputeError::File)?;
+    let n = response::samples_per_period(m)?;
+    let directions = response::directions(m)?;
     if directions.len() < 2 {
-        return Err(RecomputeError::File(format!(
-            "{} time series per signal: the noise needs two periods (both directions)",
-            directions.len()
-        )));
+        return Err(RecomputeError::OneDirection(directions.len()));
     }
     let (mut input, mut output) = (Vec::new(), Vec::new());
     for d in &directions {

@@ -26,6 +26,49 @@ use nalgebra::Complex;
 
 use super::measurement::{Measurement, Signal, Spectrum};
 
+/// Why the file's response cannot be read.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ResponseError {
+    #[error("control loop type {loop_type}, injection point {injection_point}, {}: rtid reads the speed loop's reference response (type 2, injection point 3, closed loop), the one kind seen in a file so far; its channels are listed as they are", if *.closed_loop { "closed loop" } else { "open loop" })]
+    UnknownLoop {
+        loop_type: u32,
+        injection_point: u32,
+        closed_loop: bool,
+    },
+    #[error("the file names no primary response (m_listPrimaryFreqRespSigNodeData)")]
+    NoPrimary,
+    #[error("the primary response's {what} is signal instance {id}, which the file does not hold")]
+    MissingSignal { what: &'static str, id: i64 },
+    #[error("the series hold {len} samples where a PRBS of order {order} repeats every {period}")]
+    SeriesLength {
+        len: usize,
+        order: u32,
+        period: usize,
+    },
+    #[error("neither time series nor a PRBS order{} say the period's length", .order.map_or(String::new(), |o| format!(" (m_uPrbsOrder {o} is out of 2 … 24)")))]
+    NoPeriod { order: Option<u32> },
+    #[error("signal {0} has no autospectrum")]
+    NoAutospectrum(u32),
+    #[error("no cross spectrum of signals {output} and {input}")]
+    NoCrossSpectrum { output: u32, input: u32 },
+    #[error("the spectra have {input}, {output} and {cross} lines: they must be of one length")]
+    SpectraLengths {
+        input: usize,
+        output: usize,
+        cross: usize,
+    },
+    #[error("{lines} spectral lines from periods of {period} samples, which have {}", .period / 2 + 1)]
+    TooManyLines { lines: usize, period: usize },
+    #[error("signal {input} has {input_series} series and signal {output} {output_series}: one per direction each")]
+    Directions {
+        input: u32,
+        input_series: usize,
+        output: u32,
+        output_series: usize,
+    },
+}
+
 /// The loops rtid knows how to read from the codes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MeasuredLoop {
@@ -52,22 +95,15 @@ impl MeasuredLoop {
 }
 
 /// The loop of `m`, or why rtid does not read it.
-pub fn measured_loop(m: &Measurement) -> Result<MeasuredLoop, String> {
+pub fn measured_loop(m: &Measurement) -> Result<MeasuredLoop, ResponseError> {
     if m.loop_type == 2 && m.injection_point == 3 && m.excitation.closed_loop {
         return Ok(MeasuredLoop::SpeedClosed);
     }
-    Err(format!(
-        "control loop type {}, injection point {}, {}: rtid reads the speed loop's \
-         reference response (type 2, injection point 3, closed loop), the one kind seen \
-         in a file so far; its channels are listed as they are",
-        m.loop_type,
-        m.injection_point,
-        if m.excitation.closed_loop {
-            "closed loop"
-        } else {
-            "open loop"
-        }
-    ))
+    Err(ResponseError::UnknownLoop {
+        loop_type: m.loop_type,
+        injection_point: m.injection_point,
+        closed_loop: m.excitation.closed_loop,
+    })
 }
 
 /// The primary response from the stored spectra, at the DFT's lines 1 … L − 1.
@@ -90,20 +126,17 @@ pub struct StoredResponse {
 }
 
 /// The primary input and output signals of `m`.
-pub fn primary_signals(m: &Measurement) -> Result<(&Signal, &Signal), String> {
-    let (input, output) = m
-        .primary
-        .ok_or("the file names no primary response (m_listPrimaryFreqRespSigNodeData)")?;
-    let find = |id: i64, what: &str| {
-        m.signal(id).ok_or_else(|| {
-            format!("the primary response's {what} is signal instance {id}, which the file does not hold")
-        })
+pub fn primary_signals(m: &Measurement) -> Result<(&Signal, &Signal), ResponseError> {
+    let (input, output) = m.primary.ok_or(ResponseError::NoPrimary)?;
+    let find = |id: i64, what: &'static str| {
+        m.signal(id)
+            .ok_or(ResponseError::MissingSignal { what, id })
     };
     Ok((find(input, "input")?, find(output, "output")?))
 }
 
 /// Samples per period: the PRBS's 2^order − 1, which the series must be.
-pub fn samples_per_period(m: &Measurement) -> Result<usize, String> {
+pub fn samples_per_period(m: &Measurement) -> Result<usize, ResponseError> {
     let from_series = m
         .signals
         .iter()
@@ -112,32 +145,26 @@ pub fn samples_per_period(m: &Measurement) -> Result<usize, String> {
         .next();
     match (m.excitation.prbs_order, from_series) {
         (Some(order), series) if (2..=24).contains(&order) => {
-            let n = (1usize << order) - 1;
+            let period = (1usize << order) - 1;
             match series {
-                Some(len) if len != n => Err(format!(
-                    "the series hold {len} samples where a PRBS of order {order} repeats \
-                     every {n}"
-                )),
-                _ => Ok(n),
+                Some(len) if len != period => {
+                    Err(ResponseError::SeriesLength { len, order, period })
+                }
+                _ => Ok(period),
             }
         }
         (_, Some(len)) => Ok(len),
-        (order, None) => Err(format!(
-            "neither time series nor a PRBS order{} say the period's length",
-            order.map_or(String::new(), |o| format!(
-                " (m_uPrbsOrder {o} is out of 2 … 24)"
-            ))
-        )),
+        (order, None) => Err(ResponseError::NoPeriod { order }),
     }
 }
 
 /// The response output/input of the primary signals from the stored spectra.
-pub fn stored_response(m: &Measurement) -> Result<StoredResponse, String> {
+pub fn stored_response(m: &Measurement) -> Result<StoredResponse, ResponseError> {
     let (input, output) = primary_signals(m)?;
     let auto = |s: &'_ Signal| {
         s.autospectrum
             .clone()
-            .ok_or_else(|| format!("signal {} has no autospectrum", s.node))
+            .ok_or(ResponseError::NoAutospectrum(s.node))
     };
     let (s_in, s_out) = (auto(input)?, auto(output)?);
     let (cross, conjugate) = match (
@@ -147,27 +174,23 @@ pub fn stored_response(m: &Measurement) -> Result<StoredResponse, String> {
         (Some(c), _) => (c, true),
         (None, Some(c)) => (c, false),
         (None, None) => {
-            return Err(format!(
-                "no cross spectrum of signals {} and {}",
-                output.node, input.node
-            ))
+            return Err(ResponseError::NoCrossSpectrum {
+                output: output.node,
+                input: input.node,
+            })
         }
     };
     let lines = s_in.re.len();
     if s_out.re.len() != lines || cross.re.len() != lines {
-        return Err(format!(
-            "the spectra have {}, {} and {} lines: they must be of one length",
-            lines,
-            s_out.re.len(),
-            cross.re.len()
-        ));
+        return Err(ResponseError::SpectraLengths {
+            input: lines,
+            output: s_out.re.len(),
+            cross: cross.re.len(),
+        });
     }
     let n = samples_per_period(m)?;
     if lines > n / 2 + 1 {
-        return Err(format!(
-            "{lines} spectral lines from periods of {n} samples, which have {}",
-            n / 2 + 1
-        ));
+        return Err(ResponseError::TooManyLines { lines, period: n });
     }
     Ok(assemble(m, n, &s_in, &s_out, cross, conjugate))
 }
@@ -216,16 +239,15 @@ pub struct Direction<'a> {
 
 /// The primary signals' series, direction by direction (the file's order; the sign
 /// of each from the mean of its input).
-pub fn directions(m: &Measurement) -> Result<Vec<Direction<'_>>, String> {
+pub fn directions(m: &Measurement) -> Result<Vec<Direction<'_>>, ResponseError> {
     let (input, output) = primary_signals(m)?;
     if input.series.len() != output.series.len() {
-        return Err(format!(
-            "signal {} has {} series and signal {} {}: one per direction each",
-            input.node,
-            input.series.len(),
-            output.node,
-            output.series.len()
-        ));
+        return Err(ResponseError::Directions {
+            input: input.node,
+            input_series: input.series.len(),
+            output: output.node,
+            output_series: output.series.len(),
+        });
     }
     Ok(input
         .series

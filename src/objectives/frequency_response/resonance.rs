@@ -5,22 +5,22 @@
 //! motor-held modes — never the undamped eigenvalues (fitting those to measured peaks
 //! biases Kw by ~6 %). With [`Fidelity::Linear`] they come from the exact
 //! linear response with damping; with [`Fidelity::Nonlinear`] from the nonlinear
-//! virtual test at the experiment's conditions ([`super::model_peaks`]), sampled on
+//! virtual test at the experiment's conditions ([`crate::objectives::model_peaks`]), sampled on
 //! the measured frequencies when there is a measured gain curve.
 //!
 //! Pairing: the model's `n` highest peaks in the band (n = measured peaks), in
 //! ascending frequency, against the measured ones in ascending frequency. A measured
 //! peak the model does not have costs a residual of 100 % of its frequency.
 
-use super::definition::{Definition, SetupError, Source, Stage};
-use super::detail::list;
-use super::measured_peaks::measured_peaks;
-use super::model_peaks::ModelPeaks;
-use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::frequency_response::measured::{self, fits_whole_curve};
 use crate::experiments::frequency_response::FrequencyTest;
 use crate::io::experiment_file::Kind;
 use crate::model::Params;
+use crate::objectives::definition::{Definition, SetupError, Source, Stage};
+use crate::objectives::detail::list;
+use crate::objectives::measured_peaks::measured_peaks;
+use crate::objectives::model_peaks::ModelPeaks;
+use crate::objectives::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 
 /// The resonance objective: fed by default by every frequency response and resonance
 /// list; determines the drive stiffnesses.

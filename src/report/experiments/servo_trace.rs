@@ -1,10 +1,10 @@
 //! Figures of a servo trace: the following error and the drive's effort over time,
 //! measured and, when the model replayed it, replayed.
 
-use super::figure::{Figure, Series, Style};
 use crate::experiments::positioning::iso230::ARCSEC_PER_RAD;
 use crate::experiments::servo_trace::{Replay, ServoTrace};
 use crate::io::experiment_file::Axis;
+use crate::report::figure::{Figure, Series, Style};
 
 /// Points kept per series (a trace has tens of thousands of samples).
 const MAX_POINTS: usize = 4000;

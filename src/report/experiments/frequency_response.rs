@@ -2,8 +2,8 @@
 //! log axis), the linear model's curve where the file carries one, the resonances
 //! marked; the phase on the same frequency axis, and the Nyquist plot to equal scale.
 
-use super::figure::{Figure, Series, Style};
 use crate::estimation::peaks::Peak;
+use crate::report::figure::{Figure, Series, Style};
 
 /// The gain curve (`frequency_hz`, `gain_db`), the linear model's gain at the same
 /// frequencies when given, and the resonances.

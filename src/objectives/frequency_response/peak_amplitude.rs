@@ -1,23 +1,23 @@
 //! Peak-amplitude match: the dB error of the model's resonance peak heights against
 //! measured ones (paper §4.1: the internal damping Ciw, Cig from the peak heights).
 //!
-//! The model's peaks are found as in [`super::resonance`] (same pairing); the height
+//! The model's peaks are found as in [`crate::objectives::resonance`] (same pairing); the height
 //! of a lightly damped peak is very sensitive to where it is sampled, so the linear
 //! variant locates each maximum to 1e-7 relative and the nonlinear one fits a
 //! parabola of half-width 0.5 % around it. Note that the roller preset's first mode
 //! has ζ ≈ 7.5e-5 (0.025 Hz half-power width): a measurement on a 1 Hz grid
 //! under-estimates such a peak by tens of dB, so compare like with like.
 
-use super::definition::{Definition, SetupError, Source, Stage};
-use super::detail::list;
-use super::measured_peaks::measured_peaks;
-use super::model_peaks::ModelPeaks;
-use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::estimation::peaks::Peak;
 use crate::experiments::frequency_response::measured::{self, fits_whole_curve};
 use crate::experiments::frequency_response::FrequencyTest;
 use crate::io::experiment_file::Kind;
 use crate::model::Params;
+use crate::objectives::definition::{Definition, SetupError, Source, Stage};
+use crate::objectives::detail::list;
+use crate::objectives::measured_peaks::measured_peaks;
+use crate::objectives::model_peaks::ModelPeaks;
+use crate::objectives::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 
 /// Weight, relative to the resonance frequencies, of the peak heights that a gain curve
 /// feeds by default: resonance frequencies alone admit two (Kw, Kg) pairs for the worm

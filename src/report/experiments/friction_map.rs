@@ -1,10 +1,10 @@
 //! Figures of the friction map: effort over speed in both directions with the fitted
 //! laws drawn over it, and the selected law's residuals.
 
-use super::figure::{Figure, Series, Style};
 use crate::estimation::friction_law::LawFit;
 use crate::experiments::friction_map::MapEvaluation;
 use crate::model::Axis;
+use crate::report::figure::{Figure, Series, Style};
 
 /// Speeds in the field's unit: rpm on a rotary axis, mm/s on a linear one.
 fn speed_unit(axis: Axis) -> (f64, &'static str) {

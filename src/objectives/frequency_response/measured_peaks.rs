@@ -2,12 +2,12 @@
 //! prominent peaks of a gain curve; the curve's own helpers are
 //! [`crate::experiments::frequency_response::measured`]'s.
 
-use super::definition::{SetupError, Source};
 use crate::estimation::peaks::{self, Peak};
 use crate::experiments::frequency_response::measured::{
     form, in_band, valid_points, PROMINENCE_DB,
 };
 use crate::io::experiment_file::{Data, Response};
+use crate::objectives::definition::{SetupError, Source};
 
 /// The measured resonances of an experiment: the manifest's peaks, or the prominent
 /// peaks of the gain curve ([`PROMINENCE_DB`]), inside its band when it has one.

@@ -1,8 +1,8 @@
 //! Figures of the rotational-fluctuation and unbalance tests (paper Figs. 11, 12, 14).
 
-use super::figure::{Figure, Series, Style};
 use crate::experiments::fluctuation::Evaluation;
 use crate::io::experiment_file::Direction;
+use crate::report::figure::{Figure, Series, Style};
 
 /// Points per curve kept in the SVG.
 const MAX_POINTS: usize = 4000;

@@ -1,8 +1,8 @@
 //! Figures of a frequency response estimated from raw time series: the gain (stepped
 //! sine or H1) with its resonances, and the coherence of an H1 estimate.
 
-use super::figure::{Figure, Series, Style};
 use crate::experiments::frequency_response::time_evaluation::{kept_runs, Bin, Evaluation};
+use crate::report::figure::{Figure, Series, Style};
 
 /// The gain with the resonances marked, and for H1 the coherence figure too.
 pub fn figures(e: &Evaluation, mechanism: &str) -> (Figure, Option<Figure>) {
@@ -50,7 +50,7 @@ pub fn figures(e: &Evaluation, mechanism: &str) -> (Figure, Option<Figure>) {
             let coherence = coherence(bins, *min_coherence, mechanism);
             (gain.with(markers).log_x(), Some(coherence))
         }
-        Evaluation::Periodic(p) => super::periodic::figures(p, mechanism),
+        Evaluation::Periodic(p) => crate::report::periodic::figures(p, mechanism),
     }
 }
 

@@ -1,7 +1,7 @@
 //! Figures of the positioning test (ISO 230-2; paper Fig. 10).
 
-use super::figure::{Figure, Series, Style};
 use crate::experiments::positioning::iso230::{Iso230Report, ReportUnits, TargetStats};
+use crate::report::figure::{Figure, Series, Style};
 
 /// The paper's Fig. 10: x̄↑, x̄↓, their ±2s bands and x̄ over the target, in the
 /// axis's report units (degrees and arc-seconds, or mm and µm).

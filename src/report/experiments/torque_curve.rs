@@ -1,7 +1,7 @@
 //! Figures of the friction-torque test (paper Fig. 9).
 
-use super::figure::{Figure, Series, Style};
 use crate::experiments::torque_curve::{TorqueCurve, TorqueReport};
+use crate::report::figure::{Figure, Series, Style};
 
 /// The paper's Fig. 9: motor torque over time, the velocity reversals marked.
 pub fn over_time(curve: &TorqueCurve, report: &TorqueReport, title: &str) -> Figure {

@@ -9,12 +9,6 @@
 
 use std::f64::consts::TAU;
 
-use super::complex_response::{fit_delay, rms_errors, sigmas, wrap};
-use super::definition::{Definition, SetupError, Source, Stage};
-use super::measured_peaks::measured_peaks;
-use super::model_peaks::{nonlinear_responses, GRID_BAND};
-use super::resonance::drive_stiffnesses;
-use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::experiments::frequency_response::measured::{
     self, fits_whole_curve, of_the_mechanics, DB_PER_NEPER,
 };
@@ -22,6 +16,12 @@ use crate::experiments::frequency_response::FrequencyTest;
 use crate::io::experiment_file::{Delay, Experiment, Kind, Response};
 use crate::model::linear_response::{Channel, LinearResponse};
 use crate::model::{Params, Topology};
+use crate::objectives::complex_response::{fit_delay, rms_errors, sigmas, wrap};
+use crate::objectives::definition::{Definition, SetupError, Source, Stage};
+use crate::objectives::measured_peaks::measured_peaks;
+use crate::objectives::model_peaks::{nonlinear_responses, GRID_BAND};
+use crate::objectives::resonance::drive_stiffnesses;
+use crate::objectives::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 
 const PROPERTIES: Properties = Properties {
     smoothness: Smoothness::Smooth,
@@ -113,7 +113,7 @@ pub struct GainCurve {
     pub gain_db: Vec<f64>,
     /// σ of each gain, dB.
     pub sigma_db: Vec<f64>,
-    /// The complex response: the residual is then complex ([`super::complex_response`]).
+    /// The complex response: the residual is then complex ([`crate::objectives::complex_response`]).
     pub complex: Option<Complex>,
     pub response: Response,
     pub fidelity: Fidelity,
@@ -279,7 +279,7 @@ fn check_orientation(
     };
     match (response, complex) {
         (Response::TableOverMotor, Some(c)) if c.phase_rad.len() >= 3 => {
-            let mut phase = super::complex_response::unwrap(&c.phase_rad);
+            let mut phase = crate::objectives::complex_response::unwrap(&c.phase_rad);
             let shift = TAU * (phase[0] / TAU).round();
             phase.iter_mut().for_each(|p| *p -= shift);
             phase.sort_by(f64::total_cmp);

@@ -1,8 +1,8 @@
 //! Figures of a multisine record's evaluation: both channels' gains with their
 //! resonances and antiresonances, and their coherence over the excited lines.
 
-use super::figure::{Figure, Series, Style};
 use crate::experiments::frequency_response::periodic_evaluation::{Channel, PeriodicEvaluation};
+use crate::report::figure::{Figure, Series, Style};
 
 /// The gains (each channel in its own unit, dB) with the modes marked, and the
 /// coherence.

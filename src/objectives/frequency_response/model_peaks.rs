@@ -128,12 +128,12 @@ pub(crate) fn nonlinear_peak_on_grid(
     ))
 }
 
-/// How the objectives that compare peaks ([`super::resonance`],
-/// [`super::peak_amplitude`]) find the model's: at which fidelity, in which band,
+/// How the objectives that compare peaks ([`crate::objectives::resonance`],
+/// [`crate::objectives::peak_amplitude`]) find the model's: at which fidelity, in which band,
 /// under which test conditions, and on which measured frequencies.
 #[derive(Clone, Debug)]
 pub struct ModelPeaks {
-    pub fidelity: super::Fidelity,
+    pub fidelity: crate::objectives::Fidelity,
     /// Conditions of the nonlinear virtual test.
     pub test: FrequencyTest,
     /// Band in which the model's peaks are sought, Hz.
@@ -149,7 +149,7 @@ impl ModelPeaks {
     pub fn new(
         lowest_hz: f64,
         highest_hz: f64,
-        fidelity: super::Fidelity,
+        fidelity: crate::objectives::Fidelity,
         test: FrequencyTest,
     ) -> Self {
         ModelPeaks {
@@ -163,11 +163,15 @@ impl ModelPeaks {
     /// The model's `n` resonances in the band: the highest linear peaks, each located
     /// in the nonlinear virtual test when the fidelity asks for it (peaks in parallel)
     /// — on the measured frequencies when they are given ([`nonlinear_peak_on_grid`]).
-    pub fn locate(&self, p: &Params, n: usize) -> Result<Vec<Peak>, super::ObjectiveError> {
+    pub fn locate(
+        &self,
+        p: &Params,
+        n: usize,
+    ) -> Result<Vec<Peak>, crate::objectives::ObjectiveError> {
         let guesses = of_linear_response(p, self.band.0, self.band.1, n)?;
         match self.fidelity {
-            super::Fidelity::Linear => Ok(guesses),
-            super::Fidelity::Nonlinear => guesses
+            crate::objectives::Fidelity::Linear => Ok(guesses),
+            crate::objectives::Fidelity::Nonlinear => guesses
                 .par_iter()
                 .map(|g| {
                     match &self.grid_hz {

@@ -3,7 +3,7 @@
 //! one or more settings (lines) — as `rtid experiment speed-loop`, `rtid compare`
 //! and `rtid tune --measured` draw them.
 
-use super::figure::{Figure, Series, Style};
+use crate::report::figure::{Figure, Series, Style};
 
 /// One response: its name, its lines (Hz), gains (dB) and phases (deg), and whether
 /// it is a measurement (drawn as markers) or a model (a line).

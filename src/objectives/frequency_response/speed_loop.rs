@@ -2,7 +2,7 @@
 //! speed loop (actual speed over speed setpoint, `response: "speed_loop"`) against the
 //! model inside its speed controller, exact on the sampled loop
 //! ([`crate::tuning::speed_loop::model`]), line by line as
-//! [`super::complex_response`] weighs a complex response: the errors of ln|T| and of
+//! [`crate::objectives::complex_response`] weighs a complex response: the errors of ln|T| and of
 //! the phase, each over its line's σ (from the coherence and the averages, else 1 %).
 //!
 //! **What it determines.** The loop closes over the PI, the drive gain and the
@@ -14,10 +14,10 @@
 //! with the inertia held, and the values are relative to it. Fitting both is
 //! singular, and the identification's correlations say so.
 
-use super::definition::{Definition, SetupError, Source, Stage};
-use super::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::io::experiment_file::{Experiment, Kind};
 use crate::model::{Params, Topology};
+use crate::objectives::definition::{Definition, SetupError, Source, Stage};
+use crate::objectives::{Detail, Fidelity, Objective, ObjectiveError, Properties, Smoothness};
 use crate::tuning::speed_loop::measured::{is_speed_loop, MeasuredSpeedLoop};
 
 /// The closed speed loop's whole complex response.
@@ -57,7 +57,7 @@ fn determines(exp: &Experiment, p: &Params) -> Vec<&'static str> {
         (_, false) => vec!["Kvp", "Kvi"],
     };
     if matches!(p.topology, Topology::SpurGear | Topology::Direct) {
-        out.extend(super::resonance::drive_stiffnesses(p));
+        out.extend(crate::objectives::resonance::drive_stiffnesses(p));
     }
     out.push("encoder_delay");
     out
@@ -66,7 +66,7 @@ fn determines(exp: &Experiment, p: &Params) -> Vec<&'static str> {
 fn build(source: &Source<'_>, _: Fidelity) -> Result<Box<dyn Objective>, SetupError> {
     let measured = MeasuredSpeedLoop::of(source.experiment).map_err(|reason| SetupError::Data {
         file: source.file.into(),
-        reason,
+        reason: reason.to_string(),
     })?;
     Ok(Box::new(SpeedLoop { measured }))
 }
