@@ -566,6 +566,22 @@ fn an_unreachable_target_names_the_best() {
         dir.path(),
     );
     assert!(err(&out).contains("--max-kpp"), "{}", err(&out));
+    let out = rtid(
+        &[
+            "tune",
+            "--preset",
+            "worm-gear",
+            "--nominal",
+            "--vary",
+            "Jt=1..2",
+        ],
+        dir.path(),
+    );
+    assert!(
+        err(&out).contains("--nominal") && err(&out).contains("--vary"),
+        "{}",
+        err(&out)
+    );
 }
 
 /// `tune FIT.json --preset …` tunes the identified model: the base set with the fit's
@@ -593,13 +609,16 @@ fn the_command_tunes_the_model_of_an_identification() {
     }
     args.push("--json".into());
     let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    // The ranges' quantities are the same (the preset's Jw; the fitted backlash and
+    // frictions would not enter the linearised loop); where they come from differs.
     let settings = |text: String| {
         let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
         v["search"]["wall_s"] = serde_json::Value::Null;
-        v
+        let origins = v["range"]["origins"].take();
+        (v, origins)
     };
-    let by_set = settings(ok(&rtid(&refs, dir.path())));
-    let by_fit = settings(ok(&rtid(
+    let (by_set, _) = settings(ok(&rtid(&refs, dir.path())));
+    let (by_fit, origins) = settings(ok(&rtid(
         &[
             "tune",
             fit_path.to_str().unwrap(),
@@ -612,6 +631,25 @@ fn the_command_tunes_the_model_of_an_identification() {
         dir.path(),
     )));
     assert_eq!(by_fit, by_set);
+    let theta_bw = origins
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|o| o["name"] == "theta_bw")
+        .unwrap_or_else(|| panic!("{origins}"));
+    // The shipped fit (a torque curve's rough cost, no bootstrap) knows its standard
+    // errors to be lower bounds: its parameters are named and held, not given the
+    // preset's held range in their place.
+    let why = theta_bw["left_out"].as_str().unwrap_or_default();
+    assert!(
+        theta_bw["from"] == "the fit" && why.contains("lower bound"),
+        "{theta_bw}"
+    );
+    assert_eq!(
+        by_fit["range"]["vary"][0]["name"], "Jw",
+        "{}",
+        by_fit["range"]
+    );
     let e = err(&rtid(
         &["tune", "missing.json", "--preset", "worm-gear"],
         dir.path(),

@@ -285,6 +285,10 @@ def tune(
     notch_depth_db: float = -20.0,
     notch_min_width: float = 0.2,
     torque_reserve: float = 0.2,
+    fit: IdentifyResult | Mapping[str, Any] | str | os.PathLike[str] | None = None,
+    vary: Mapping[str, tuple[float, float]] | None = None,
+    delay_periods: int = 0,
+    nominal: bool = False,
     progress: bool | Callable[..., object] | None = None,
 ) -> Tuning: ...
 

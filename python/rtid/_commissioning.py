@@ -193,7 +193,8 @@ class Tuning:
 def tune(params: Params, *, phase_margin_deg: float = 50.0, gain_margin_db: float = 6.0,
          objective: str = "positioning", loop: str | None = None, max_kpp: float | None = None,
          max_bandwidth_hz: float | None = None, notch_depth_db: float = -20.0,
-         notch_min_width: float = 0.2, torque_reserve: float = 0.2, progress=None) -> Tuning:
+         notch_min_width: float = 0.2, torque_reserve: float = 0.2, fit=None, vary: dict | None = None,
+         delay_periods: int = 0, nominal: bool = False, progress=None) -> Tuning:
     """Tunes the velocity PI, the position gain and notch filters on the nonlinear
     model (``rtid tune``; docs/tuning.md): candidates whose cascade as it runs keeps
     the margins, weighed against today's settings.
@@ -206,6 +207,13 @@ def tune(params: Params, *, phase_margin_deg: float = 50.0, gain_margin_db: floa
         loop: ``semi_closed`` or ``full_closed`` (default the set's).
         max_kpp, max_bandwidth_hz, notch_depth_db, notch_min_width, torque_reserve:
             the limits of the search, as the flags of the same names.
+        fit: an identification (:class:`IdentifyResult`, its ``to_dict()``, or a result
+            file) whose values are set in ``params`` and whose intervals make the range.
+        vary: the machine as it may be, ``{"Jt": (0.5, 2)}``: ratios of each value
+            (``--vary``); delay_periods: control periods of delay beyond the model's
+            (``--delay-periods``); nominal: the nominal machine alone (``--nominal``).
+            Without them the range is the fit's intervals and the held ranges, the four
+            that move today's margins most, as ``rtid tune``'s.
         progress: a progress bar of the candidates weighed, as :func:`rtid.identify`'s
             (a function is called as ``progress(done, total)``).
 
@@ -236,12 +244,33 @@ def tune(params: Params, *, phase_margin_deg: float = 50.0, gain_margin_db: floa
         "max_bandwidth_hz": _positive_or_none(max_bandwidth_hz, "max_bandwidth_hz"),
         "notch_depth_db": depth, "notch_min_width": width, "torque_reserve": reserve,
     }
+    options.update(_range_options(vary, delay_periods, nominal))
+    text = None if fit is None else _fit_json(fit, "fit")
     callback, close = _progress.reporter(progress, "tune", "candidate")
     try:
-        summary, tuned = _rtid.tune(_params_arg(params), options, callback)
+        summary, tuned = _rtid.tune(_params_arg(params), options, text, callback)
     finally:
         close()
     return Tuning(json.loads(summary), Params(tuned))
+
+
+def _range_options(vary, delay_periods, nominal) -> dict:
+    """``rtid tune``'s --vary, --delay-periods and --nominal, checked."""
+    pairs = []
+    if vary is not None:
+        if not isinstance(vary, Mapping):
+            raise TypeError(f"vary: expected a dict {{name: (low, high)}}, got {type(vary).__name__}")
+        for name, ratios in vary.items():
+            try:
+                low, high = ratios
+            except (TypeError, ValueError):
+                raise RtidError(f"vary: {name}: give (low, high), ratios of the value, e.g. (0.5, 2)") from None
+            pairs.append((str(name), _finite_number(low, f"vary: {name}"), _finite_number(high, f"vary: {name}")))
+    if isinstance(delay_periods, bool) or not isinstance(delay_periods, int) or delay_periods < 0:
+        raise RtidError(f"delay_periods: {delay_periods!r}: a whole number of control periods, 0 or more")
+    if nominal and (pairs or delay_periods):
+        raise RtidError("nominal: the nominal machine alone, without vary or delay_periods")
+    return {"vary": pairs, "delay_periods": delay_periods, "nominal": bool(nominal)}
 
 
 def _positive_or_none(value, name: str):

@@ -16,7 +16,7 @@ use rtid::io::compensation_file;
 use rtid::io::drive_settings::{sinamics, sinumerik, ServoSettings};
 use rtid::prediction::request::{self, Request, RequestError};
 use rtid::prediction::{self, DrawSource, Setup};
-use rtid::tuning::{self, Limits, Objective, Options, Targets};
+use rtid::tuning::{self, Limits, Objective, Options, Range, Targets, Vary};
 
 /// `rtid tune`'s options.
 #[derive(FromPyObject)]
@@ -32,21 +32,34 @@ pub struct TuneOptions {
     notch_depth_db: f64,
     notch_min_width: f64,
     torque_reserve: f64,
+    /// `--vary`: (name, low, high) ratios.
+    vary: Vec<(String, f64, f64)>,
+    delay_periods: u32,
+    nominal: bool,
 }
 
-/// Tunes the cascade of `params` on the nonlinear model (`rtid tune`); returns
-/// `rtid tune --json`'s JSON and the tuned set. `progress(done, total)`, if given, is
+/// Tunes the cascade of `params` (with `fit`'s values set, where given) on the
+/// nonlinear model (`rtid tune`); returns `rtid tune --json`'s JSON and the tuned set.
+/// The range as the command line's: `vary` and `delay_periods`, the nominal machine,
+/// or the fit's intervals and the held ranges. `progress(done, total)`, if given, is
 /// called as the candidates are weighed.
 #[pyfunction]
-#[pyo3(signature = (params, options, progress=None))]
+#[pyo3(signature = (params, options, fit=None, progress=None))]
 pub fn tune(
     py: Python<'_>,
     params: PyRef<'_, PyParams>,
     options: TuneOptions,
+    fit: Option<&str>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<(String, PyParams)> {
     let mut p = params.inner.clone();
     drop(params);
+    let fit = fit.map(|text| read_fit(text, "fit")).transpose()?;
+    if let Some(f) = &fit {
+        f.apply_to(&mut p)
+            .and_then(|()| p.validate())
+            .map_err(|e| with_context("fit: its values on the model", &e))?;
+    }
     if let Some(mode) = &options.loop_mode {
         p.controller.loop_mode = mode.parse().map_err(|e| with_context("loop", &e))?;
     }
@@ -67,8 +80,7 @@ pub fn tune(
             notch_min_width: options.notch_min_width,
         },
         torque_reserve: options.torque_reserve,
-        // The command line's defaults without --vary, --delay-periods, --ensemble.
-        range: tuning::range::default_range(&p),
+        range: tune_range(&options, &p, fit.as_ref()),
         ensemble: Default::default(),
     };
     let (done, total) = (AtomicUsize::new(0), AtomicUsize::new(0));
@@ -91,6 +103,22 @@ pub fn tune(
         .and_then(|v| rtid::io::json::pretty(&v))
         .map_err(|e| rtid_error(&e))?;
     Ok((json, PyParams { inner: t.params }))
+}
+
+/// The range `options` ask for on `p` ([`tuning::range::default::asked`]).
+fn tune_range(options: &TuneOptions, p: &rtid::Params, fit: Option<&IdentifyResult>) -> Range {
+    let f = fit.map(|f| f.spreads()).unwrap_or_default();
+    let vary = options
+        .vary
+        .iter()
+        .map(|(name, low, high)| Vary {
+            name: name.clone(),
+            low: *low,
+            high: *high,
+        })
+        .collect();
+    let (delay, nominal) = (options.delay_periods, options.nominal);
+    tuning::range::default::asked(vary, delay, nominal, p, (&f.spreads, &f.without))
 }
 
 /// The servo settings of `params` as a SINAMICS parameter list (`rtid tune

@@ -134,10 +134,24 @@ def test_tune_is_the_cli_s(cli, drive, tmp_path):
                 json_out=True)
     t = rtid.tune(drive, progress=False)
     for key in ("before", "after", "proposes", "targets", "loop", "objective", "warnings", "check",
-                "resonances", "candidates"):
+                "resonances", "candidates", "range"):
         close(shown[key], t.summary[key], rel=1e-12)
     assert t.params == rtid.params(path=tuned_file)
     assert t.sinamics() == sinamics.read_text()
+    # The default range: the preset's held ranges that move today's margins.
+    varied = [v["name"] for v in t.summary["range"]["vary"]]
+    assert "Jt" in varied and "ft" not in varied, t.summary["range"]
+
+
+def test_a_tunings_range_is_checked_before_it_runs(drive):
+    with pytest.raises(rtid.RtidError, match="vary: Jt"):
+        rtid.tune(drive, vary={"Jt": (0.5,)}, progress=False)
+    with pytest.raises(rtid.RtidError, match="delay_periods"):
+        rtid.tune(drive, delay_periods=-1, progress=False)
+    with pytest.raises(rtid.RtidError, match="nominal"):
+        rtid.tune(drive, nominal=True, vary={"Jt": (0.5, 2)}, progress=False)
+    with pytest.raises(rtid.RtidError, match="Jt"):
+        rtid.tune(drive, vary={"Jt": (2, 0.5)}, progress=False)
 
 
 def test_a_tuned_controller_runs_in_the_tests_as_the_cli_s_tune_file(cli, tmp_path):

@@ -7,6 +7,7 @@ use anyhow::{bail, Context};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Table};
 
 use crate::cli::common::inputs::refuse_overwrite;
+use crate::cli::common::model_args;
 use crate::cli::common::plot::Plot;
 use crate::cli::ModelArgs;
 use rtid::experiments::positioning::ensemble;
@@ -45,6 +46,14 @@ in the controller. Today's settings are a candidate: if none beats them, tune sa
 proposes nothing new; a proposed setting that makes any criterion worse than today's \
 carries a warning naming it and by how much.
 
+The settings must hold on the machine as it may be. By default that is the machine as \
+the data leave it: each parameter the fit (FIT.json) determined over its interval, each \
+held range it carried, and the parameter set's own held ranges (a preset's uncertain \
+values, `rtid params`) — the four that move today's margins most, by 0.5° or 0.5 dB at \
+least; the others (a backlash, a Coulomb friction) are listed above the table, held at \
+their values, with the reason. --vary and --delay-periods give a range of one's own, \
+--nominal the nominal machine alone.
+
 The table shows each setting's gains with their units (Tn = Kvp/Kvi; Kv in 1/s and in the \
 CNC's (rev/min)/rev or (m/min)/mm), the margins of the velocity loop alone and of the \
 cascade as it runs, and the check before and after. With -o the tuned parameter file is \
@@ -58,6 +67,7 @@ Examples:
   rtid tune fit.json --preset worm-gear -o worm-tuned.json     (the identified model)
   rtid tune --preset two-mass --objective following --max-kpp 60 --json
   rtid tune --preset two-mass --phase-margin-deg 60 --gain-margin-db 10 --plot loop.svg
+  rtid tune --preset direct-drive --vary Jt=1..3 --delay-periods 1   (a range of one's own)
 
 The tuned file's setpoint filters are the notches only: filters of the input (a \
 low-pass, say) are in the \"before\" column and not carried over.";
@@ -110,6 +120,11 @@ pub struct Args {
     /// to the encoder's dead time): the targets must hold with each.
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub delay_periods: u32,
+    /// Tune for the nominal machine alone. Without --vary, --delay-periods or this, the
+    /// range is the fit's intervals and the parameter set's held ranges (a preset's
+    /// uncertain values), the four that move today's margins most.
+    #[arg(long, conflicts_with_all = ["vary", "delay_periods"])]
+    pub nominal: bool,
     /// Runs in each ensemble the check weighs a setting by (1 to 256): the standard
     /// ISO 230-2 cycle and the servo's step and move, perturbed by sub-count offsets
     /// that do not change the machine.
@@ -159,7 +174,15 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let plot = outputs(&a)?;
-    let mut p = crate::cli::common::model_args::fitted(&a.model, a.fit.as_deref(), None)?;
+    let mut p = a.model.load()?;
+    let fit = match &a.fit {
+        Some(path) => {
+            let fit = model_args::read_fit(path)?;
+            model_args::apply_fit(&mut p, &fit, path)?;
+            Some(fit)
+        }
+        None => None,
+    };
     if let Some(mode) = a.loop_mode {
         if mode != p.controller.loop_mode && !a.quiet {
             eprintln!(
@@ -169,7 +192,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         p.controller.loop_mode = mode;
     }
-    let options = options(&a, &p)?;
+    let options = options(&a, &p, fit.as_ref())?;
     let measured = match &a.measured {
         Some(path) => {
             let m = crate::cli::tune_measured::read(path)?;
@@ -255,7 +278,11 @@ fn outputs(a: &Args) -> anyhow::Result<Plot> {
 
 /// The search's targets, objective, limits, range and ensemble (the library checks
 /// the range against `p` and the ensemble's size).
-fn options(a: &Args, p: &rtid::Params) -> anyhow::Result<Options> {
+fn options(
+    a: &Args,
+    p: &rtid::Params,
+    fit: Option<&rtid::identify::IdentifyResult>,
+) -> anyhow::Result<Options> {
     if !(a.phase_margin_deg > 0.0 && a.phase_margin_deg < 180.0) {
         bail!(
             "--phase-margin-deg {}: a phase margin lies between 0° and 180°",
@@ -281,24 +308,18 @@ fn options(a: &Args, p: &rtid::Params) -> anyhow::Result<Options> {
             notch_min_width: a.notch_min_width,
         },
         torque_reserve: a.torque_reserve,
-        range: range(a, p),
+        range: range(a, p, fit),
         ensemble: ensemble::Ensemble {
             members: a.ensemble,
         },
     })
 }
 
-/// The range of machines: `--vary` and `--delay-periods`, or the parameter set's
-/// own where neither is given.
-fn range(a: &Args, p: &rtid::Params) -> Range {
-    if a.vary.is_empty() && a.delay_periods == 0 {
-        tuning::range::default_range(p)
-    } else {
-        Range {
-            vary: a.vary.clone(),
-            delay_periods: a.delay_periods,
-        }
-    }
+/// The range of machines ([`tuning::range::default::asked`]).
+fn range(a: &Args, p: &rtid::Params, fit: Option<&rtid::identify::IdentifyResult>) -> Range {
+    let f = fit.map(|f| f.spreads()).unwrap_or_default();
+    let (vary, delay) = (a.vary.clone(), a.delay_periods);
+    tuning::range::default::asked(vary, delay, a.nominal, p, (&f.spreads, &f.without))
 }
 
 /// `NAME=LOW..HIGH`: a parameter's ratios.
@@ -402,6 +423,7 @@ fn print_table(p: &rtid::Params, t: &Tuned) {
         "{}: {} loop; targets on the cascade as it runs: phase margin ≥ {}°, gain margins ≥ {} dB up and down, no conditional window",
         p.name, t.loop_mode, t.targets.phase_margin_deg, t.targets.gain_margin_db
     );
+    print_range(&t.range);
     let mut table = Table::new();
     table.load_preset(UTF8_FULL_CONDENSED);
     let after = if t.proposes {
@@ -418,6 +440,28 @@ fn print_table(p: &rtid::Params, t: &Tuned) {
     }
     println!("{table}");
     print_search(t);
+}
+
+/// Where a default range's quantities come from, and those left at their values.
+fn print_range(r: &Range) {
+    if r.origins.is_empty() {
+        return;
+    }
+    println!("the range (the fit's intervals and the held ranges; --vary or --nominal to choose):");
+    for o in &r.origins {
+        let s = &o.spread;
+        match &o.left_out {
+            None => println!(
+                "  {} ×{}…{}: {}; moves today's margins by {:.1}",
+                s.name,
+                Num(tuning::range::round4(s.low)),
+                Num(tuning::range::round4(s.high)),
+                s.from,
+                o.effect
+            ),
+            Some(why) => println!("  {} held at its value: {why}", s.name),
+        }
+    }
 }
 
 /// A row of the table: `label`, then `f` of today's setting and of the proposed one.

@@ -58,10 +58,10 @@ impl Default for Options {
 }
 
 impl Options {
-    /// The defaults with the parameter set's own range.
+    /// The defaults with the parameter set's own range (its held ranges).
     pub fn for_params(p: &Params) -> Options {
         Options {
-            range: super::range::default_range(p),
+            range: super::range::default_range(p, &[], &[]),
             ..Options::default()
         }
     }

@@ -805,45 +805,22 @@ fn parameter_table(r: &IdentifyResult) -> Table {
     t
 }
 
-/// The 95 % interval of `name` (identified `v`) that holds, and what it comes from:
-/// the bootstrap's, the standard error widened by the held ranges' shifts, or the
-/// standard error alone where it is not a lower bound.
+/// The 95 % interval of `name` (identified `v`) that holds, and what it comes from
+/// ([`IdentifyResult::interval`]).
 fn interval_of(r: &IdentifyResult, name: &str, v: f64) -> (String, String) {
+    use rtid::identify::result::interval::FitInterval;
     let cell = |lo: f64, hi: f64| {
         let rel = |x: f64| 100.0 * (x - v) / v.abs();
         format!("{lo:.4e} … {hi:.4e} ({:+.2} / {:+.2} %)", rel(lo), rel(hi))
     };
-    let undetermined = r
-        .plan
-        .as_ref()
-        .is_some_and(|p| p.undetermined.iter().any(|n| n == name));
-    if undetermined {
-        return ("not determined".into(), "no record determines it".into());
-    }
-    if let Some(i) = r.resampling.as_ref().and_then(|s| s.intervals.get(name)) {
-        let n = r.resampling.as_ref().map_or(0, |s| s.fitted);
-        return (cell(i.lower, i.upper), format!("bootstrap, {n} replicates"));
-    }
-    let se = r.standard_error(name);
-    let lower_bounds = r.uncertainty.as_ref().is_some_and(|u| u.lower_bounds);
-    match se {
-        None => ("not determined".into(), "no standard error".into()),
-        Some(_) if lower_bounds => (
+    match r.interval(name) {
+        Some(FitInterval::Bounds { lower, upper, from }) => (cell(lower, upper), from),
+        Some(FitInterval::NotDetermined(why)) => ("not determined".into(), why.into()),
+        Some(FitInterval::LowerBound) => (
             "—".into(),
             "the standard error is a lower bound here: --intervals bootstrap".into(),
         ),
-        Some(se) if !r.held.is_empty() => {
-            let held: f64 = r.held.iter().map(|h| h.spread(name).powi(2)).sum();
-            let s = (se * se + held).sqrt();
-            (
-                cell(v - 1.96 * s, v + 1.96 * s),
-                "standard error and held ranges".into(),
-            )
-        }
-        Some(se) => (
-            cell(v - 1.96 * se, v + 1.96 * se),
-            "±1.96 standard errors".into(),
-        ),
+        None => ("—".into(), "not fitted".into()),
     }
 }
 

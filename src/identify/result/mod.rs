@@ -3,6 +3,7 @@
 
 pub mod comparison;
 pub mod held;
+pub mod interval;
 pub mod profile;
 pub mod record_plan;
 pub mod resampling;

@@ -11,6 +11,8 @@
 //! The grid holds the range's corners, and with one quantity its geometric middle.
 //! A setting's worst case over the range is its smallest margins at these points.
 
+pub mod default;
+
 use serde::Serialize;
 
 use super::sampled::{Closure, DiscretePlant, SampledLoop};
@@ -40,6 +42,10 @@ pub struct Range {
     pub vary: Vec<Vary>,
     /// Control periods of delay beyond the model's, from 0 to this (whole periods).
     pub delay_periods: u32,
+    /// Where a default range's quantities come from, and those it left at their
+    /// values ([`default::default_range`]; empty for `--vary`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub origins: Vec<default::Origin>,
 }
 
 /// One machine of the range: each varied parameter's ratio, the added delay.
@@ -294,7 +300,8 @@ impl Point {
     }
 }
 
-fn round4(x: f64) -> f64 {
+/// `x` to four significant digits (a ratio as the table names it).
+pub fn round4(x: f64) -> f64 {
     let k = 10f64.powi(3 - x.abs().log10().floor() as i32);
     (x * k).round() / k
 }
@@ -338,13 +345,7 @@ fn product(lists: &[Vec<f64>]) -> Vec<Vec<f64>> {
     })
 }
 
-/// The default range of a parameter set: where the held ranges of its uncertain
-/// values (a preset's, a parameter file's) and an identification's intervals would
-/// come in. Today the nominal machine alone: `--vary` and `--delay-periods` give the
-/// range (issue 58; the presets' held ranges are being added to the presets).
-pub fn default_range(_p: &Params) -> Range {
-    Range::nominal()
-}
+pub use default::default_range;
 
 /// The machines of `range` on `p`, each with its drive held over a control period.
 pub struct Machines {
@@ -471,7 +472,7 @@ mod tests {
                 low,
                 high,
             }],
-            delay_periods: 0,
+            ..Range::default()
         }
     }
 
@@ -509,6 +510,7 @@ mod tests {
                 },
             ],
             delay_periods: 2,
+            ..Range::default()
         };
         let p = presets::load("two-mass").unwrap();
         r.check(&p).unwrap();
