@@ -452,12 +452,15 @@ fn print_range(r: &Range) {
         let s = &o.spread;
         match &o.left_out {
             None => println!(
-                "  {} ×{}…{}: {}; moves today's margins by {:.1}",
+                "  {} ×{}…{}: {}; {}",
                 s.name,
                 Num(tuning::range::round4(s.low)),
                 Num(tuning::range::round4(s.high)),
                 s.from,
                 o.effect
+                    .map_or("today's loop is unstable: kept unranked".into(), |e| {
+                        format!("moves today's margins by {e:.1}° / dB")
+                    })
             ),
             Some(why) => println!("  {} held at its value: {why}", s.name),
         }

@@ -15,6 +15,7 @@
 use serde::Serialize;
 
 use super::{Range, Vary};
+use crate::model::modes::LinearModel;
 use crate::model::{Params, Spread};
 use crate::tuning::margins::GRID_POINTS;
 use crate::tuning::sampled::{Closure, DiscretePlant, SampledLoop};
@@ -25,6 +26,8 @@ pub const MAX_DEFAULT: usize = 4;
 /// The least change of a margin (° of phase, dB of gain) at a quantity's ends that
 /// puts it in the default range.
 pub const MIN_EFFECT: f64 = 0.5;
+/// The effect of a quantity that makes the loop invalid at an end.
+pub const MAX_EFFECT: f64 = 180.0;
 /// The margin grid the effects are measured on (coarser than the tuning's: the
 /// effect ranks quantities, the range's own analysis decides).
 const EFFECT_GRID: usize = GRID_POINTS / 4;
@@ -35,8 +38,10 @@ pub struct Origin {
     #[serde(flatten)]
     pub spread: Spread,
     /// The largest change of today's cascade margins at its ends (° or dB; a margin
-    /// that appears or vanishes counts its whole size).
-    pub effect: f64,
+    /// that appears or vanishes counts its whole size, an unstable end
+    /// [`MAX_EFFECT`]); `None` where it does not enter the linearised loop or
+    /// today's loop is unstable (then the range keeps the first four, unranked).
+    pub effect: Option<f64>,
     /// Why it is held at its value (`None`: it is in the range).
     pub left_out: Option<String>,
 }
@@ -67,7 +72,8 @@ pub fn default_range(p: &Params, given: &[Spread], left: &[(String, String)]) ->
             }
         })
         .collect();
-    origins.sort_by(|a, b| b.effect.total_cmp(&a.effect));
+    let rank = |o: &Origin| o.effect.unwrap_or(-1.0);
+    origins.sort_by(|a, b| rank(b).total_cmp(&rank(a)));
     let mut kept = 0;
     for o in origins.iter_mut().filter(|o| o.left_out.is_none()) {
         kept += 1;
@@ -84,7 +90,7 @@ pub fn default_range(p: &Params, given: &[Spread], left: &[(String, String)]) ->
             high: 1.0,
             from: "the fit".into(),
         },
-        effect: 0.0,
+        effect: None,
         left_out: Some(why.clone()),
     }));
     Range {
@@ -126,8 +132,10 @@ pub fn asked(
     }
 }
 
-/// `q`'s effect on today's margins `today`, and why it is left out if it is.
-fn weigh(p: &Params, today: &LoopMargins, q: &Spread) -> (f64, Option<String>) {
+/// `q`'s effect on today's margins `today` (`None` where it does not enter the
+/// linearised loop, or today's loop is unstable and has no margins to move), and
+/// why it is left out if it is.
+fn weigh(p: &Params, today: &LoopMargins, q: &Spread) -> (Option<f64>, Option<String>) {
     let probe = Range {
         vary: vec![Vary {
             name: q.name.clone(),
@@ -141,33 +149,41 @@ fn weigh(p: &Params, today: &LoopMargins, q: &Spread) -> (f64, Option<String>) {
         let why = why
             .strip_prefix(&format!("--vary {}: ", q.name))
             .unwrap_or(&why);
-        return (0.0, Some(why.to_string()));
+        return (None, Some(why.to_string()));
     }
-    let effect = [q.low, q.high]
+    let ends: Result<Vec<Params>, _> = [q.low, q.high]
         .into_iter()
         .map(|ratio| {
             let point = super::Point {
                 ratios: vec![ratio],
                 delay_periods: 0,
             };
-            probe
-                .apply(p, &point)
-                .ok()
-                .and_then(|at| margins_of(&at).ok())
-                .map_or(f64::INFINITY, |m| change(today, &m))
+            probe.apply(p, &point)
         })
-        .fold(0.0, f64::max);
-    if !effect.is_finite() {
-        return (0.0, Some("the drive is not valid at its ends".into()));
-    }
-    let left_out = match effect {
-        0.0 => Some("does not enter the linearised loop".into()),
-        e if e < MIN_EFFECT => Some(format!(
-            "moves today's margins by less than {MIN_EFFECT}° / {MIN_EFFECT} dB"
-        )),
-        _ => None,
+        .collect();
+    let Ok(ends) = ends else {
+        return (None, Some("the drive is not valid at its ends".into()));
     };
-    (effect, left_out)
+    if !ends.iter().any(|at| enters(p, at)) {
+        return (None, Some("does not enter the linearised loop".into()));
+    }
+    if !today.stability.stable {
+        return (None, None);
+    }
+    let effect = ends
+        .iter()
+        .map(|at| margins_of(at).map_or(f64::INFINITY, |m| change(today, &m)))
+        .fold(0.0, f64::max);
+    let left_out = (effect < MIN_EFFECT)
+        .then(|| format!("moves today's margins by less than {MIN_EFFECT}° / {MIN_EFFECT} dB"));
+    (Some(effect.min(MAX_EFFECT)), left_out)
+}
+
+/// Whether `at` differs from `p` in the linearised drive (its matrices, the
+/// encoder's dead time).
+fn enters(p: &Params, at: &Params) -> bool {
+    let linear = |x: &Params| LinearModel::new(x).ok();
+    linear(p) != linear(at) || p.encoder_delay != at.encoder_delay
 }
 
 /// Today's cascade on `p`'s drive.
@@ -220,13 +236,17 @@ mod tests {
         // The backlashes and the fluctuation do not enter the linearised loop.
         for name in ["theta_bw", "theta_bg", "W"] {
             let o = named(&r, name);
-            assert_eq!(o.effect, 0.0, "{o:?}");
-            assert!(o.left_out.is_some(), "{o:?}");
+            assert_eq!(o.effect, None, "{o:?}");
+            let why = o.left_out.as_deref();
+            assert_eq!(why, Some("does not enter the linearised loop"), "{o:?}");
         }
         // The spur gears' inertia on the motor's side does, by its held 50 %; the
         // table's, behind the worm's ratio, hardly (0.04° at ±25 %).
         let jw = named(&r, "Jw");
-        assert!(jw.left_out.is_none() && jw.effect >= MIN_EFFECT, "{jw:?}");
+        assert!(
+            jw.left_out.is_none() && jw.effect >= Some(MIN_EFFECT),
+            "{jw:?}"
+        );
         assert_eq!(
             r.vary
                 .iter()
@@ -235,7 +255,7 @@ mod tests {
             Some((0.5, 1.5))
         );
         let jt = named(&r, "Jt");
-        assert!(jt.effect > 0.0 && jt.left_out.is_some(), "{jt:?}");
+        assert!(jt.effect > Some(0.0) && jt.left_out.is_some(), "{jt:?}");
         assert!(r.vary.len() <= MAX_DEFAULT);
         r.check(&p).unwrap();
     }
@@ -251,6 +271,18 @@ mod tests {
         assert!(named(&r, "Jt").spread.from.contains("fit's interval"));
         assert_eq!(named(&r, "Jm").left_out.as_deref(), Some("not determined"));
         assert!(!r.vary.iter().any(|v| v.name == "Jm"));
+    }
+
+    #[test]
+    fn with_todays_loop_unstable_the_quantities_that_enter_it_are_kept_unranked() {
+        let mut p = presets::load("two-mass").unwrap();
+        p.controller.kvp *= 1000.0;
+        assert!(!margins_of(&p).unwrap().stability.stable);
+        let r = default_range(&p, &[], &[]);
+        let mut varied: Vec<&str> = r.vary.iter().map(|v| v.name.as_str()).collect();
+        varied.sort();
+        assert_eq!(varied, ["Cm", "Ct", "Jm", "Jt"], "{:?}", r.origins);
+        assert!(r.origins.iter().all(|o| o.effect.is_none()));
     }
 
     #[test]
