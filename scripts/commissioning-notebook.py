@@ -56,8 +56,11 @@ print(fit.report())"""),
 and position gains whose cascade, exact on the sampled loop, keeps a 50° phase margin
 and 6 dB gain margins both ways, and weighs them on the nonlinear model — the ISO
 230-2 cycle after the compensation built for each, a step, the following error —
-against today's settings."""),
-    ("code", """tuning = rtid.tune(fit.params, progress=False)
+against today's settings. Given the fit, the settings must hold over the machine as
+the data leave it: the fit's intervals and the datasheet's held ranges, the ones that
+move today's margins (`tuning.summary["range"]`)."""),
+    ("code", """tuning = rtid.tune(fit.params, fit=fit, progress=False)
+print("range:", ", ".join(f"{v['name']} x{v['low']:.3g}..{v['high']:.3g}" for v in tuning.summary["range"]["vary"]))
 for name in ("Kvp", "Kvi", "Kpp"):
     print(f"{name:4} {tuning.before[name]:10.4g} -> {tuning.after[name]:10.4g}")
 print("filters:", [f"{f['type']} {f.get('centre_hz', f.get('frequency_hz')):.1f} Hz" for f in tuning.after["filters"]])
