@@ -17,13 +17,13 @@ pub mod presets;
 pub mod registry;
 pub mod rest;
 pub mod setpoint_filter;
-pub mod spread;
 
 pub use by_name::MAGNITUDE_RANGE;
 pub use drive::{idx, Drive, NSTATE};
 pub use kernel::{Kernel, States};
 pub use lane_drive::{LaneDrive, LaneKey, LaneMismatch};
-pub use params::{Axis, ControllerParams, HeldRange, LoopMode, ParamError, Params, Topology};
+pub use params::{
+    Axis, ControllerParams, HeldRange, LoopMode, ParamError, Params, Spread, Topology,
+};
 pub use registry::{spec, Applies, Constraint, ParamSpec, PARAMS};
 pub use setpoint_filter::{FilterError, SetpointFilter, MAX_FILTERS};
-pub use spread::Spread;

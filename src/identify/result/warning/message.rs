@@ -20,12 +20,7 @@ pub(super) fn text(w: &Warning) -> String {
         }
         Warning::DistinctSolution { start, solution } => distinct_solution(*start, solution),
         Warning::AtBound { name, side } => at_bound(name, *side),
-        Warning::PhaseDelay { source, delay_s } => format!(
-            "{source}: the phase error grows with frequency like a delay of {:.1} µs that the \
-             manifest does not state — a measurement chain's delay (filters, a recorder)? \
-             State it as conditions.delay_s (seconds), or \"unknown\" to fit it",
-            1e6 * delay_s
-        ),
+        Warning::PhaseDelay { source, delay_s } => phase_delay(source, *delay_s),
         Warning::ResonanceMiss {
             source,
             max_miss_hz,
@@ -34,20 +29,8 @@ pub(super) fn text(w: &Warning) -> String {
             source,
             position_rms,
             position_span,
-        } => format!(
-            "{source}: the replay does not follow the record (position error {position_rms:.4e} \
-             RMS over a span of {position_span:.4e}, SI): the fitted values do not describe this \
-             drive — check the controller's settings, the loop and the frame (ratio)"
-        ),
-        Warning::NotDetermined { names } => format!(
-            "{} not determined: no record moves {} apart from the other fitted parameters, nor \
-             do all of them together; held at the start value, without an interval (fix {}, \
-             or add a record that moves {})",
-            names.join(", "),
-            if names.len() == 1 { "it" } else { "them" },
-            if names.len() == 1 { "it" } else { "them" },
-            if names.len() == 1 { "it" } else { "them" },
-        ),
+        } => not_followed(source, *position_rms, *position_span),
+        Warning::NotDetermined { names } => not_determined(names),
         Warning::NoEffect { name } => {
             format!("{name} has no effect on the residuals: the data say nothing about it")
         }
@@ -93,17 +76,12 @@ pub(super) fn text(w: &Warning) -> String {
             noise_db,
             max_miss_percent,
             assumed,
-        } => format!(
-            "{source}: the linear fit explains the gain curve within its noise (misfit \
-             {linear_misfit_db:.3} dB RMS, the curve's own noise {noise_db:.3} dB), so it \
-             stands: the nonlinear test at its parameters{} moves the resonances by up to \
-             {max_miss_percent:.2} %, but these data do not show it (--model nonlinear \
-             corrects all the same)",
-            if assumed.is_empty() {
-                String::new()
-            } else {
-                format!(", with {assumed} assumed,")
-            }
+        } => linear_stands(
+            source,
+            *linear_misfit_db,
+            *noise_db,
+            *max_miss_percent,
+            assumed,
         ),
         Warning::ProfileOpen {
             name,
@@ -118,6 +96,54 @@ pub(super) fn text(w: &Warning) -> String {
             fit_cost,
         } => profile_better_fit(name, *value, *cost, *fit_cost),
     }
+}
+
+fn phase_delay(source: &str, delay_s: f64) -> String {
+    format!(
+        "{source}: the phase error grows with frequency like a delay of {:.1} µs that the \
+         manifest does not state — a measurement chain's delay (filters, a recorder)? \
+         State it as conditions.delay_s (seconds), or \"unknown\" to fit it",
+        1e6 * delay_s
+    )
+}
+
+fn not_followed(source: &str, position_rms: f64, position_span: f64) -> String {
+    format!(
+        "{source}: the replay does not follow the record (position error {position_rms:.4e} \
+         RMS over a span of {position_span:.4e}, SI): the fitted values do not describe this \
+         drive — check the controller's settings, the loop and the frame (ratio)"
+    )
+}
+
+fn not_determined(names: &[String]) -> String {
+    let them = if names.len() == 1 { "it" } else { "them" };
+    format!(
+        "{} not determined: no record moves {them} apart from the other fitted parameters, nor \
+         do all of them together; held at the start value, without an interval (fix {them}, \
+         or add a record that moves {them})",
+        names.join(", "),
+    )
+}
+
+fn linear_stands(
+    source: &str,
+    linear_misfit_db: f64,
+    noise_db: f64,
+    max_miss_percent: f64,
+    assumed: &str,
+) -> String {
+    let assumed = if assumed.is_empty() {
+        String::new()
+    } else {
+        format!(", with {assumed} assumed,")
+    };
+    format!(
+        "{source}: the linear fit explains the gain curve within its noise (misfit \
+         {linear_misfit_db:.3} dB RMS, the curve's own noise {noise_db:.3} dB), so it \
+         stands: the nonlinear test at its parameters{assumed} moves the resonances by up to \
+         {max_miss_percent:.2} %, but these data do not show it (--model nonlinear \
+         corrects all the same)"
+    )
 }
 
 fn method_switched(residuals: usize, parameters: usize) -> String {
