@@ -91,6 +91,25 @@ pub struct ComplexPoints {
     pub sigma_phase: Option<Vec<f64>>,
 }
 
+/// The RMS of the gain errors (dB) and of the phase errors (deg) of complex residuals
+/// `r` (gain block, then phase block) with their σs.
+pub fn rms_errors(r: &[f64], sigma_ln: &[f64], sigma_phase: &[f64]) -> (f64, f64) {
+    let n = sigma_ln.len();
+    let rms = |part: &[f64], s: &[f64], unit: f64| {
+        (part
+            .iter()
+            .zip(s)
+            .map(|(x, s)| (x * s * unit).powi(2))
+            .sum::<f64>()
+            / n.max(1) as f64)
+            .sqrt()
+    };
+    (
+        rms(&r[..n], sigma_ln, DB_PER_NEPER),
+        rms(&r[n..], sigma_phase, 1f64.to_degrees()),
+    )
+}
+
 /// The complex response of a frequency-response file with phase, on the lines where
 /// `keep` holds; `None` without a phase. Noise per line: `gain_sigma_db` (and
 /// `phase_sigma_deg`, else the same relative σ), or `coherence` (γ²) with

@@ -17,7 +17,8 @@
 
 use std::f64::consts::TAU;
 
-use crate::experiments::frequency_response::measured::{ComplexPoints, DB_PER_NEPER};
+pub use crate::experiments::frequency_response::measured::rms_errors;
+use crate::experiments::frequency_response::measured::ComplexPoints;
 
 pub use crate::angle::wrap;
 
@@ -96,25 +97,6 @@ fn straight_line_slope(y: &[f64], x: &[f64], w: &[f64]) -> f64 {
     } else {
         0.0
     }
-}
-
-/// The RMS of the gain errors (dB) and of the phase errors (deg) of complex residuals
-/// `r` (gain block, then phase block) with their σs.
-pub fn rms_errors(r: &[f64], sigma_ln: &[f64], sigma_phase: &[f64]) -> (f64, f64) {
-    let n = sigma_ln.len();
-    let rms = |part: &[f64], s: &[f64], unit: f64| {
-        (part
-            .iter()
-            .zip(s)
-            .map(|(x, s)| (x * s * unit).powi(2))
-            .sum::<f64>()
-            / n.max(1) as f64)
-            .sqrt()
-    };
-    (
-        rms(&r[..n], sigma_ln, DB_PER_NEPER),
-        rms(&r[n..], sigma_phase, 1f64.to_degrees()),
-    )
 }
 
 #[cfg(test)]

@@ -131,20 +131,12 @@ impl MeasuredSpeedLoop {
 
     /// The misfit of residuals `r` ([`Self::residuals`]).
     pub fn misfit_of(&self, r: &[f64]) -> Misfit {
-        let n = self.frequency_hz.len();
-        let rms = |part: &[f64], s: &[f64], unit: f64| {
-            (part
-                .iter()
-                .zip(s)
-                .map(|(x, s)| (x * s * unit).powi(2))
-                .sum::<f64>()
-                / n as f64)
-                .sqrt()
-        };
+        let (gain_rms_db, phase_rms_deg) =
+            measured::rms_errors(r, &self.sigma_ln, &self.sigma_phase);
         let chi2 = r.iter().map(|x| x * x).sum::<f64>() / r.len().max(1) as f64;
         Misfit {
-            gain_rms_db: rms(&r[..n], &self.sigma_ln, DB_PER_NEPER),
-            phase_rms_deg: rms(&r[n..], &self.sigma_phase, 1f64.to_degrees()),
+            gain_rms_db,
+            phase_rms_deg,
             reduced_chi2: chi2,
             explained: chi2 <= MISFIT_CHI2,
         }
