@@ -16,7 +16,7 @@ const SIZE: usize = 100 << 20;
 
 fn fixture(relative: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("fixtures/formats")
+        .join("../fixtures/formats")
         .join(relative)
 }
 

@@ -25,7 +25,7 @@ use rtid::io::experiment_file::{self, Data};
 use rtid::model::{Params, SetpointFilter};
 
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/real/emps")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures/real/emps")
 }
 
 fn emps() -> (ServoTrace, Params) {

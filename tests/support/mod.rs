@@ -12,9 +12,18 @@ use rtid::model::{presets, Params};
 
 /// A fixture file's path (`worm-gear/frequency_response.json`).
 pub fn fixture_path(relative: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("fixtures")
-        .join(relative)
+    root().join("fixtures").join(relative)
+}
+
+/// The repository's root: the package's folder, or its parent for the benches'
+/// package (benches/, which includes this module as well).
+pub fn root() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    if dir.join("fixtures").is_dir() {
+        dir
+    } else {
+        dir.parent().expect("benches/ has a parent").to_path_buf()
+    }
 }
 
 /// The experiment in a fixture file.
