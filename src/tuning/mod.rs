@@ -270,7 +270,7 @@ pub fn tune(
         .take(weigh::CHECKED)
         .map(|r| r.0)
         .collect();
-    let chosen = weigh::choose(
+    let mut chosen = weigh::choose(
         options.objective,
         &sets,
         &picked,
@@ -278,37 +278,22 @@ pub fn tune(
         replace,
     )
     .map_err(TuneError::Today)?;
-    let mut warnings = Vec::new();
-    if replace {
-        warnings.push(TuneWarning::TodayOutsideTargets {
-            replaced: chosen.best.is_some(),
-        });
-    }
-    let (params, after_check, judgement, screen_score, proposes) = match chosen.best {
-        Some((i, checked, judgement)) => (
-            sets[i].clone(),
-            checked,
-            judgement,
-            ranked_score(&ranked, i),
-            true,
-        ),
-        None => {
-            warnings.push(TuneWarning::NothingBetter {
-                best_check_score: chosen.best_failed.as_ref().map(|j| j.score.after.mean),
-                half_width: chosen.best_failed.as_ref().map(|j| j.score.half_width),
-            });
-            let same = judge::judge(options.objective, &chosen.today, &chosen.today);
-            (p.clone(), chosen.today.clone(), same, 1.0, false)
-        }
-    };
-    warnings.extend(judgement.worse().map(|c| {
-        TuneWarning::Worse(Worse {
-            criterion: c.criterion,
-            before: c.compared.before.mean,
-            after: c.compared.after.mean,
-        })
-    }));
-    warnings.extend(torque_limits(p, &chosen.today, &after_check, proposes));
+    let best = chosen.best.take();
+    let Outcome {
+        params,
+        after_check,
+        judgement,
+        screen_score,
+        proposes,
+        warnings,
+    } = outcome(
+        p,
+        options.objective,
+        (&sets, &ranked),
+        best,
+        &chosen,
+        replace,
+    );
     let after = Setting::over(&params, &params.controller, &machines)?;
     Ok(Tuned {
         targets,
@@ -343,6 +328,68 @@ pub fn tune(
         candidates: table,
         params,
     })
+}
+
+/// What `tune` proposes, and the warnings that go with it.
+struct Outcome {
+    params: Params,
+    after_check: Checked,
+    judgement: Judgement,
+    screen_score: f64,
+    proposes: bool,
+    warnings: Vec<TuneWarning>,
+}
+
+/// The outcome of the check: the best setting that beat today's (`best`), or
+/// today's kept; warnings for today's outside the targets (`replace`), for nothing
+/// better, for every criterion made worse and for the torque limit.
+fn outcome(
+    p: &Params,
+    objective: Objective,
+    (sets, ranked): (&[Params], &[(usize, f64)]),
+    best: Option<(usize, Checked, Judgement)>,
+    chosen: &weigh::Chosen,
+    replace: bool,
+) -> Outcome {
+    let mut warnings = Vec::new();
+    if replace {
+        warnings.push(TuneWarning::TodayOutsideTargets {
+            replaced: best.is_some(),
+        });
+    }
+    let (params, after_check, judgement, screen_score, proposes) = match best {
+        Some((i, checked, judgement)) => (
+            sets[i].clone(),
+            checked,
+            judgement,
+            ranked_score(ranked, i),
+            true,
+        ),
+        None => {
+            warnings.push(TuneWarning::NothingBetter {
+                best_check_score: chosen.best_failed.as_ref().map(|j| j.score.after.mean),
+                half_width: chosen.best_failed.as_ref().map(|j| j.score.half_width),
+            });
+            let same = judge::judge(objective, &chosen.today, &chosen.today);
+            (p.clone(), chosen.today.clone(), same, 1.0, false)
+        }
+    };
+    warnings.extend(judgement.worse().map(|c| {
+        TuneWarning::Worse(Worse {
+            criterion: c.criterion,
+            before: c.compared.before.mean,
+            after: c.compared.after.mean,
+        })
+    }));
+    warnings.extend(torque_limits(p, &chosen.today, &after_check, proposes));
+    Outcome {
+        params,
+        after_check,
+        judgement,
+        screen_score,
+        proposes,
+        warnings,
+    }
 }
 
 /// The warnings of tests whose peak torque reaches the limit, today's and (when a
