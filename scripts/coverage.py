@@ -11,7 +11,7 @@ machine's own ISO 230-2 test before and after that compensation, and counts how 
 of the machine's values fall inside the predicted intervals.
 
     python3 scripts/coverage.py [--rtid target/release/rtid] [--machines 6]
-        [--first 1] [--other-held] [--out DIR] [-- IDENTIFY-OPTIONS...]
+        [--first 1] [--other-held] [--held-moved] [--out DIR] [-- IDENTIFY-OPTIONS...]
 
 Options after `--` are given to `rtid identify` (e.g. `--intervals standard-errors`
 or `--uncertain Kw=0%`); without any, the default chain (by rtid's defaults the fit's
@@ -141,12 +141,15 @@ def main():
     ap.add_argument("--first", type=int, default=1, help="number of the first machine")
     ap.add_argument("--other-held", action="store_true",
                     help="the second half moves Kg, Jw and W instead of Kw, theta_bg and Jt")
+    ap.add_argument("--held-moved", action="store_true",
+                    help="every machine moves held parameters, not only the second half")
     ap.add_argument("--out", default="coverage-run")
     ap.add_argument("identify", nargs="*", help="options for rtid identify (after --)")
     args = ap.parse_args()
     results = []
     for k in range(args.first, args.first + args.machines):
-        r = one(args.rtid, k, k - args.first >= args.machines // 2, args, args.out)
+        held_moved = args.held_moved or k - args.first >= args.machines // 2
+        r = one(args.rtid, k, held_moved, args, args.out)
         results.append(r)
         print(f"machine {k}: " + ", ".join(f"{s} {t} s" for s, t in r["seconds"].items())
               + f", chain {sum(r['seconds'].values()):.1f} s", flush=True)

@@ -209,6 +209,7 @@ fn with_intervals(
                 params: &fit.params,
                 objective: fit.objective.as_ref(),
                 settings: fit.settings,
+                replay: fit.replay.as_ref(),
                 replicates,
                 held: &held,
                 stop: &|| monitor.stopped(),

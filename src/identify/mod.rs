@@ -57,7 +57,7 @@ pub use result::starts::{StartEstimate, StartRecord};
 pub use result::termination::Termination;
 pub use result::warning::Warning;
 pub use result::IdentifyResult;
-pub use run::Identified;
+pub use run::{Identified, Replay, ReplayStage};
 pub use search::problem::{Best, Monitor};
 pub use search::settings::Method;
 pub use search::settings::Settings;

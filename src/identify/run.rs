@@ -39,6 +39,37 @@ pub struct Identified {
     /// The stage and model of the objectives whose residuals the result reports
     /// (the last stage run).
     pub(crate) report: (Stage, Fidelity),
+    /// A fit by plan's stages, for a bootstrap to run them again (`None`: one
+    /// search of `objective` with `settings`).
+    pub replay: Option<Replay>,
+}
+
+/// The estimator a fit by plan ran ([`crate::identify::by_record`]), as a bootstrap
+/// replicate repeats it: each stage's search of its parameters on its record alone
+/// (part `part` of `objective`, whose parts are the records side by side), one
+/// after the other, then the joint refinement.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Replay {
+    pub stages: Vec<ReplayStage>,
+    /// The parameters refined jointly after the stages, and that search.
+    pub refined: Vec<String>,
+    pub refinement: Settings,
+}
+
+impl Replay {
+    /// The searches one replicate runs: the stages and the refinement.
+    pub fn steps(&self) -> usize {
+        self.stages.len() + usize::from(!self.refined.is_empty())
+    }
+}
+
+/// One stage of a [`Replay`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReplayStage {
+    /// The record's index among the objective's parts.
+    pub part: usize,
+    pub names: Vec<String>,
+    pub settings: Settings,
 }
 
 /// One identification of all of `config`'s experiments together: its plan's search
@@ -113,5 +144,6 @@ pub(crate) fn identify_one(
         },
         settings: plan.stages[0].settings,
         report,
+        replay: None,
     })
 }

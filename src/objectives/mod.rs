@@ -189,6 +189,12 @@ pub trait Objective: Sync + Send {
     }
     /// What one unit of scaled residual means, for reports, e.g. `0.1 % of frequency`.
     fn scale(&self) -> String;
+    /// Part `i` of an objective whose residuals are its parts' side by side (the
+    /// records of a fit by plan), in the order of its residuals; `None` for others.
+    fn part(&self, i: usize) -> Option<&dyn Objective> {
+        let _ = i;
+        None
+    }
     /// The residuals `r` (at the parameter set `p`) in the measurement's own units,
     /// for reports.
     fn detail(&self, p: &Params, r: &[f64]) -> Option<Detail> {

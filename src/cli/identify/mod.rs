@@ -557,6 +557,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         objective,
         settings,
         smoothness,
+        replay,
         ..
     } = outcome?;
     if let Some(names) = &a.profile {
@@ -567,7 +568,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     match chosen::decide(&result, smoothness, a.intervals.into(), replicates) {
         _ if result.interrupted => {}
         Chosen::Bootstrap(n) => {
-            let fit = (objective.as_ref(), settings);
+            let fit = (objective.as_ref(), settings, replay.as_ref());
             add_resampling(n, &held, &mut result, &params, fit, &monitor, a.quiet)?;
         }
         Chosen::StandardErrors if !held.is_empty() && !chosen::rough(&result, smoothness) => {

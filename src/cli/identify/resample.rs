@@ -15,16 +15,22 @@ pub fn add_resampling(
     held: &[(String, f64, f64)],
     result: &mut IdentifyResult,
     params: &Params,
-    fit: (&dyn rtid::objectives::Objective, rtid::identify::Settings),
+    fit: (
+        &dyn rtid::objectives::Objective,
+        rtid::identify::Settings,
+        Option<&rtid::identify::Replay>,
+    ),
     monitor: &Monitor,
     quiet: bool,
 ) -> anyhow::Result<()> {
-    let bar = progress::bar(replicates as u64, "resampling (fits)", quiet);
+    let steps = replicates * fit.2.map_or(1, |r| r.steps());
+    let bar = progress::bar(steps as u64, "resampling (fits)", quiet);
     let request = resample::Request {
         result,
         params,
         objective: fit.0,
         settings: fit.1,
+        replay: fit.2,
         replicates,
         held,
         stop: &|| monitor.stopped(),

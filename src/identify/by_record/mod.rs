@@ -28,7 +28,7 @@ use crate::identify::plan::Plan;
 use crate::identify::result::record_plan::{RecordPlan, RecordStage};
 use crate::identify::result::starts::StartRecord;
 use crate::identify::result::warning::Warning;
-use crate::identify::run::{identify_one, Identified};
+use crate::identify::run::{identify_one, Identified, Replay, ReplayStage};
 use crate::identify::search::problem::Monitor;
 use crate::identify::search::search;
 use crate::identify::search::settings::{Method, Settings, SIMPLEX_STEP_NEAR};
@@ -111,6 +111,13 @@ pub fn run(
     let mut reports = Vec::with_capacity(config.experiments.len());
     let mut stage_records: Vec<RecordStage> = Vec::new();
     let mut warnings: Vec<Warning> = planned.start.warnings.clone();
+    let replayed: Vec<ReplayStage> = (stages.iter())
+        .map(|s| ReplayStage {
+            part: s.record,
+            names: s.identified.result.parameters.keys().cloned().collect(),
+            settings: s.identified.settings,
+        })
+        .collect();
     let mut by_record: Vec<Option<StageRun>> =
         (0..config.experiments.len()).map(|_| None).collect();
     for s in stages {
@@ -172,7 +179,12 @@ pub fn run(
         undetermined: planned.names(&planned.assignment.undetermined),
         shares: planned.shares(config),
     };
-    report::assemble(
+    let replay = Replay {
+        stages: replayed,
+        refined: refined.clone(),
+        refinement: settings,
+    };
+    let mut identified = report::assemble(
         config,
         &planned,
         report::Found {
@@ -187,7 +199,9 @@ pub fn run(
             wall_time_s: clock.elapsed().as_secs_f64(),
             interrupted: monitor.stopped(),
         },
-    )
+    )?;
+    identified.replay = Some(replay);
+    Ok(identified)
 }
 
 /// The records in the order their stages run: rough ones (closed-loop simulations)

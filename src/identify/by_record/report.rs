@@ -142,6 +142,7 @@ pub(super) fn assemble(
         objective: Box::new(found.objective),
         settings: found.settings,
         report: (Stage::Search, first),
+        replay: None,
     })
 }
 

@@ -40,6 +40,10 @@ impl Objective for Stacked {
         self.parts.iter().map(|p| p.len()).sum()
     }
 
+    fn part(&self, i: usize) -> Option<&dyn Objective> {
+        self.parts.get(i).map(|p| p.as_ref())
+    }
+
     fn scale(&self) -> String {
         "Σ weight · mean(scaled residual²) over the records".into()
     }

@@ -20,7 +20,7 @@
 //! lane batches (search/lockstep.rs): each replicate's numbers are those it gets
 //! alone.
 
-use crate::identify::result::resampling::{Interval, Resampling};
+use crate::identify::result::resampling::{AtBound, Interval, Resampling};
 use std::collections::BTreeMap;
 use std::ops::Range;
 
@@ -30,8 +30,9 @@ use rayon::prelude::*;
 
 use crate::identify::error::IdentifyError;
 use crate::identify::pipeline::correction::Corrected;
-use crate::identify::result::warning::Warning;
+use crate::identify::result::warning::{Coded, Side, Warning};
 use crate::identify::result::IdentifyResult;
+use crate::identify::run::Replay;
 use crate::identify::search::lockstep::side_by_side;
 use crate::identify::search::problem::Monitor;
 use crate::identify::search::search;
@@ -44,6 +45,14 @@ pub use super::request::LEVEL;
 use super::request::Z;
 /// Fewer finished replicates than this give no interval.
 pub const MIN_REPLICATES: usize = 5;
+/// The share of replicates (and at least two) that ran to a bound of the search for
+/// the parameter to be not determined there: on a machine that is not the preset,
+/// the torque curve's plateau in the backlash θbw took 4 of 12 replicates to its
+/// lower bound while the machine's value lay above all of them.
+pub const AT_BOUND: f64 = 0.15;
+/// A replicate within this fraction of the bounds' range (in log where they are
+/// positive) of a bound ran to it.
+const BOUND_NEAR: f64 = 0.025;
 
 /// What is resampled and how each replicate is fitted.
 pub struct Request<'a> {
@@ -54,6 +63,10 @@ pub struct Request<'a> {
     /// ([`crate::identify::run::Identified`]).
     pub objective: &'a dyn Objective,
     pub settings: Settings,
+    /// A fit by plan's stages ([`Identified::replay`](crate::identify::Identified)):
+    /// each replicate runs them as the fit did (`None`: one search of `objective`
+    /// with `settings`).
+    pub replay: Option<&'a Replay>,
     pub replicates: usize,
     /// Parameters the fit held at assumed values, with their ranges (name, value,
     /// relative half-width): each replicate draws each uniformly within
@@ -63,7 +76,8 @@ pub struct Request<'a> {
     pub held: &'a [(String, f64, f64)],
     /// Asked before each replicate whether to stop (Ctrl-C).
     pub stop: &'a (dyn Fn() -> bool + Sync),
-    /// Called after each replicate (progress).
+    /// Called after each replicate's fit, or each of its stages where it replays a
+    /// plan (progress: replicates × [`Replay::steps`] in all).
     pub on_replicate: &'a (dyn Fn() + Sync),
 }
 
@@ -93,6 +107,28 @@ pub enum ResampleError {
 /// four step angles, a frequency response's two resonances. Such a part's errors are
 /// drawn normal instead (a parametric bootstrap of that part; `Problem::blocks`).
 pub const MIN_BLOCKS: usize = 10;
+
+/// One search of a replayed plan: the objective it searches (a record's part of
+/// the fit's, or the whole), that part's range in the residual vector, its
+/// parameters and its search.
+struct Step<'s> {
+    objective: &'s dyn Objective,
+    range: Range<usize>,
+    names: &'s [String],
+    settings: Settings,
+}
+
+/// Why replicate `b` has no values.
+fn failed(b: usize, e: IdentifyError) -> String {
+    format!("replicate {b}: {e}")
+}
+
+/// One replicate's data: the offset of its residuals from the fit's, and its draw
+/// of the held parameters.
+struct Draw {
+    offset: Vec<f64>,
+    held: Vec<f64>,
+}
 
 /// How one part's errors are drawn.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -130,9 +166,12 @@ pub fn resample(request: &Request) -> Result<Resampling, ResampleError> {
         params: request.params,
         objective: request.objective,
         settings: request.settings,
+        replay: request.replay,
         parts: parts(result),
     };
-    problem.run(request.replicates, request.stop, request.on_replicate)
+    let mut resampling = problem.run(request.replicates, request.stop, request.on_replicate)?;
+    problem.bounded(&mut resampling);
+    Ok(resampling)
 }
 
 /// Adds `resampling` to `result`. Where it gives intervals, they replace the
@@ -141,7 +180,43 @@ pub fn attach(result: &mut IdentifyResult, resampling: Resampling) {
     if !resampling.intervals.is_empty() {
         result.warnings.retain(|w| w.0 != Warning::RoughCost);
     }
+    result
+        .warnings
+        .extend(at_bound(&resampling).into_iter().map(Coded));
     result.resampling = Some(resampling);
+}
+
+/// The bound that replicates' `values` ran to within `bound`, where at least
+/// [`AT_BOUND`] of `fitted` replicates (and two) did; the lower where both.
+pub fn ran_to_bound(values: &[f64], bound: Bound, fitted: usize) -> Option<AtBound> {
+    let near = |end: f64| {
+        (values.iter())
+            .filter(|v| (bound.unit(**v) - end).abs() < BOUND_NEAR)
+            .count()
+    };
+    let enough = |count: usize| count >= 2 && count as f64 >= AT_BOUND * fitted as f64;
+    let (lower, upper) = (near(0.0), near(1.0));
+    let (side, replicates) = match () {
+        _ if enough(lower) && lower >= upper => (Side::Lower, lower),
+        _ if enough(upper) => (Side::Upper, upper),
+        _ => return None,
+    };
+    Some(AtBound { side, replicates })
+}
+
+/// The warnings of replicates that ran to a bound.
+fn at_bound(resampling: &Resampling) -> Vec<Warning> {
+    (resampling.intervals.iter())
+        .filter_map(|(name, i)| {
+            let a = i.at_bound?;
+            Some(Warning::BootstrapAtBound {
+                name: name.clone(),
+                side: a.side,
+                replicates: a.replicates,
+                of: resampling.fitted,
+            })
+        })
+        .collect()
 }
 
 /// Each experiment's (and objective's) residual count, named as the result names it.
@@ -166,6 +241,7 @@ struct Problem<'a> {
     params: &'a Params,
     objective: &'a dyn Objective,
     settings: Settings,
+    replay: Option<&'a Replay>,
     /// Each part of the residual vector, in order: its name and length.
     parts: Vec<(String, usize)>,
 }
@@ -185,42 +261,136 @@ impl Problem<'_> {
         let segments = self.segments(r0.len());
         let errors = modified(&centre(&r0, &segments), self.names.len());
         let blocks = self.blocks(&errors, &r0, &segments)?;
-        let replicate = |b: usize, objective: &dyn Objective| {
-            if stop() {
-                return None;
+        let draws: Vec<Draw> = (0..replicates)
+            .map(|b| {
+                let seed = seed(self.settings.seed, b);
+                let draw = draw(&errors, &segments, &blocks, seed);
+                Draw {
+                    offset: draw.iter().zip(&r0).map(|(d, r)| d - r).collect(),
+                    held: self.held_draw(seed),
+                }
+            })
+            .collect();
+        let outcomes = match self.replay {
+            Some(replay) => self.replayed(replay, &draws, stop, on_replicate),
+            None => {
+                let replicate = |b: usize, objective: &dyn Objective| {
+                    if stop() {
+                        return None;
+                    }
+                    let held = &draws[b].held;
+                    let fitted = self.start(held).and_then(|start| {
+                        let whole = (objective, draws[b].offset.clone());
+                        self.refit(whole, &self.names, start, self.settings)
+                    });
+                    on_replicate();
+                    Some(
+                        fitted
+                            .map(|p| self.values(&p, held))
+                            .map_err(|e| failed(b, e)),
+                    )
+                };
+                self.each(self.objective, self.settings, replicates, &replicate)
             }
-            let seed = seed(self.settings.seed, b);
-            let draw = draw(&errors, &segments, &blocks, seed);
-            let offset: Vec<f64> = draw.iter().zip(&r0).map(|(d, r)| d - r).collect();
-            let held = self.held_draw(seed);
-            let fitted = self
-                .refit(objective, offset, &held)
-                .map(|mut f| {
-                    f.extend(held);
-                    f
-                })
-                .map_err(|e| format!("replicate {b}: {e}"));
-            on_replicate();
-            Some(fitted)
-        };
-        let outcomes = if self.in_lockstep() {
-            side_by_side(self.objective, replicates, &replicate)
-        } else {
-            (0..replicates)
-                .into_par_iter()
-                .map(|b| replicate(b, self.objective))
-                .collect()
         };
         Ok(self.summarise(replicates, blocks, outcomes))
     }
 
-    /// Whether the replicates' searches run side by side with their evaluations in
-    /// lanes: Nelder–Mead from one start (it evaluates one point after another) on
-    /// an objective that runs in lanes.
-    fn in_lockstep(&self) -> bool {
-        self.settings.method == Method::NelderMead
-            && self.settings.starts == 1
-            && self.objective.in_lanes()
+    /// `task(b, objective)` for each of `count` replicates: side by side with their
+    /// evaluations in lanes where the search is Nelder–Mead from one start (it
+    /// evaluates one point after another) on an objective that runs in lanes, else
+    /// in parallel.
+    fn each<T: Send>(
+        &self,
+        objective: &dyn Objective,
+        settings: Settings,
+        count: usize,
+        task: &(dyn Fn(usize, &dyn Objective) -> T + Sync),
+    ) -> Vec<T> {
+        if settings.method == Method::NelderMead && settings.starts == 1 && objective.in_lanes() {
+            side_by_side(objective, count, task)
+        } else {
+            (0..count)
+                .into_par_iter()
+                .map(|b| task(b, objective))
+                .collect()
+        }
+    }
+
+    /// The fit's plan run again on each replicate's data: each stage's search of its
+    /// parameters on its record alone, from where the stages before left them, the
+    /// replicates side by side stage after stage; then the joint refinement.
+    fn replayed(
+        &self,
+        replay: &Replay,
+        draws: &[Draw],
+        stop: &(dyn Fn() -> bool + Sync),
+        on_replicate: &(dyn Fn() + Sync),
+    ) -> Vec<Option<Result<Vec<f64>, String>>> {
+        let Some(steps) = self.steps(replay) else {
+            let missing = "the fit's objective has no part for a stage of its plan";
+            return vec![Some(Err(missing.into())); draws.len()];
+        };
+        let mut states: Vec<Option<Result<Params, String>>> = (draws.iter().enumerate())
+            .map(|(b, d)| Some(self.start(&d.held).map_err(|e| failed(b, e))))
+            .collect();
+        for s in &steps {
+            let step = |b: usize, objective: &dyn Objective| match &states[b] {
+                Some(Ok(state)) if !stop() => {
+                    let offset = draws[b].offset[s.range.clone()].to_vec();
+                    let fitted =
+                        self.refit((objective, offset), s.names, state.clone(), s.settings);
+                    on_replicate();
+                    Some(fitted.map_err(|e| failed(b, e)))
+                }
+                Some(Ok(_)) | None => None,
+                Some(Err(e)) => Some(Err(e.clone())),
+            };
+            states = self.each(s.objective, s.settings, draws.len(), &step);
+        }
+        (states.into_iter().zip(draws))
+            .map(|(s, d)| s.map(|s| s.map(|p| self.values(&p, &d.held))))
+            .collect()
+    }
+
+    /// The searches of `replay`: each stage's on its record's part of the objective,
+    /// then the refinement's on the whole (`None` where the objective has no such
+    /// part).
+    fn steps<'s>(&'s self, replay: &'s Replay) -> Option<Vec<Step<'s>>> {
+        let mut steps = Vec::with_capacity(replay.steps());
+        for stage in &replay.stages {
+            steps.push(Step {
+                objective: self.objective.part(stage.part)?,
+                range: self.part_range(stage.part),
+                names: &stage.names,
+                settings: stage.settings,
+            });
+        }
+        if !replay.refined.is_empty() {
+            steps.push(Step {
+                objective: self.objective,
+                range: 0..self.objective.len(),
+                names: &replay.refined,
+                settings: replay.refinement,
+            });
+        }
+        Some(steps)
+    }
+
+    /// A replicate's fitted values `p` in `names`' order, then its `held` draw.
+    fn values(&self, p: &Params, held: &[f64]) -> Vec<f64> {
+        let mut v: Vec<f64> = (self.names.iter())
+            .map(|n| p.get(n).ok().flatten().unwrap_or(f64::NAN))
+            .collect();
+        v.extend(held);
+        v
+    }
+
+    /// The residual range of the objective's part `i`.
+    fn part_range(&self, i: usize) -> Range<usize> {
+        let len = |j: usize| self.objective.part(j).map_or(0, |o| o.len());
+        let from: usize = (0..i).map(len).sum();
+        from..from + len(i)
     }
 
     /// The parts' ranges in the residual vector of length `n` (one range when the
@@ -272,6 +442,24 @@ impl Problem<'_> {
             .collect()
     }
 
+    /// The intervals cut to the bounds the replicates were fitted within; where at
+    /// least [`AT_BOUND`] of the replicates ran to a bound, the bound named.
+    fn bounded(&self, resampling: &mut Resampling) {
+        let fitted = resampling.fitted;
+        for (name, interval) in resampling.intervals.iter_mut() {
+            let Some((_, b)) = self.bounds.iter().find(|(n, _)| n == name) else {
+                continue;
+            };
+            interval.lower = interval.lower.max(b.lo);
+            interval.upper = interval.upper.min(b.hi);
+            let values = resampling
+                .values
+                .get(name)
+                .map_or(&[][..], |v| v.as_slice());
+            interval.at_bound = ran_to_bound(values, *b, fitted);
+        }
+    }
+
     /// Replicate `seed`'s draw of each held parameter within its range.
     fn held_draw(&self, seed: u64) -> Vec<f64> {
         let mut rng = StdRng::seed_from_u64(seed ^ 0x6865_6c64);
@@ -280,34 +468,45 @@ impl Problem<'_> {
             .collect()
     }
 
-    /// The fit repeated on the objective shifted by `offset`: the same search from
-    /// the same start. The fitted values, in `names`' order.
-    fn refit(
-        &self,
-        objective: &dyn Objective,
-        offset: Vec<f64>,
-        held: &[f64],
-    ) -> Result<Vec<f64>, IdentifyError> {
+    /// Where each replicate starts: the fit's start of the fitted parameters, the
+    /// held ones at replicate's draw `held`.
+    fn start(&self, held: &[f64]) -> Result<Params, IdentifyError> {
         let mut base = self.params.clone();
         let held = self.held.iter().map(|h| &h.0).zip(held);
         for (name, &v) in self.names.iter().zip(&self.initial).chain(held) {
             base.set(name, v).map_err(ObjectiveError::from)?;
         }
-        let space = ParamSpace::new(base, &self.names, &self.bounds)?;
+        Ok(base)
+    }
+
+    /// The search of `names` from `base` with `settings` on an objective shifted by
+    /// an offset (`whole`): the parameter set at its best point.
+    fn refit(
+        &self,
+        whole: (&dyn Objective, Vec<f64>),
+        names: &[String],
+        base: Params,
+        settings: Settings,
+    ) -> Result<Params, IdentifyError> {
+        let bounds: Vec<(String, Bound)> = (self.bounds.iter())
+            .filter(|(n, _)| names.contains(n))
+            .cloned()
+            .collect();
+        let space = ParamSpace::new(base, names, &bounds)?;
         let objective = Corrected {
-            linear: objective,
-            offset,
+            linear: whole.0,
+            offset: whole.1,
         };
         let settings = Settings {
             max_evaluations: None,
-            ..self.settings
+            ..settings
         };
         let monitor = Monitor::default();
         search(&space, &objective, &settings, &monitor, &[], &|_| {});
-        monitor
-            .best()
-            .map(|b| b.values)
-            .ok_or_else(|| IdentifyError::NothingEvaluated(monitor.failure().unwrap_or_default()))
+        let best = monitor.best().map(|b| b.values).ok_or_else(|| {
+            IdentifyError::NothingEvaluated(monitor.failure().unwrap_or_default())
+        })?;
+        Ok(space.params(&best).map_err(ObjectiveError::from)?)
     }
 
     /// The replicates' values and the intervals they give.
@@ -494,12 +693,37 @@ fn interval(fit: f64, v: &[f64], correct: bool) -> Interval {
         upper: centre + Z * sd,
         standard_error: sd,
         bias,
+        at_bound: None,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn replicates_that_ran_to_a_bound_are_counted_there() {
+        let b = Bound { lo: 8e-6, hi: 8e-4 };
+        // θbw on a machine that is not the preset: 4 of 12 at the lower bound.
+        let theta = [
+            1.55e-5, 1.69e-5, 1.51e-5, 8.02e-6, 8.86e-6, 3.76e-5, 8.02e-6, 1.68e-5, 3.61e-5,
+            8.48e-6, 4.91e-5, 1.36e-5,
+        ];
+        let at = ran_to_bound(&theta, b, 12).unwrap();
+        assert_eq!((at.side, at.replicates), (Side::Lower, 4));
+        // One replicate at a bound is not enough, nor two of twenty.
+        assert_eq!(ran_to_bound(&[8e-6, 1e-4, 2e-4, 3e-4, 1e-4], b, 5), None);
+        let mut twenty = vec![1e-4; 18];
+        twenty.extend([7.9e-4, 8e-4]);
+        assert_eq!(ran_to_bound(&twenty, b, 20), None);
+        twenty[0] = 7.95e-4;
+        let at = ran_to_bound(&twenty, b, 20).unwrap();
+        assert_eq!((at.side, at.replicates), (Side::Upper, 3));
+        // Linear bounds (a signed parameter): the same fraction of the range.
+        let signed = Bound { lo: -1.0, hi: 1.0 };
+        assert!(ran_to_bound(&[-0.99, -0.98, 0.1, 0.2, 0.3], signed, 5).is_some());
+        assert_eq!(ran_to_bound(&[-0.9, -0.9, 0.1, 0.2, 0.3], signed, 5), None);
+    }
     use crate::model::presets;
     use crate::objectives::sum_of_squares;
     use rand_distr::{Distribution, Normal};
@@ -618,6 +842,7 @@ mod tests {
             params: &params,
             objective: &decay,
             settings,
+            replay: None,
             parts: vec![("decay".into(), 200)],
             held: &[],
         };
@@ -673,6 +898,7 @@ mod tests {
             params: &p,
             objective: &decay,
             settings: Settings::default(),
+            replay: None,
             parts: vec![("unbalance.json [unbalance_step]".into(), 4)],
             held: &[],
         };

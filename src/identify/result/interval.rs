@@ -33,6 +33,11 @@ impl IdentifyResult {
             return Some(FitInterval::NotDetermined("no record determines it"));
         }
         if let Some(i) = self.resampling.as_ref().and_then(|s| s.intervals.get(name)) {
+            if i.at_bound.is_some() {
+                return Some(FitInterval::NotDetermined(
+                    "its bootstrap replicates ran to a bound",
+                ));
+            }
             let n = self.resampling.as_ref().map_or(0, |s| s.fitted);
             return Some(FitInterval::Bounds {
                 lower: i.lower,
@@ -130,6 +135,7 @@ mod tests {
             upper: 1.1 * fm,
             standard_error: 0.0,
             bias: 0.0,
+            at_bound: None,
         };
         fit.resampling = Some(Resampling {
             method: "residual block bootstrap".into(),

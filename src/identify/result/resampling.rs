@@ -5,6 +5,8 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use crate::identify::result::warning::Side;
+
 /// The bootstrap of a fit.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Resampling {
@@ -25,8 +27,9 @@ pub struct Resampling {
     pub notes: Vec<String>,
 }
 
-/// A bias-corrected normal bootstrap interval: the fit minus the replicates' mean
-/// offset, ± 1.96 of their standard deviation.
+/// A normal bootstrap interval: ± 1.96 of the replicates' standard deviation
+/// about the fit less their mean offset (bias-corrected), or about their mean where
+/// they drew held parameters; cut to the search's bounds.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Interval {
     pub lower: f64,
@@ -35,4 +38,16 @@ pub struct Interval {
     pub standard_error: f64,
     /// The replicates' mean minus the fit: the estimated bias of the fit.
     pub bias: f64,
+    /// The bound of the search that replicates ran to, where enough did
+    /// ([`crate::identify::intervals::resample::AT_BOUND`]): the records do not
+    /// bound the parameter there, and it is not determined.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub at_bound: Option<AtBound>,
+}
+
+/// How many replicates ran to which bound.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct AtBound {
+    pub side: Side,
+    pub replicates: usize,
 }

@@ -31,6 +31,14 @@ pub(super) fn text(w: &Warning) -> String {
             position_span,
         } => not_followed(source, *position_rms, *position_span),
         Warning::NotDetermined { names } => not_determined(names),
+        Warning::BootstrapAtBound {
+            name,
+            side,
+            replicates,
+            of,
+        } => format!(
+            "{name}: {replicates} of {of} bootstrap replicates ran to its {side} bound: the records do not bound it there, and where the fit stopped says little — not determined, no interval (state it with --set, or add a record that determines it)"
+        ),
         Warning::NoEffect { name } => {
             format!("{name} has no effect on the residuals: the data say nothing about it")
         }

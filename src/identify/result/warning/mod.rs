@@ -125,6 +125,14 @@ pub enum Warning {
         bound: f64,
         family: Vec<(String, f64)>,
     },
+    /// `replicates` of a bootstrap's `of` ran to the parameter's bound on `side`:
+    /// the records do not bound it there, and it is not determined (no interval).
+    BootstrapAtBound {
+        name: String,
+        side: Side,
+        replicates: usize,
+        of: usize,
+    },
     /// A point of a profile fits better than the fit itself: the search stopped
     /// short of the optimum.
     ProfileBetterFit {
@@ -159,6 +167,7 @@ impl Warning {
             Warning::CorrectionsNotConverged { .. } => "corrections_not_converged",
             Warning::NotDetermined { .. } => "not_determined",
             Warning::ProfileOpen { .. } => "profile_open",
+            Warning::BootstrapAtBound { .. } => "bootstrap_at_bound",
             Warning::ProfileBetterFit { .. } => "profile_better_fit",
         }
     }
