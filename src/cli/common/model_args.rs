@@ -78,11 +78,31 @@ pub fn fitted(
     Ok(p)
 }
 
-/// Sets the values of the identification result `fit` (read from `path`) in `p`.
+/// Sets the values of the identification result `fit` (read from `path`) in `p`,
+/// warning of each value the fit did not determine.
 pub fn apply_fit(p: &mut Params, fit: &IdentifyResult, path: &Path) -> anyhow::Result<()> {
     fit.apply_to(p)
         .and_then(|()| p.validate())
-        .with_context(|| format!("{}: its values on the model", path.display()))
+        .with_context(|| format!("{}: its values on the model", path.display()))?;
+    for warning in not_determined(fit, path) {
+        eprintln!("warning: {warning}");
+    }
+    Ok(())
+}
+
+/// The fitted values `fit` (from `path`) says it did not determine: the model takes
+/// them where the fit stopped.
+fn not_determined(fit: &IdentifyResult, path: &Path) -> Vec<String> {
+    use rtid::identify::result::interval::FitInterval;
+    (fit.parameters.iter())
+        .filter_map(|(name, value)| match fit.interval(name) {
+            Some(FitInterval::NotDetermined(why)) => Some(format!(
+                "{}: {name} = {value:.5e} is not determined ({why}): the model takes it where the fit stopped, and what follows from it rests on that value",
+                path.display()
+            )),
+            _ => None,
+        })
+        .collect()
 }
 
 /// An identification result (`rtid identify --out`).
@@ -118,6 +138,29 @@ pub fn parse_assignment(s: &str) -> anyhow::Result<(&str, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_fitted_value_not_determined_is_named_where_the_fit_is_used() {
+        let text = include_str!("../../../fixtures/predict/worm-gear/fit.json");
+        let mut fit: IdentifyResult = serde_json::from_str(text).unwrap();
+        let path = Path::new("fit.json");
+        assert!(not_determined(&fit, path).is_empty());
+        let plan = rtid::identify::result::record_plan::RecordPlan {
+            stages: Vec::new(),
+            refined: Vec::new(),
+            refinement: None,
+            undetermined: vec!["fm".into()],
+            shares: Vec::new(),
+        };
+        fit.plan = Some(plan);
+        let warnings = not_determined(&fit, path);
+        assert_eq!(warnings.len(), 1);
+        assert!(
+            warnings[0].starts_with("fit.json: fm = ")
+                && warnings[0].contains("not determined (no record determines it)"),
+            "{warnings:?}"
+        );
+    }
 
     fn args(preset: &str, set: &[&str]) -> ModelArgs {
         ModelArgs {
