@@ -89,77 +89,14 @@ pub fn run(
     monitor: &Monitor,
 ) -> Result<Identified, IdentifyError> {
     let clock = Instant::now();
-    let mut current = planned.space.base.clone();
-    let mut stages: Vec<StageRun> = Vec::new();
-    for (k, e) in order(&planned).into_iter().enumerate() {
-        if monitor.stopped() {
-            break;
-        }
-        let names = planned.names(&planned.assignment.owned[e]);
-        let sub = planned.sub_config(config, e, &current, &names, k);
-        monitor.reset_best();
-        let before = monitor.evaluations();
-        let mut identified = identify_one(&sub, monitor)?;
-        identified.result.evaluations -= before;
-        current = identified.params.clone();
-        stages.push(StageRun {
-            record: e,
-            identified,
-        });
-    }
-    let mut parts = Vec::with_capacity(config.experiments.len());
-    let mut reports = Vec::with_capacity(config.experiments.len());
-    let mut stage_records: Vec<RecordStage> = Vec::new();
-    let mut warnings: Vec<Warning> = planned.start.warnings.clone();
-    let replayed: Vec<ReplayStage> = (stages.iter())
-        .map(|s| ReplayStage {
-            part: s.record,
-            names: s.identified.result.parameters.keys().cloned().collect(),
-            settings: s.identified.settings,
-        })
-        .collect();
-    let mut by_record: Vec<Option<StageRun>> =
-        (0..config.experiments.len()).map(|_| None).collect();
-    for s in stages {
-        let e = s.record;
-        by_record[e] = Some(s);
-    }
-    for (e, spec) in config.experiments.iter().enumerate() {
-        match by_record[e].take() {
-            Some(s) => {
-                let r = &s.identified.result;
-                stage_records.push(RecordStage {
-                    record: spec.source.clone(),
-                    parameters: r.parameters.keys().cloned().collect(),
-                    evaluations: r.evaluations,
-                    wall_time_s: r.wall_time_s,
-                    termination: r.termination.0.to_string(),
-                });
-                warnings.extend(stage_warnings(&s.identified));
-                reports.push(Some(s.identified.report));
-                parts.push(s.identified.objective);
-            }
-            None => {
-                let first = planned.first_fidelity(config);
-                parts.push(Box::new(setup::build(
-                    std::slice::from_ref(spec),
-                    Stage::Search,
-                    first,
-                )?) as Box<dyn Objective>);
-                reports.push(None);
-            }
-        }
-    }
-    // Stages in the order they ran.
-    let ran_order = order(&planned);
-    stage_records.sort_by_key(|s| {
-        let e = config
-            .experiments
-            .iter()
-            .position(|x| x.source == s.record)
-            .unwrap_or(0);
-        ran_order.iter().position(|&o| o == e).unwrap_or(usize::MAX)
-    });
+    let (stages, mut current) = run_stages(config, &planned, monitor)?;
+    let replayed: Vec<ReplayStage> = stages.iter().map(StageRun::replayed).collect();
+    let stage_records: Vec<RecordStage> = (stages.iter()).map(|s| s.record_stage(config)).collect();
+    let Records {
+        parts,
+        reports,
+        warnings,
+    } = records(config, &planned, stages)?;
     let stacked = Stacked { parts };
     let refined = planned.names(&planned.assignment.refined);
     let mut refinement = None;
@@ -179,12 +116,7 @@ pub fn run(
         undetermined: planned.names(&planned.assignment.undetermined),
         shares: planned.shares(config),
     };
-    let replay = Replay {
-        stages: replayed,
-        refined: refined.clone(),
-        refinement: settings,
-    };
-    let mut identified = report::assemble(
+    report::assemble(
         config,
         &planned,
         report::Found {
@@ -194,14 +126,112 @@ pub fn run(
             settings,
             refinement: refinement.unwrap_or_default(),
             plan,
+            replay: Replay {
+                stages: replayed,
+                refined,
+                refinement: settings,
+            },
             warnings,
             evaluations: monitor.evaluations(),
             wall_time_s: clock.elapsed().as_secs_f64(),
             interrupted: monitor.stopped(),
         },
-    )?;
-    identified.replay = Some(replay);
-    Ok(identified)
+    )
+}
+
+/// Each record's stage, in the order they run, each from where the ones before left
+/// the parameters; and the parameter set after the last.
+fn run_stages(
+    config: &Config,
+    planned: &Planned,
+    monitor: &Monitor,
+) -> Result<(Vec<StageRun>, Params), IdentifyError> {
+    let mut current = planned.space.base.clone();
+    let mut stages: Vec<StageRun> = Vec::new();
+    for (k, e) in order(planned).into_iter().enumerate() {
+        if monitor.stopped() {
+            break;
+        }
+        let names = planned.names(&planned.assignment.owned[e]);
+        let sub = planned.sub_config(config, e, &current, &names, k);
+        monitor.reset_best();
+        let before = monitor.evaluations();
+        let mut identified = identify_one(&sub, monitor)?;
+        identified.result.evaluations -= before;
+        current = identified.params.clone();
+        stages.push(StageRun {
+            record: e,
+            identified,
+        });
+    }
+    Ok((stages, current))
+}
+
+impl StageRun {
+    /// The stage as a bootstrap replicate runs it again.
+    fn replayed(&self) -> ReplayStage {
+        ReplayStage {
+            part: self.record,
+            names: self.identified.result.parameters.keys().cloned().collect(),
+            settings: self.identified.settings,
+        }
+    }
+
+    /// The stage as the plan in the result reports it.
+    fn record_stage(&self, config: &Config) -> RecordStage {
+        let r = &self.identified.result;
+        RecordStage {
+            record: config.experiments[self.record].source.clone(),
+            parameters: r.parameters.keys().cloned().collect(),
+            evaluations: r.evaluations,
+            wall_time_s: r.wall_time_s,
+            termination: r.termination.0.to_string(),
+        }
+    }
+}
+
+/// Each record's objective as its stage left it (the search's where it ran none),
+/// its report objective, and the stages' warnings with the start's.
+struct Records {
+    parts: Vec<Box<dyn Objective>>,
+    reports: Vec<Option<(Stage, Fidelity)>>,
+    warnings: Vec<Warning>,
+}
+
+/// The [`Records`] of `config`'s experiments, in their order, from `stages`.
+fn records(
+    config: &Config,
+    planned: &Planned,
+    stages: Vec<StageRun>,
+) -> Result<Records, IdentifyError> {
+    let n = config.experiments.len();
+    let mut by_record: Vec<Option<StageRun>> = (0..n).map(|_| None).collect();
+    for s in stages {
+        let e = s.record;
+        by_record[e] = Some(s);
+    }
+    let mut out = Records {
+        parts: Vec::with_capacity(n),
+        reports: Vec::with_capacity(n),
+        warnings: planned.start.warnings.clone(),
+    };
+    for (spec, stage) in config.experiments.iter().zip(by_record) {
+        match stage {
+            Some(s) => {
+                out.warnings.extend(stage_warnings(&s.identified));
+                out.reports.push(Some(s.identified.report));
+                out.parts.push(s.identified.objective);
+            }
+            None => {
+                let first = planned.first_fidelity(config);
+                let spec = std::slice::from_ref(spec);
+                let objective = setup::build(spec, Stage::Search, first)?;
+                out.parts.push(Box::new(objective));
+                out.reports.push(None);
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// The records in the order their stages run: rough ones (closed-loop simulations)

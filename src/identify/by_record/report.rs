@@ -19,7 +19,7 @@ use crate::identify::result::termination::Termination;
 use crate::identify::result::uncertainty::Uncertainty;
 use crate::identify::result::warning::{Coded, Warning};
 use crate::identify::result::IdentifyResult;
-use crate::identify::run::Identified;
+use crate::identify::run::{Identified, Replay};
 use crate::identify::search::settings::Settings;
 use crate::identify::setup;
 use crate::identify::space::ParamSpace;
@@ -35,6 +35,8 @@ pub(super) struct Found {
     pub settings: Settings,
     pub refinement: Vec<StartRecord>,
     pub plan: RecordPlan,
+    /// The stages and refinement for a bootstrap to run again.
+    pub replay: Replay,
     pub warnings: Vec<Warning>,
     pub evaluations: usize,
     pub wall_time_s: f64,
@@ -142,7 +144,7 @@ pub(super) fn assemble(
         objective: Box::new(found.objective),
         settings: found.settings,
         report: (Stage::Search, first),
-        replay: None,
+        replay: Some(found.replay),
     })
 }
 

@@ -284,11 +284,8 @@ impl Problem<'_> {
                         self.refit(whole, &self.names, start, self.settings)
                     });
                     on_replicate();
-                    Some(
-                        fitted
-                            .map(|p| self.values(&p, held))
-                            .map_err(|e| failed(b, e)),
-                    )
+                    let values = fitted.and_then(|p| self.values(&p, held));
+                    Some(values.map_err(|e| failed(b, e)))
                 };
                 self.each(self.objective, self.settings, replicates, &replicate)
             }
@@ -349,7 +346,11 @@ impl Problem<'_> {
             states = self.each(s.objective, s.settings, draws.len(), &step);
         }
         (states.into_iter().zip(draws))
-            .map(|(s, d)| s.map(|s| s.map(|p| self.values(&p, &d.held))))
+            .enumerate()
+            .map(|(b, (s, d))| {
+                let values = |p: Params| self.values(&p, &d.held).map_err(|e| failed(b, e));
+                s.map(|s| s.and_then(values))
+            })
             .collect()
     }
 
@@ -378,12 +379,17 @@ impl Problem<'_> {
     }
 
     /// A replicate's fitted values `p` in `names`' order, then its `held` draw.
-    fn values(&self, p: &Params, held: &[f64]) -> Vec<f64> {
-        let mut v: Vec<f64> = (self.names.iter())
-            .map(|n| p.get(n).ok().flatten().unwrap_or(f64::NAN))
-            .collect();
+    fn values(&self, p: &Params, held: &[f64]) -> Result<Vec<f64>, IdentifyError> {
+        let mut v = Vec::with_capacity(self.names.len() + held.len());
+        for name in &self.names {
+            let value = p.get(name).map_err(ObjectiveError::from)?;
+            v.push(
+                value
+                    .ok_or_else(|| IdentifyError::NothingEvaluated(format!("{name}: no value")))?,
+            );
+        }
         v.extend(held);
-        v
+        Ok(v)
     }
 
     /// The residual range of the objective's part `i`.
