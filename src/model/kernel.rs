@@ -62,6 +62,10 @@
 //! by small rotations (computed afresh every 1024 steps, drive.rs); later stages
 //! use the cubic Taylor polynomial of e about the step start.
 //!
+//! **Unbalance.** sin(θt + ψ) is carried along the table angle the same way
+//! ([`Carried`]) and rotated from the step start to each later stage's angle: one
+//! library call per 1024 steps where there was one per stage and lane.
+//!
 //! The step allocates nothing: stage derivatives and step-start values live in the
 //! [`Kernel`], which the caller owns and reuses.
 
@@ -90,13 +94,10 @@ struct LaneState<const L: usize> {
     direction: [[f64; L]; 3],
     /// free / inertia: net torque → acceleration (0 while stuck).
     gain: [[f64; L]; 3],
-    /// Shaft angle, and sin, cos of the fluctuation phase there.
-    shaft: [f64; L],
-    sin: [f64; L],
-    cos: [f64; L],
-    /// Steps left before the phase is computed afresh (0: compute now); a whole
-    /// number, kept as `f64` so that its update vectorises with the rest.
-    fresh: [f64; L],
+    /// The fluctuation's phase N·θw + φ, carried along the shaft angle.
+    phase: Carried<L>,
+    /// The unbalance's angle θt + ψ, carried along the table angle.
+    table: Carried<L>,
     /// Taylor coefficients of e(θ0 + Δ) = e0 + e1·Δ + e2·Δ²/2 + e3·Δ³/6 at the
     /// step start: [e0, e1, e2/2, e3/6, e2, e3/2].
     taylor: [[f64; L]; 6],
@@ -112,10 +113,8 @@ impl<const L: usize> Default for LaneState<L> {
             free: [[1.0; L]; 3],
             direction: [[0.0; L]; 3],
             gain: [[0.0; L]; 3],
-            shaft: [0.0; L],
-            sin: [0.0; L],
-            cos: [1.0; L],
-            fresh: [0.0; L],
+            phase: Carried::default(),
+            table: Carried::default(),
             taylor: [[0.0; L]; 6],
             twist: [[0.0; L]; 2],
             rate: [[0.0; L]; 2],
@@ -131,10 +130,8 @@ impl<const L: usize> LaneState<L> {
             free: self.free.map(|b| [b[l]]),
             direction: self.direction.map(|b| [b[l]]),
             gain: self.gain.map(|b| [b[l]]),
-            shaft: [self.shaft[l]],
-            sin: [self.sin[l]],
-            cos: [self.cos[l]],
-            fresh: [self.fresh[l]],
+            phase: self.phase.lane(l),
+            table: self.table.lane(l),
             taylor: self.taylor.map(|t| [t[l]]),
             twist: self.twist.map(|t| [t[l]]),
             rate: self.rate.map(|t| [t[l]]),
@@ -149,10 +146,8 @@ impl<const L: usize> LaneState<L> {
             self.direction[b][l] = one.direction[b][0];
             self.gain[b][l] = one.gain[b][0];
         }
-        self.shaft[l] = one.shaft[0];
-        self.sin[l] = one.sin[0];
-        self.cos[l] = one.cos[0];
-        self.fresh[l] = one.fresh[0];
+        self.phase.set_lane(l, &one.phase);
+        self.table.set_lane(l, &one.table);
         for k in 0..6 {
             self.taylor[k][l] = one.taylor[k][0];
         }
@@ -208,32 +203,13 @@ impl<const L: usize> LaneState<L> {
     }
 
     /// e and e' at a step's start: sin/cos of the phase carried from the previous
-    /// step's start by a small rotation (drive.rs), computed afresh every
-    /// [`PHASE_RESYNC`] steps, after a jump and on the first step (out of line, only
-    /// for the lanes that need it). Stores the Taylor coefficients for later stages.
+    /// step's start ([`Carried::advance`]). Stores the Taylor coefficients for later
+    /// stages.
     #[inline(always)]
     fn fluctuation_first(&mut self, d: &LaneDrive<L>, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
-        let x = d.n * (shaft - Lanes(self.shaft));
-        let sx = x.map(|x| taylor_sin_cos(x).0);
-        let cx = x.map(|x| taylor_sin_cos(x).1);
-        let (s0, c0) = (Lanes(self.sin), Lanes(self.cos));
-        let mut s = s0 * cx + c0 * sx;
-        let mut c = c0 * cx - s0 * sx;
-        let resync_at = PHASE_RESYNC as f64;
-        let fresh = Lanes(self.fresh).zip(x, |fresh, x| {
-            if (fresh > 0.0) & (x.abs() < SMALL_ANGLE) {
-                fresh - 1.0
-            } else {
-                resync_at
-            }
-        });
-        self.fresh = fresh.0;
-        if fresh.any(|f| f == resync_at) {
-            self.resync_phase(d, shaft, &mut s, &mut c);
-        }
-        self.shaft = shaft.0;
-        self.sin = s.0;
-        self.cos = c.0;
+        let (s, c) = self
+            .phase
+            .advance(d.n, shaft, |l, shaft| d.exact_phase(l, shaft));
         let e0 = d.w * s;
         let e1 = (d.w * d.n) * c;
         let (e2, e3) = ((-d.n * d.n) * e0, (-d.n * d.n) * e1);
@@ -248,15 +224,18 @@ impl<const L: usize> LaneState<L> {
         (e0, e1)
     }
 
-    /// The library sin/cos for the lanes whose counter was just reset.
-    #[cold]
-    #[inline(never)]
-    fn resync_phase(&self, d: &LaneDrive<L>, shaft: Lanes<L>, s: &mut Lanes<L>, c: &mut Lanes<L>) {
-        for l in 0..L {
-            if self.fresh[l] == PHASE_RESYNC as f64 {
-                (s.0[l], c.0[l]) = d.exact_phase(l, shaft.0[l]);
-            }
-        }
+    /// Tu = −m·g·e·sin(θt + ψ) at table angles `table`: at a step's start (`FIRST`)
+    /// the angle's sin carried from the previous step's start, at later stages
+    /// rotated from there ([`Carried`]); the library's `sin` of every stage before.
+    #[inline(always)]
+    fn unbalance<const FIRST: bool>(&mut self, d: &LaneDrive<L>, table: Lanes<L>) -> Lanes<L> {
+        let exact = |l: usize, t: f64| d.exact_unbalance(l, t);
+        let s = if FIRST {
+            self.table.advance(Lanes::splat(1.0), table, exact).0
+        } else {
+            self.table.near(Lanes::splat(1.0), table).0
+        };
+        -d.mge * s
     }
 
     /// e and e' at a later stage: the cubic Taylor polynomial of e about the step
@@ -265,7 +244,7 @@ impl<const L: usize> LaneState<L> {
     /// for a lane that moved |N·Δθ| ≥ 0.01 within the step (out of line).
     #[inline(always)]
     fn fluctuation_later(&self, d: &LaneDrive<L>, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
-        let dx = shaft - Lanes(self.shaft);
+        let dx = shaft - Lanes(self.phase.base);
         let t = self.taylor.map(Lanes);
         let mut e = t[0] + dx * (t[1] + dx * (t[2] + dx * t[3]));
         let mut ep = t[1] + dx * (t[4] + dx * t[5]);
@@ -284,10 +263,11 @@ impl<const L: usize> LaneState<L> {
         e: &mut Lanes<L>,
         ep: &mut Lanes<L>,
     ) {
+        let p = &self.phase;
         for l in 0..L {
-            if far(d.n.0[l] * (shaft.0[l] - self.shaft[l])) {
+            if far(d.n.0[l] * (shaft.0[l] - p.base[l])) {
                 (e.0[l], ep.0[l]) =
-                    d.fluctuation_near(l, shaft.0[l], self.shaft[l], (self.sin[l], self.cos[l]));
+                    d.fluctuation_near(l, shaft.0[l], p.base[l], (p.sin[l], p.cos[l]));
             }
         }
     }
@@ -297,15 +277,118 @@ impl<const L: usize> LaneState<L> {
     /// with |N·Δθ| ≥ 0.01).
     #[inline(always)]
     fn fluctuation_near(&self, d: &LaneDrive<L>, shaft: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
-        let x = d.n * (shaft - Lanes(self.shaft));
+        let (s, c) = self.phase.near(d.n, shaft);
+        (d.w * s, (d.w * d.n) * c)
+    }
+}
+
+/// sin and cos of an angle a·θ + φ carried along θ from step start to step start by
+/// small rotations (the library's `sin_cos` every [`PHASE_RESYNC`] steps, after a
+/// jump and on the first step, out of line for the lanes that need it), and rotated
+/// from the step start to a later stage's θ: exact to rounding, with one library
+/// call per 1024 steps instead of one per stage.
+#[derive(Clone, Copy, Debug)]
+struct Carried<const L: usize> {
+    /// θ at the step start, and sin, cos of a·θ + φ there.
+    base: [f64; L],
+    sin: [f64; L],
+    cos: [f64; L],
+    /// Steps left before the angle is computed afresh (0: compute now); a whole
+    /// number, kept as `f64` so that its update vectorises with the rest.
+    fresh: [f64; L],
+}
+
+impl<const L: usize> Default for Carried<L> {
+    fn default() -> Self {
+        Carried {
+            base: [0.0; L],
+            sin: [0.0; L],
+            cos: [1.0; L],
+            fresh: [0.0; L],
+        }
+    }
+}
+
+impl<const L: usize> Carried<L> {
+    fn lane(&self, l: usize) -> Carried<1> {
+        Carried {
+            base: [self.base[l]],
+            sin: [self.sin[l]],
+            cos: [self.cos[l]],
+            fresh: [self.fresh[l]],
+        }
+    }
+
+    fn set_lane(&mut self, l: usize, one: &Carried<1>) {
+        self.base[l] = one.base[0];
+        self.sin[l] = one.sin[0];
+        self.cos[l] = one.cos[0];
+        self.fresh[l] = one.fresh[0];
+    }
+
+    /// sin, cos of a·θ + φ at the step start `theta` (`a` = `scale`), made the new
+    /// base: rotated from the previous base, or `exact(l, θ)` where lane `l`'s
+    /// counter ran out or the angle moved |a·Δθ| ≥ 0.01.
+    #[inline(always)]
+    fn advance(
+        &mut self,
+        scale: Lanes<L>,
+        theta: Lanes<L>,
+        exact: impl Fn(usize, f64) -> (f64, f64),
+    ) -> (Lanes<L>, Lanes<L>) {
+        let x = scale * (theta - Lanes(self.base));
+        let sx = x.map(|x| taylor_sin_cos(x).0);
+        let cx = x.map(|x| taylor_sin_cos(x).1);
+        let (s0, c0) = (Lanes(self.sin), Lanes(self.cos));
+        let mut s = s0 * cx + c0 * sx;
+        let mut c = c0 * cx - s0 * sx;
+        let resync_at = PHASE_RESYNC as f64;
+        let fresh = Lanes(self.fresh).zip(x, |fresh, x| {
+            if (fresh > 0.0) & (x.abs() < SMALL_ANGLE) {
+                fresh - 1.0
+            } else {
+                resync_at
+            }
+        });
+        self.fresh = fresh.0;
+        if fresh.any(|f| f == resync_at) {
+            self.resync(theta, &mut s, &mut c, exact);
+        }
+        self.base = theta.0;
+        self.sin = s.0;
+        self.cos = c.0;
+        (s, c)
+    }
+
+    /// The library's sin/cos for the lanes whose counter was just reset.
+    #[cold]
+    #[inline(never)]
+    fn resync(
+        &self,
+        theta: Lanes<L>,
+        s: &mut Lanes<L>,
+        c: &mut Lanes<L>,
+        exact: impl Fn(usize, f64) -> (f64, f64),
+    ) {
+        for l in 0..L {
+            if self.fresh[l] == PHASE_RESYNC as f64 {
+                (s.0[l], c.0[l]) = exact(l, theta.0[l]);
+            }
+        }
+    }
+
+    /// sin, cos of a·θ + φ at `theta` within a step: the base rotated by a·Δθ
+    /// (Taylor polynomials, the library out of line where |a·Δθ| ≥ 0.01).
+    #[inline(always)]
+    fn near(&self, scale: Lanes<L>, theta: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
+        let x = scale * (theta - Lanes(self.base));
         let mut sx = x.map(|x| taylor_sin_cos(x).0);
         let mut cx = x.map(|x| taylor_sin_cos(x).1);
         if x.any(far) {
             library_sin_cos(x, &mut sx, &mut cx);
         }
         let (s0, c0) = (Lanes(self.sin), Lanes(self.cos));
-        let (s, c) = (s0 * cx + c0 * sx, c0 * cx - s0 * sx);
-        (d.w * s, (d.w * d.n) * c)
+        (s0 * cx + c0 * sx, c0 * cx - s0 * sx)
     }
 }
 
@@ -862,7 +945,7 @@ fn derivative<const L: usize, const SPUR: bool, const FIRST: bool, F: FrictionLa
     let tw = mesh_torque_lanes((d.kw, d.ciw, d.bw), d.gapped[1], dw, dw_rate);
 
     let unbalance = if d.unbalance {
-        Lanes(std::array::from_fn(|l| d.unbalance_torque(l, tt.0[l])))
+        st.unbalance::<FIRST>(d, tt)
     } else {
         zero
     };

@@ -153,6 +153,14 @@ impl<const L: usize> LaneDrive<L> {
     pub(crate) fn unbalance_torque(&self, l: usize, table_angle: f64) -> f64 {
         -self.mge.0[l] * (table_angle + self.psi.0[l]).sin()
     }
+
+    /// sin and cos of θt + ψ of lane `l` by the library (out of line, as
+    /// [`Self::exact_phase`]).
+    #[cold]
+    #[inline(never)]
+    pub(crate) fn exact_unbalance(&self, l: usize, table_angle: f64) -> (f64, f64) {
+        (table_angle + self.psi.0[l]).sin_cos()
+    }
 }
 
 #[cfg(test)]

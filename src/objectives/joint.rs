@@ -5,6 +5,8 @@
 
 use std::sync::Mutex;
 
+use rayon::prelude::*;
+
 use super::{sum_of_squares, Objective, ObjectiveError, ObjectiveKind, Smoothness};
 use crate::model::Params;
 use crate::sim::batch::by_point;
@@ -112,20 +114,20 @@ impl Objective for Joint {
         "joint"
     }
 
+    /// The parts side by side on the cores (a torque curve's one long run beside an
+    /// unbalance test's windows); the first part's error in their order.
     fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
-        let parts = self
-            .parts
-            .iter()
+        let parts: Vec<_> = (self.parts.par_iter())
             .map(|part| part.objective.residuals(p))
-            .collect::<Result<_, _>>()?;
+            .collect();
+        let parts = parts.into_iter().collect::<Result<_, _>>()?;
         Ok(self.stacked(p, parts))
     }
 
     fn residuals_batch(&self, points: &[Params]) -> Vec<Result<Vec<f64>, ObjectiveError>> {
-        let parts = self
-            .parts
-            .iter()
-            .map(|p| p.objective.residuals_batch(points));
+        let parts: Vec<_> = (self.parts.par_iter())
+            .map(|p| p.objective.residuals_batch(points))
+            .collect();
         by_point(points.len(), parts)
             .into_iter()
             .zip(points)

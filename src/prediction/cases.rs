@@ -17,6 +17,14 @@ pub struct Output {
     pub value: f64,
 }
 
+/// A case's outputs at the fit and, where the test is run as an ensemble there, the
+/// widening (below, above) of each output's interval by the test's own spread.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AtFit {
+    pub outputs: Vec<Output>,
+    pub spread: Option<Vec<(f64, f64)>>,
+}
+
 /// A virtual test with its settings, under a label (`compensated`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Case {
@@ -77,24 +85,28 @@ impl Case {
         }
     }
 
-    /// The test's own spread on the model `p`: for each output, the range (largest
-    /// less least) of its runs under `ensemble` (the rest positions' stick, sub-count
-    /// offsets of the compensation, the noise's seed: issue 58's ensemble), as the
-    /// widening (below, above) of an interval: a draw is one run of the test, the
-    /// machine's another, so either may lie at either end of the range. None for a
+    /// The outputs on the model `p` (the fit), and the test's own spread there: for
+    /// each output, the range (largest less least) of its runs under `ensemble` (the
+    /// rest positions' stick, sub-count offsets of the compensation, the noise's
+    /// seed: issue 58's ensemble), as the widening (below, above) of an interval: a
+    /// draw is one run of the test, the machine's another, so either may lie at
+    /// either end of the range. The outputs are the ensemble's member 0, the test as
+    /// given (bit for bit [`Case::run`]'s). No spread without an ensemble or for a
     /// test run once (the servo's responses).
-    pub fn spread(
-        &self,
-        p: &Params,
-        ensemble: &Ensemble,
-    ) -> Result<Option<Vec<(f64, f64)>>, CaseError> {
-        let Test::Positioning { test, .. } = &self.test else {
-            return Ok(None);
+    pub fn at_fit(&self, p: &Params, ensemble: Option<&Ensemble>) -> Result<AtFit, CaseError> {
+        let (Test::Positioning { test, .. }, Some(ensemble)) = (&self.test, ensemble) else {
+            return Ok(AtFit {
+                outputs: self.run(p)?,
+                spread: None,
+            });
         };
         let e = ensemble::run(&self.tuned(p), test, ensemble)?;
         let (least, largest) = (iso_values(&e.min), iso_values(&e.max));
         let range = least.iter().zip(&largest).map(|(lo, hi)| hi.1 - lo.1);
-        Ok(Some(range.map(|r| (-r, r)).collect()))
+        Ok(AtFit {
+            outputs: outputs(iso_values(&e.members[0]).to_vec()),
+            spread: Some(range.map(|r| (-r, r)).collect()),
+        })
     }
 
     /// `p` with the case's controller settings, if it has its own.

@@ -19,7 +19,7 @@ use crate::experiments::positioning::ensemble::Ensemble;
 use crate::model::{ParamError, Params};
 use crate::sim::batch::{by_point, on_valid};
 use crate::sim::LANES;
-pub use cases::{Case, CaseError, Output, Test};
+pub use cases::{AtFit, Case, CaseError, Output, Test};
 pub use draws::{DrawSource, Draws};
 
 /// Why a prediction could not be made.
@@ -146,38 +146,12 @@ pub fn predict(
     if !(s.level > 0.0 && s.level < 1.0) {
         return Err(PredictError::Level(s.level));
     }
-    let nominal = s
-        .cases
-        .iter()
-        .map(|c| {
-            c.run(s.params).map_err(|source| PredictError::Nominal {
-                case: c.label.clone(),
-                source,
-            })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let spreads = spreads(s)?;
     let skipped = AtomicUsize::new(0);
-    // Draws in groups of the kernel's lane count: each case runs a group together.
-    let runs: Vec<Result<Vec<Vec<Output>>, String>> = s
-        .draws
-        .sets
-        .par_chunks(LANES)
-        .flat_map_iter(|sets| {
-            if stop.load(Ordering::Relaxed) {
-                skipped.fetch_add(sets.len(), Ordering::Relaxed);
-                return Vec::new();
-            }
-            let runs = run_draws(s, sets);
-            // Draws a stop cut short (`crate::interrupt`) were not run, not failed.
-            if stop.load(Ordering::Relaxed) || crate::interrupt::requested() {
-                skipped.fetch_add(sets.len(), Ordering::Relaxed);
-                return Vec::new();
-            }
-            sets.iter().for_each(|_| progress());
-            runs
-        })
-        .collect();
+    // The fit's runs beside the draws': the cores are not left to the ensemble's
+    // last lane batch.
+    let (at_fit, runs) = rayon::join(|| at_fit(s), || run_all(s, progress, stop, &skipped));
+    let (nominal, spreads): (Vec<_>, Spreads) =
+        (at_fit?.into_iter()).map(|a| (a.outputs, a.spread)).unzip();
     let total = runs.len();
     let (done, failures): (Vec<_>, Vec<_>) = runs.into_iter().partition(Result::is_ok);
     let failures: Vec<String> = failures.into_iter().filter_map(Result::err).collect();
@@ -226,13 +200,15 @@ impl Prediction {
 fn run_draws(s: &Setup, sets: &[Vec<f64>]) -> Vec<Result<Vec<Vec<Output>>, String>> {
     let params: Vec<Result<Params, String>> = sets.iter().map(|set| drawn(s, set)).collect();
     on_valid(params, |ps| {
-        let cases = s.cases.iter().map(|c| {
-            let label = |e: CaseError| format!("{}: {e}", c.label);
-            c.run_batch(ps)
-                .into_iter()
-                .map(|r| r.map_err(label))
-                .collect()
-        });
+        let cases: Vec<Vec<_>> = (s.cases.par_iter())
+            .map(|c| {
+                let label = |e: CaseError| format!("{}: {e}", c.label);
+                c.run_batch(ps)
+                    .into_iter()
+                    .map(|r| r.map_err(label))
+                    .collect()
+            })
+            .collect();
         by_point(ps.len(), cases)
     })
 }
@@ -322,17 +298,45 @@ fn outside(x: f64, lo: f64, hi: f64) -> bool {
 /// Each case's spread of its test at the fit (None for a case run once).
 type Spreads = Vec<Option<Vec<(f64, f64)>>>;
 
-fn spreads(s: &Setup) -> Result<Spreads, PredictError> {
-    let Some(ensemble) = &s.ensemble else {
-        return Ok(vec![None; s.cases.len()]);
-    };
-    (s.cases.par_iter())
+/// Each case's outputs at the fit and its test's spread there ([`Case::at_fit`]),
+/// the cases in parallel; the first case's error in their order.
+fn at_fit(s: &Setup) -> Result<Vec<AtFit>, PredictError> {
+    let runs: Vec<_> = (s.cases.par_iter())
         .map(|c| {
-            c.spread(s.params, ensemble)
+            c.at_fit(s.params, s.ensemble.as_ref())
                 .map_err(|source| PredictError::Nominal {
                     case: c.label.clone(),
                     source,
                 })
+        })
+        .collect();
+    runs.into_iter().collect()
+}
+
+/// Every draw's outputs, the draws in groups of the kernel's lane count (each case
+/// runs a group together), `progress` after each group, none begun after `stop`.
+fn run_all(
+    s: &Setup,
+    progress: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+    skipped: &AtomicUsize,
+) -> Vec<Result<Vec<Vec<Output>>, String>> {
+    s.draws
+        .sets
+        .par_chunks(LANES)
+        .flat_map_iter(|sets| {
+            if stop.load(Ordering::Relaxed) {
+                skipped.fetch_add(sets.len(), Ordering::Relaxed);
+                return Vec::new();
+            }
+            let runs = run_draws(s, sets);
+            // Draws a stop cut short (`crate::interrupt`) were not run, not failed.
+            if stop.load(Ordering::Relaxed) || crate::interrupt::requested() {
+                skipped.fetch_add(sets.len(), Ordering::Relaxed);
+                return Vec::new();
+            }
+            sets.iter().for_each(|_| progress());
+            runs
         })
         .collect()
 }

@@ -19,7 +19,7 @@ pub use lanes::{LaneSimulation, LANES};
 
 /// The RK4 step is chosen so that |λ|·dt ≤ this for the fastest eigenvalue λ of the
 /// linearised model (docs/model.md gives the resulting errors).
-pub const STEP_ACCURACY: f64 = 0.1;
+pub const STEP_ACCURACY: f64 = 0.2;
 /// Beyond |λ|·dt = this a step is refused (RK4's stability limit is ≈ 2.8; past 1
 /// the fastest mode is badly resolved).
 pub const STEP_LIMIT: f64 = 1.0;

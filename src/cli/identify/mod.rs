@@ -212,11 +212,13 @@ pub struct Args {
     /// (lower bounds on a rough cost: fast); `bootstrap` — whatever the cost.
     #[arg(long, value_enum, default_value = "auto")]
     pub intervals: IntervalsArg,
-    /// The bootstrap's replicates [default: 16] (`--resample` alone: 20), and the
-    /// bootstrap whatever the cost: each replicate is the fitted model's response
-    /// plus the fit's residuals resampled in blocks (an unbalance test's few steps:
-    /// normal errors), each held parameter drawn within its range, fitted again from
-    /// the fit by the fit's solver, side by side in the kernel's lanes. Its 95 %
+    /// The bootstrap's replicates (`--resample` alone: 20; the bootstrap `--intervals
+    /// auto` chooses on a rough cost: 12), and the bootstrap whatever the cost: each
+    /// replicate is the fitted model's response plus the fit's residuals resampled
+    /// in blocks (an unbalance test's few steps: normal errors), each held parameter
+    /// drawn within its range, fitted again from the fit's start by the fit's own
+    /// search (a fit by plan: its stages replayed), side by side in the kernel's
+    /// lanes. Its 95 %
     /// interval (the fit less the replicates' bias, ± 1.96 of their spread; with
     /// held ranges around the replicates' mean) holds where the standard errors do
     /// not and replaces the warning that they are lower bounds. In the result as

@@ -2,6 +2,8 @@
 //! them. Each is already its record's share of the joint cost (scaled by
 //! √(weight / count)), so the sum of squares is the joint cost.
 
+use rayon::prelude::*;
+
 use crate::model::Params;
 use crate::objectives::{Objective, ObjectiveError};
 use crate::sim::batch::by_point;
@@ -16,16 +18,17 @@ impl Objective for Stacked {
         "records"
     }
 
+    /// The parts side by side on the cores; the first part's error in their order.
     fn residuals(&self, p: &Params) -> Result<Vec<f64>, ObjectiveError> {
-        let mut out = Vec::with_capacity(self.len());
-        for part in &self.parts {
-            out.extend(part.residuals(p)?);
-        }
-        Ok(out)
+        let parts: Vec<_> = self.parts.par_iter().map(|o| o.residuals(p)).collect();
+        let parts = parts.into_iter().collect::<Result<Vec<_>, _>>()?;
+        Ok(parts.concat())
     }
 
     fn residuals_batch(&self, points: &[Params]) -> Vec<Result<Vec<f64>, ObjectiveError>> {
-        let parts = self.parts.iter().map(|o| o.residuals_batch(points));
+        let parts: Vec<_> = (self.parts.par_iter())
+            .map(|o| o.residuals_batch(points))
+            .collect();
         by_point(points.len(), parts)
             .into_iter()
             .map(|parts| parts.map(|r| r.concat()))

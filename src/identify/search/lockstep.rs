@@ -22,6 +22,10 @@ use crate::sim::LANES;
 /// evaluation from a thread pool's task), never reached in the bootstrap's use.
 const PATIENCE: Duration = Duration::from_millis(20);
 
+/// The most searches [`side_by_side`] runs at once per worker thread: four lane
+/// batches' worth.
+const SEATS_PER_WORKER: usize = 4 * LANES;
+
 /// `objective` shared by `searches` threads, its evaluations gathered into batches
 /// of up to `width` points. Each thread holds a [`Seat`] while it runs searches.
 pub struct Lockstep<'a> {
@@ -195,19 +199,23 @@ impl Objective for Lockstep<'_> {
     }
 }
 
-/// `task(i, objective)` for i in 0..`count`, on threads of their own ([`LANES`] per
-/// worker thread of rayon's pool), the objective's evaluations gathered into lane
-/// batches ([`Lockstep`]): each task's result is the one it gets alone. A batch
-/// holds up to as many points as spread the running searches over the workers
-/// (two each for four searches on two cores: two batches at once, not one of four).
+/// `task(i, objective)` for i in 0..`count`, on threads of their own (all of them
+/// at once, up to [`SEATS_PER_WORKER`] per worker thread of rayon's pool), the
+/// objective's evaluations gathered into lane batches ([`Lockstep`]): each task's
+/// result is the one it gets alone. A batch holds up to as many points as spread
+/// the running searches over the workers, at most [`LANES`] (two each for four
+/// searches on two cores: two batches at once, not one of four; twelve searches,
+/// three full batches). Every task starts at once so that the last ones do not run
+/// alone, a batch of their own each on one core, after the others have finished.
 pub(crate) fn side_by_side<T: Send>(
     objective: &dyn Objective,
     count: usize,
     task: &(dyn Fn(usize, &dyn Objective) -> T + Sync),
 ) -> Vec<T> {
     let workers = rayon::current_num_threads();
-    let threads = (workers * LANES).min(count).max(1);
-    let lockstep = Lockstep::new(objective, threads, threads.div_ceil(workers));
+    let threads = (workers * SEATS_PER_WORKER).min(count).max(1);
+    let width = threads.div_ceil(workers).min(LANES);
+    let lockstep = Lockstep::new(objective, threads, width);
     let next = AtomicUsize::new(0);
     let mut outcomes: Vec<(usize, T)> = std::thread::scope(|s| {
         let spawned: Vec<_> = (0..threads)
