@@ -148,6 +148,31 @@ struct Builder<'a> {
     next: Vec<(usize, Expr)>,
 }
 
+/// The controller's memories' state coordinates, and how far back the encoder is
+/// read.
+struct Memories {
+    /// The encoder's dead time: whole control periods and a fraction of one.
+    whole: usize,
+    fraction: f64,
+    /// θm one, two, … periods back.
+    history: Vec<usize>,
+    /// The reading a period back (the backward-difference speed).
+    previous: usize,
+    speed_integral: Option<usize>,
+    /// Whether the position loop is closed.
+    cascade: bool,
+    position_integral: Option<usize>,
+    sections: Vec<Biquad>,
+    /// Each section's two states (direct form II transposed).
+    filter_states: Vec<[usize; 2]>,
+    /// The output held a period (output delay).
+    pending: Option<usize>,
+    /// The current loop's lag.
+    lag: Option<usize>,
+    /// The position loop's past outputs (its slower cycle).
+    held: Vec<usize>,
+}
+
 impl<'a> Builder<'a> {
     fn new(plant: &'a DiscretePlant, c: &'a ControllerParams, closure: Closure) -> Self {
         Builder {
@@ -169,6 +194,19 @@ impl<'a> Builder<'a> {
     /// the matrices. Every memory is allocated before any expression is formed, so
     /// that the expressions have the final length.
     fn build(mut self) -> SampledLoop {
+        let m = self.memories();
+        self.plant_rows();
+        let reading = self.reading(&m);
+        let speed = (&reading - self.unit(m.previous)) / self.c.tc;
+        self.next.push((m.previous, reading.clone()));
+        let command = self.command(&m, &reading);
+        let law = self.speed_law(&m, command - speed);
+        let output = self.applied(&m, law) * self.c.drive_gain;
+        self.matrices(output)
+    }
+
+    /// The controller's memories, each a new state coordinate.
+    fn memories(&mut self) -> Memories {
         let periods = self.plant.encoder_delay / self.c.tc;
         let (whole, fraction) = (periods.floor() as usize, periods - periods.floor());
         let depth = whole + usize::from(fraction > 0.0);
@@ -177,32 +215,47 @@ impl<'a> Builder<'a> {
         let speed_integral = (self.c.kvi != 0.0).then(|| self.state());
         let cascade = self.closure == Closure::Cascade;
         let position_integral = (cascade && self.c.kpi != 0.0).then(|| self.state());
-        let sections: Vec<Biquad> = self
-            .c
-            .filters
-            .iter()
+        let sections: Vec<Biquad> = (self.c.filters.iter())
             .map(|f| Biquad::new(f, self.c.tc))
             .collect();
-        let filter_states: Vec<[usize; 2]> = sections
-            .iter()
+        let filter_states = (sections.iter())
             .map(|_| [self.state(), self.state()])
             .collect();
         let pending = (self.c.output_delay_periods == 1.0).then(|| self.state());
         let lag = (self.c.current_lag_s > 0.0).then(|| self.state());
         let every = self.c.position_every() as usize;
-        let held: Vec<usize> = if cascade {
+        let held = if cascade {
             (1..every).map(|_| self.state()).collect()
         } else {
             Vec::new()
         };
+        Memories {
+            whole,
+            fraction,
+            history,
+            previous,
+            speed_integral,
+            cascade,
+            position_integral,
+            sections,
+            filter_states,
+            pending,
+            lag,
+            held,
+        }
+    }
+
+    /// The expression of state coordinate `i` alone.
+    fn unit(&self, i: usize) -> Expr {
+        let mut e = Expr::zeros(self.n + 1);
+        e[i] = 1.0;
+        e
+    }
+
+    /// The plant: Φ·x + Γ·w.
+    fn plant_rows(&mut self) {
         let len = self.n + 1;
-        let unit = |i: usize| {
-            let mut e = Expr::zeros(len);
-            e[i] = 1.0;
-            e
-        };
         let plant_rows = self.plant.phi.nrows();
-        // The plant: Φ·x + Γ·w.
         for i in 0..plant_rows {
             let mut e = Expr::zeros(len);
             e.rows_mut(0, plant_rows)
@@ -210,75 +263,89 @@ impl<'a> Builder<'a> {
             e[len - 1] = self.plant.gamma[i];
             self.next.push((i, e));
         }
-        let motor = unit(self.plant.motor);
+    }
+
+    /// The motor angle the controller reads, `whole` periods and `fraction` of one
+    /// back (interpolated), and the history's shift.
+    fn reading(&mut self, m: &Memories) -> Expr {
         // θm[k − i] is `motor` for i = 0, history[i − 1] after.
         let back = |i: usize| {
             if i == 0 {
-                motor.clone()
+                self.unit(self.plant.motor)
             } else {
-                unit(history[i - 1])
+                self.unit(m.history[i - 1])
             }
         };
-        let reading = if fraction > 0.0 {
-            back(whole) * (1.0 - fraction) + back(whole + 1) * fraction
+        let reading = if m.fraction > 0.0 {
+            back(m.whole) * (1.0 - m.fraction) + back(m.whole + 1) * m.fraction
         } else {
-            back(whole)
+            back(m.whole)
         };
-        for (i, &h) in history.iter().enumerate() {
-            self.next.push((h, back(i)));
+        let shifted: Vec<_> = (m.history.iter().enumerate())
+            .map(|(i, &h)| (h, back(i)))
+            .collect();
+        self.next.extend(shifted);
+        reading
+    }
+
+    /// The position loop's speed command (zero for the velocity loop alone).
+    fn command(&mut self, m: &Memories, reading: &Expr) -> Expr {
+        if !m.cascade {
+            return Expr::zeros(self.n + 1);
         }
-        let speed = (&reading - unit(previous)) / self.c.tc;
-        self.next.push((previous, reading.clone()));
-        let command = if cascade {
-            let error = match self.c.loop_mode {
-                LoopMode::SemiClosed => -reading.clone(),
-                LoopMode::FullClosed => -unit(self.plant.table) / self.plant.ratio,
-            };
-            let now = match position_integral {
-                Some(i) => {
-                    let integral = unit(i) + &error * self.c.tc;
-                    self.next.push((i, integral.clone()));
-                    &error * self.c.kpp + integral * self.c.kpi
-                }
-                None => error * self.c.kpp,
-            };
-            self.held_average(now, &held, &unit)
-        } else {
-            Expr::zeros(len)
+        let error = match self.c.loop_mode {
+            LoopMode::SemiClosed => -reading.clone(),
+            LoopMode::FullClosed => -self.unit(self.plant.table) / self.plant.ratio,
         };
-        let speed_error = command - speed;
+        let now = match m.position_integral {
+            Some(i) => {
+                let integral = self.unit(i) + &error * self.c.tc;
+                self.next.push((i, integral.clone()));
+                &error * self.c.kpp + integral * self.c.kpi
+            }
+            None => error * self.c.kpp,
+        };
+        self.held_average(now, &m.held)
+    }
+
+    /// The speed controller's PI on `speed_error`, then the setpoint filters.
+    fn speed_law(&mut self, m: &Memories, speed_error: Expr) -> Expr {
         let mut law = &speed_error * self.c.kvp;
-        if let Some(i) = speed_integral {
-            let integral = unit(i) + &speed_error * self.c.tc;
+        if let Some(i) = m.speed_integral {
+            let integral = self.unit(i) + &speed_error * self.c.tc;
             self.next.push((i, integral.clone()));
             law += integral * self.c.kvi;
         }
-        for (s, z) in sections.iter().zip(&filter_states) {
+        for (s, z) in m.sections.iter().zip(&m.filter_states) {
             let (b, a) = s.coefficients();
-            let out = &law * b[0] + unit(z[0]);
-            self.next
-                .push((z[0], &law * b[1] - &out * a[0] + unit(z[1])));
+            let out = &law * b[0] + self.unit(z[0]);
+            let first = &law * b[1] - &out * a[0] + self.unit(z[1]);
+            self.next.push((z[0], first));
             self.next.push((z[1], &law * b[2] - &out * a[1]));
             law = out;
         }
-        let applied = match pending {
+        law
+    }
+
+    /// The law as the current loop applies it: a period's output delay, the
+    /// current loop's first-order lag.
+    fn applied(&mut self, m: &Memories, law: Expr) -> Expr {
+        let applied = match m.pending {
             Some(i) => {
                 self.next.push((i, law));
-                unit(i)
+                self.unit(i)
             }
             None => law,
         };
-        let applied = match lag {
+        match m.lag {
             Some(i) => {
                 let a = -(-self.c.tc / self.c.current_lag_s).exp_m1();
-                let lagged = unit(i) * (1.0 - a) + applied * a;
+                let lagged = self.unit(i) * (1.0 - a) + applied * a;
                 self.next.push((i, lagged.clone()));
                 lagged
             }
             None => applied,
-        };
-        let output = applied * self.c.drive_gain;
-        self.matrices(output)
+        }
     }
 
     /// The position loop's output `now` as the velocity loop sees it when the
@@ -286,18 +353,18 @@ impl<'a> Builder<'a> {
     /// its past outputs): the sample-and-hold's baseband response, the mean of the
     /// last N outputs (its images at the position cycle's rate neglected: docs/
     /// tuning.md, "The position controller's cycle"); `now` itself for N = 1.
-    fn held_average(&mut self, now: Expr, held: &[usize], unit: &dyn Fn(usize) -> Expr) -> Expr {
+    fn held_average(&mut self, now: Expr, held: &[usize]) -> Expr {
         if held.is_empty() {
             return now;
         }
         let n = (held.len() + 1) as f64;
         let mut sum = now.clone();
         for (i, &h) in held.iter().enumerate() {
-            sum += unit(h);
+            sum += self.unit(h);
             let previous = if i == 0 {
                 now.clone()
             } else {
-                unit(held[i - 1])
+                self.unit(held[i - 1])
             };
             self.next.push((h, previous));
         }
