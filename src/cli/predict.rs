@@ -33,11 +33,13 @@ with the fit's values set. The interval carries the fitted parameters' uncertain
 that of the held parameters: the parameter set's held ranges (`rtid params` shows a \
 preset's) — those `identify` carried drawn with the fitted parameters moving as the \
 fit said, or as the replicates drew them; the others, and those given here with \
---uncertain NAME=X%, uniformly within value·(1 ± X %); 0 % holds one exactly. It is \
-extended to the value at the fit where the draws' interval misses it. Every other \
-parameter keeps its value, and the output names them. On six worm gears that are not \
-the preset, 69 of 72 intervals held the machine's value with 24 replicates and three \
-ranges given by hand (docs/validation.md). A fitted parameter \
+--uncertain NAME=X%, uniformly within value·(1 ± X %); 0 % holds one exactly. The \
+draws' interval is joined with its reflection about the value at the fit (the basic \
+bootstrap interval): the draws' offset from the fit may be the fit's offset from the \
+machine, the other way, and the interval always holds the value at the fit. Every other \
+parameter keeps its value, and the output names them. On fifteen worm gears that are \
+not the preset, the default chain (identify → compensate --fit → predict, no interval \
+option) held 179 of 180 values (docs/validation.md). A fitted parameter \
 the data did not determine (no standard error) cannot be drawn: the command refuses \
 until it is held at its value (--hold NAME), and then says so.
 

@@ -49,13 +49,10 @@ pub enum PredictError {
 }
 
 /// One output's prediction: its value at the fit, and the draws' median and central
-/// interval (absent with fewer than [`MIN_DRAWS`] completed draws), extended to hold
-/// the value at the fit where the draws' alone does not: the fit is itself a
-/// parameter set the data allow, and an output folded at a floor (the reversal
-/// after a compensation: any mismatch adds to it) has draws that all lie above it.
-/// On six machines around the worm gear (docs/validation.md) the draws' interval
-/// alone missed the machine's value at the encoder's floor where the value at the
-/// fit had it.
+/// interval (absent with fewer than [`MIN_DRAWS`] completed draws) joined with its
+/// reflection about the value at the fit ([`both_ways`]), so that it always holds
+/// that value: the fit is itself a parameter set the data allow, and the draws'
+/// offset from it may be the fit's offset from the machine, the other way.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Predicted {
     pub name: String,
@@ -63,7 +60,8 @@ pub struct Predicted {
     pub median: Option<f64>,
     pub lower: Option<f64>,
     pub upper: Option<f64>,
-    /// Whether the interval was extended to the value at the fit.
+    /// Whether the draws' interval alone missed the value at the fit (which the
+    /// reflection holds).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub extended: bool,
     /// The test's own spread at the fit, added to the draws' interval (below,
@@ -263,8 +261,8 @@ fn note_assumed(notes: &mut Vec<String>, params: &Params, drawn: &[String]) {
     }
 }
 
-/// Names each output whose value at the fit lay outside the draws' interval (which
-/// was then extended to it): one folded at a floor, or that jumps with the
+/// Names each output whose value at the fit lay outside the draws' interval (the
+/// reflection about it holds it): one folded at a floor, or that jumps with the
 /// parameters (where the axis sticks, how it rattles in the backlash) rather than
 /// following them smoothly.
 fn note_rough(notes: &mut Vec<String>, cases: &[CasePrediction]) {
@@ -278,8 +276,8 @@ fn note_rough(notes: &mut Vec<String>, cases: &[CasePrediction]) {
         .collect();
     if !rough.is_empty() {
         notes.push(format!(
-            "the value at the fit lies outside the draws' interval for {}, which is extended to \
-             it: these outputs are folded at a floor (any mismatch of a compensation adds to \
+            "the value at the fit lies outside the draws' interval for {}, which holds it by its \
+             reflection about it: these outputs are folded at a floor (any mismatch of a compensation adds to \
              them) or jump with small changes of the parameters (where the axis sticks, how it \
              rattles in the backlash)",
             rough.join(", ")
@@ -341,15 +339,15 @@ fn run_all(
         .collect()
 }
 
-/// Each case's outputs: value at the fit, the draws' median and central interval,
-/// widened by the test's own spread.
+/// Each case's outputs: value at the fit, the draws' median and central interval
+/// joined with its reflection about the value at the fit ([`both_ways`]), widened by
+/// the test's own spread.
 fn summarise(
     s: &Setup,
     nominal: &[Vec<Output>],
     done: &[Vec<Vec<Output>>],
     spreads: &Spreads,
 ) -> Vec<CasePrediction> {
-    let tail = (1.0 - s.level) / 2.0;
     s.cases
         .iter()
         .enumerate()
@@ -357,36 +355,55 @@ fn summarise(
             test: case.test_name().to_string(),
             case: case.label.clone(),
             unit: case.unit().to_string(),
-            values: nominal[c]
-                .iter()
-                .enumerate()
+            values: (nominal[c].iter().enumerate())
                 .map(|(k, out)| {
-                    let mut v: Vec<f64> = done.iter().map(|d| d[c][k].value).collect();
-                    v.sort_by(f64::total_cmp);
-                    let at = |q: f64| (v.len() >= MIN_DRAWS).then(|| quantile(&v, q));
-                    let spread = spreads[c].as_ref().map(|v| v[k]);
-                    let (below, above) = spread.unwrap_or((0.0, 0.0));
-                    // B, E, M, R, A are magnitudes (B̄ alone is signed): the widening
-                    // stops at 0.
-                    let floor = if spread.is_some() && out.name != cases::SIGNED { 0.0 } else { f64::NEG_INFINITY };
-                    let (lower, upper) = (
-                        at(tail).map(|lo| (lo + below).max(floor.min(lo))),
-                        at(1.0 - tail).map(|hi| hi + above),
-                    );
-                    let extended = matches!((lower, upper), (Some(lo), Some(hi)) if outside(out.value, lo, hi));
-                    Predicted {
-                        name: out.name.to_string(),
-                        nominal: out.value,
-                        median: at(0.5),
-                        lower: lower.map(|lo| if extended { lo.min(out.value) } else { lo }),
-                        upper: upper.map(|hi| if extended { hi.max(out.value) } else { hi }),
-                        extended,
-                        spread,
-                    }
+                    let v: Vec<f64> = done.iter().map(|d| d[c][k].value).collect();
+                    predicted(out, v, spreads[c].as_ref().map(|v| v[k]), s.level)
                 })
                 .collect(),
         })
         .collect()
+}
+
+/// One output's [`Predicted`] from its value at the fit `out`, the draws' values
+/// `v` and the test's spread at the fit.
+fn predicted(out: &Output, mut v: Vec<f64>, spread: Option<(f64, f64)>, level: f64) -> Predicted {
+    v.sort_by(f64::total_cmp);
+    let tail = (1.0 - level) / 2.0;
+    let at = |q: f64| (v.len() >= MIN_DRAWS).then(|| quantile(&v, q));
+    // B, E, M, R, A are magnitudes (B̄ alone is signed): nothing takes them below 0.
+    let floor = if out.name == cases::SIGNED {
+        f64::NEG_INFINITY
+    } else {
+        0.0
+    };
+    let draws = at(tail).zip(at(1.0 - tail));
+    let joined = draws.map(|(lo, hi)| both_ways(out.value, lo, hi, floor));
+    let (below, above) = spread.unwrap_or((0.0, 0.0));
+    Predicted {
+        name: out.name.to_string(),
+        nominal: out.value,
+        median: at(0.5),
+        lower: joined.map(|(lo, _)| (lo + below).max(floor.min(lo))),
+        upper: joined.map(|(_, hi)| hi + above),
+        extended: draws.is_some_and(|(lo, hi)| outside(out.value, lo, hi)),
+        spread,
+    }
+}
+
+/// The draws' central interval [lo, hi] joined with its reflection about the
+/// value at the fit `v`, [2v − hi, 2v − lo] (the percentile and the basic bootstrap
+/// interval), cut at `floor`. The draws' offset from the fit may stand for the
+/// fit's offset from the machine the other way (the basic interval's reading) or
+/// not (the percentile's); the draws cannot tell which. On θbw's cost, a plateau
+/// below the machine's value and a cliff above it, a fit comes down the plateau
+/// and so do its replicates, all to one side of it: the draws' interval alone
+/// held 61 of 72 values on six machines, the union 71 (docs/validation.md). An
+/// output folded at a floor (the lost motion after a compensation: any mismatch
+/// adds to it) has draws all above the fit's value; the reflection reaches the
+/// floor. The union always holds `v`.
+fn both_ways(v: f64, lo: f64, hi: f64, floor: f64) -> (f64, f64) {
+    ((2.0 * v - hi).max(floor).min(lo), (2.0 * v - lo).max(hi))
 }
 
 /// The `q` quantile of sorted values, linear between order statistics (type 7).
@@ -405,6 +422,31 @@ mod tests {
     fn a_value_at_an_end_of_the_interval_is_inside() {
         assert!(!outside(36.0 - 1e-12, 36.0, 37.0));
         assert!(outside(35.9, 36.0, 37.0) && outside(37.1, 36.0, 37.0));
+    }
+
+    #[test]
+    fn the_interval_holds_the_draws_and_their_reflection_about_the_fit() {
+        // Draws all below the fit (θbw's plateau): the reflection reaches above it.
+        assert_eq!(both_ways(10.0, 6.0, 9.0, f64::NEG_INFINITY), (6.0, 14.0));
+        // Draws around the fit: the union is the wider of the two on each side.
+        assert_eq!(both_ways(10.0, 9.0, 12.0, f64::NEG_INFINITY), (8.0, 12.0));
+        // A magnitude folded at a floor, every draw above the fit: cut at 0.
+        assert_eq!(both_ways(0.5, 1.0, 9.0, 0.0), (0.0, 9.0));
+    }
+
+    #[test]
+    fn a_prediction_holds_its_value_at_the_fit_and_names_a_miss() {
+        let out = Output {
+            name: "A",
+            value: 3.0,
+        };
+        let draws: Vec<f64> = (0..20).map(|i| 4.0 + i as f64 * 0.5).collect();
+        let p = predicted(&out, draws, Some((-0.5, 0.25)), 0.95);
+        let (lo, hi) = (p.lower.unwrap(), p.upper.unwrap());
+        assert!(p.extended && lo <= 3.0 && hi >= 13.0, "{lo} … {hi}");
+        assert_eq!(lo, 0.0, "the reflection of the upper end reaches below 0");
+        let few = predicted(&out, vec![4.0; MIN_DRAWS - 1], None, 0.95);
+        assert!(few.lower.is_none() && few.upper.is_none() && !few.extended);
     }
 
     #[test]

@@ -220,7 +220,8 @@ pub struct Args {
     /// search (a fit by plan: its stages replayed), side by side in the kernel's
     /// lanes. Its 95 %
     /// interval (the fit less the replicates' bias, ± 1.96 of their spread; with
-    /// held ranges around the replicates' mean) holds where the standard errors do
+    /// held ranges the fit ± (|bias| + 1.96 sd), which holds the interval about
+    /// the replicates' mean as well) holds where the standard errors do
     /// not and replaces the warning that they are lower bounds. In the result as
     /// `resampling`.
     #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "20",

@@ -28,8 +28,8 @@ pub struct Resampling {
 }
 
 /// A normal bootstrap interval: ± 1.96 of the replicates' standard deviation
-/// about the fit less their mean offset (bias-corrected), or about their mean where
-/// they drew held parameters; cut to the search's bounds.
+/// about the fit less their mean offset (bias-corrected), or, where they drew held
+/// parameters, about both the fit less it and their mean; cut to the search's bounds.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Interval {
     pub lower: f64,
