@@ -122,10 +122,7 @@ impl Factor {
 /// Parses one `--vary` specification against the registry and the base parameters
 /// `base` (for the topology and, for a bare name, the base value).
 pub fn parse(spec: &str, base: &Params) -> Result<Factor, SpecError> {
-    let syntax = |reason: &str| SpecError::Syntax {
-        spec: spec.to_string(),
-        reason: reason.to_string(),
-    };
+    let syntax = |reason: &str| syntax(spec, reason);
     let (name, rest) = match spec.split_once('=') {
         Some((n, r)) => (n.trim(), Some(r.trim())),
         None => (spec.trim(), None),
@@ -135,9 +132,8 @@ pub fn parse(spec: &str, base: &Params) -> Result<Factor, SpecError> {
         name: name.to_string(),
         known: PARAMS.iter().map(|s| s.name).collect::<Vec<_>>().join(", "),
     })?;
-    let base_value = registered.get(base);
     let Some(rest) = rest else {
-        let v = base_value.ok_or_else(|| SpecError::Bound {
+        let v = registered.get(base).ok_or_else(|| SpecError::Bound {
             spec: spec.to_string(),
             source: crate::model::ParamError::NotApplicable {
                 name: registered.name,
@@ -162,6 +158,26 @@ pub fn parse(spec: &str, base: &Params) -> Result<Factor, SpecError> {
             .map_err(|_| syntax(&format!("{what} `{}` is not a number", s.trim())))
     };
     let (low, high) = (number(low, "LOW")?, number(high, "HIGH")?);
+    let (scale, levels) = options(spec, parts)?;
+    let factor = Factor::new(registered.name, low, high, scale, levels).map_err(|e| e.of(spec))?;
+    physical(spec, registered, low, high, base)?;
+    Ok(factor)
+}
+
+/// A syntax error of `spec`.
+fn syntax(spec: &str, reason: &str) -> SpecError {
+    SpecError::Syntax {
+        spec: spec.to_string(),
+        reason: reason.to_string(),
+    }
+}
+
+/// The scale and the number of levels of `spec`'s options after its range (each
+/// at most once; linear and [`DEFAULT_LEVELS`] where absent).
+fn options<'a>(
+    spec: &str,
+    parts: impl Iterator<Item = &'a str>,
+) -> Result<(Scale, usize), SpecError> {
     let (mut scale, mut levels) = (None, None);
     for option in parts {
         let (slot, what) = match option.trim() {
@@ -169,52 +185,44 @@ pub fn parse(spec: &str, base: &Params) -> Result<Factor, SpecError> {
             "lin" => (scale.replace(Scale::Lin).is_some(), "the scale"),
             other => {
                 let n = other.parse().map_err(|_| {
-                    syntax(&format!(
-                        "`{other}` is neither `log`, `lin` nor a number of levels"
-                    ))
+                    syntax(
+                        spec,
+                        &format!("`{other}` is neither `log`, `lin` nor a number of levels"),
+                    )
                 })?;
                 (levels.replace(n).is_some(), "the number of levels")
             }
         };
         if slot {
-            return Err(syntax(&format!(
-                "{what} is given twice: write NAME=LOW..HIGH[:log][:LEVELS] with each once"
-            )));
+            return Err(syntax(
+                spec,
+                &format!(
+                    "{what} is given twice: write NAME=LOW..HIGH[:log][:LEVELS] with each once"
+                ),
+            ));
         }
     }
-    let (scale, levels) = (
+    Ok((
         scale.unwrap_or(Scale::Lin),
         levels.unwrap_or(DEFAULT_LEVELS),
-    );
-    let rename = |e: SpecError| match e {
-        SpecError::EmptyRange { low, high, .. } => SpecError::EmptyRange {
-            spec: spec.to_string(),
-            low,
-            high,
-        },
-        SpecError::LogBounds { low, high, .. } => SpecError::LogBounds {
-            spec: spec.to_string(),
-            low,
-            high,
-        },
-        SpecError::Levels { levels, .. } => SpecError::Levels {
-            spec: spec.to_string(),
-            levels,
-        },
-        SpecError::Syntax { reason, .. } => SpecError::Syntax {
-            spec: spec.to_string(),
-            reason,
-        },
-        other => other,
-    };
-    let factor = Factor::new(registered.name, low, high, scale, levels).map_err(rename)?;
-    // The whole range, not only its ends, must be physical values of this parameter
-    // (a ratio from −1 to 1 passes through 0), each end on this topology.
+    ))
+}
+
+/// Whether the whole range `low..high`, not only its ends, holds physical values of
+/// the parameter (a ratio from −1 to 1 passes through 0), each end on `base`'s
+/// topology.
+fn physical(
+    spec: &str,
+    registered: &registry::ParamSpec,
+    low: f64,
+    high: f64,
+    base: &Params,
+) -> Result<(), SpecError> {
     if let Some(fault) = registered
         .constraint
         .range_fault(low.min(high), low.max(high))
     {
-        return Err(syntax(fault));
+        return Err(syntax(spec, fault));
     }
     for v in [low, high] {
         let mut p = base.clone();
@@ -225,7 +233,22 @@ pub fn parse(spec: &str, base: &Params) -> Result<Factor, SpecError> {
                 source,
             })?;
     }
-    Ok(factor)
+    Ok(())
+}
+
+impl SpecError {
+    /// The error as the specification `spec` gave it ([`Factor::new`] names the
+    /// range it was given).
+    fn of(self, spec: &str) -> SpecError {
+        let spec = spec.to_string();
+        match self {
+            SpecError::EmptyRange { low, high, .. } => SpecError::EmptyRange { spec, low, high },
+            SpecError::LogBounds { low, high, .. } => SpecError::LogBounds { spec, low, high },
+            SpecError::Levels { levels, .. } => SpecError::Levels { spec, levels },
+            SpecError::Syntax { reason, .. } => SpecError::Syntax { spec, reason },
+            other => other,
+        }
+    }
 }
 
 /// Parses every specification; a parameter may appear once.
